@@ -1,0 +1,49 @@
+"""Dependency direction (STYLE B1): core packages never import cli or viz, and
+terrain <- planning <- deconfliction; vehicle <- optimization; mission -> everything."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+SRC = Path(__file__).parents[1] / "src" / "auvplan"
+
+# package -> auvplan subpackages it must NOT import
+FORBIDDEN = {
+    "terrain": {"planning", "deconfliction", "vehicle", "optimization", "mission", "cli", "viz"},
+    "planning": {"deconfliction", "vehicle", "optimization", "mission", "cli", "viz"},
+    "deconfliction": {"vehicle", "optimization", "mission", "cli", "viz"},
+    "vehicle": {"terrain", "planning", "deconfliction", "optimization", "mission", "cli", "viz"},
+    "optimization": {"terrain", "planning", "deconfliction", "mission", "cli", "viz"},
+    "io": {"mission", "cli", "viz", "optimization"},
+    "mission": {"cli", "viz"},
+    "viz": {"cli"},
+}
+
+
+def _imported_subpackages(path: Path) -> set[str]:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    found: set[str] = set()
+    for node in ast.walk(tree):
+        names: list[str] = []
+        if isinstance(node, ast.Import):
+            names = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names = [node.module]
+        for name in names:
+            parts = name.split(".")
+            if parts[0] == "auvplan" and len(parts) > 1:
+                found.add(parts[1])
+    return found
+
+
+@pytest.mark.parametrize("package", sorted(FORBIDDEN))
+def test_dependency_direction(package: str) -> None:
+    offenders = {
+        str(path.relative_to(SRC)): bad
+        for path in sorted((SRC / package).rglob("*.py"))
+        if (bad := _imported_subpackages(path) & FORBIDDEN[package])
+    }
+    assert not offenders, f"{package} imports forbidden subpackages: {offenders}"
