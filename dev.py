@@ -6,7 +6,7 @@ Usage::
     python3 dev.py demo        # set up, then run the default mission (`auvplan demo -o out/demo`)
     python3 dev.py test        # set up, then lint (ruff), type-check (mypy) and run the fast tests
     python3 dev.py test-slow   # the slow tests (end-to-end missions)
-    python3 dev.py bench       # the benchmarks in benchmarks/, side by side with the reference tools
+    python3 dev.py bench       # benchmarks, side by side with the reference tools
     python3 dev.py run ARGS    # any `auvplan` command inside the environment
 
 Needs only Python >= 3.11 with pip and venv. The environment lives in ``.venv`` and is
