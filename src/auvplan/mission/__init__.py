@@ -1,0 +1,7 @@
+"""Missions: the TOML mission file, the end-to-end pipeline and its results."""
+
+from __future__ import annotations
+
+from auvplan.mission.config import MissionConfig, load_mission, parse_mission
+
+__all__ = ["MissionConfig", "load_mission", "parse_mission"]
