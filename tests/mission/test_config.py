@@ -83,8 +83,10 @@ def test_geographic_poses_and_window() -> None:
         ("", ("heading_deg = 90.0", "heading = 90.0"), "vehicle[0].start.heading"),
         ("", ("goal = { north = 380.0, east = 420.0 }", "goal = { north = 380.0 }"), "goal"),
         (
-            '[[vehicle]]\nname = "blue"\nstart = { north = 0.0, east = 0.0 }\n'
-            "goal = { north = 1.0, east = 1.0 }\n",
+            (
+                '[[vehicle]]\nname = "blue"\nstart = { north = 0.0, east = 0.0 }\n'
+                "goal = { north = 1.0, east = 1.0 }\n"
+            ),
             None,
             "unique",
         ),
