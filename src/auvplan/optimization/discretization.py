@@ -183,9 +183,9 @@ class DiscreteModel:
         >>> f = ca.Function("f", [x, u, p], [-x + u])
         >>> l = ca.Function("l", [x, u, p], [x**2 + u**2])
         >>> model = discretize_rk4(f, l, 0.1)
-        >>> model.step(np.ones((2, 1)), np.zeros((2, 1)), np.zeros((2, 0))).round(6)
-        array([[0.904837],
-               [0.904837]])
+        >>> model.step(np.ones((2, 1)), np.zeros((2, 1)), np.zeros((2, 0))).round(7)
+        array([[0.9048375],
+               [0.9048375]])
         """
         n_stages, xs, us, ps = self._inputs(states, inputs, parameters)
         out = self._map(self.step_function, n_stages)(xs, us, ps)
