@@ -1,0 +1,139 @@
+"""Figures of a planned mission: the paper's Fig. 6, time series and pairwise separation.
+
+East is drawn to the right and north up, with equal aspect; all functions return a
+:class:`matplotlib.figure.Figure` and touch no global pyplot state.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+from matplotlib.colors import Colormap
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle, Polygon
+
+from auvplan._typing import FloatArray
+from auvplan.terrain.grid import BathymetryGrid
+
+VEHICLE_COLORS = ("tab:blue", "tab:green", "tab:orange", "tab:purple", "tab:red", "tab:brown")
+
+
+def _color(index: int) -> str:
+    return VEHICLE_COLORS[index % len(VEHICLE_COLORS)]
+
+
+def plot_mission_paths(
+    bathymetry: BathymetryGrid,
+    names: Sequence[str],
+    planned: Sequence[FloatArray],
+    optimized: Sequence[FloatArray] | None,
+    *,
+    safety_radius: float,
+    circles: FloatArray | None = None,
+    polygons: Sequence[FloatArray] = (),
+    background: FloatArray | None = None,
+    background_label: str = "depth [m]",
+    cmap: str | Colormap = "viridis_r",
+    title: str = "",
+) -> Figure:
+    """The paper's Fig. 6: pre-planned paths and optimised trajectories over the bathymetry.
+
+    Parameters
+    ----------
+    bathymetry : BathymetryGrid
+        Grid whose depth (or ``background``, same shape) is drawn.
+    names : sequence of str
+        Vehicle names.
+    planned : sequence of ndarray of shape (n_i, 2)
+        Pre-planned paths, ``north, east`` [m] (drawn dashed, pink as in the paper).
+    optimized : sequence of ndarray of shape (n_t, 2) or None
+        Optimised trajectories (solid, per-vehicle colour), with start/goal markers and safety
+        circles of radius ``safety_radius`` at both ends.
+    safety_radius : float
+        ``r_c`` [m].
+    circles : ndarray of shape (n, 3), optional
+        Circular obstacles ``north, east, radius`` [m].
+    polygons : sequence of ndarray of shape (n_k, 2)
+        Polygon obstacles, vertices ``north, east`` [m].
+    background : ndarray, optional
+        Field to draw instead of depth (e.g. the cost map on its own grid is not supported:
+        pass a field on the bathymetry grid).
+    """
+    figure = Figure(figsize=(9.0, 5.5), layout="constrained")
+    axes = figure.add_subplot()
+    g = bathymetry.geometry
+    field = bathymetry.depth if background is None else background
+    mesh = axes.pcolormesh(g.east, g.north, field, cmap=cmap, shading="nearest")
+    figure.colorbar(mesh, ax=axes, label=background_label, shrink=0.85)
+    if background is None:
+        finite = bathymetry.depth[np.isfinite(bathymetry.depth)]
+        if finite.size and np.ptp(finite) > 0:
+            axes.contour(g.east, g.north, bathymetry.depth, levels=12, colors="k",
+                         linewidths=0.4, alpha=0.5)  # fmt: skip
+    for k, path in enumerate(planned):
+        axes.plot(path[:, 1], path[:, 0], "--", color="hotpink", lw=1.6,
+                  label="pre-planned" if k == 0 else None)  # fmt: skip
+    if optimized is not None:
+        for k, (name, track) in enumerate(zip(names, optimized, strict=True)):
+            axes.plot(track[:, 1], track[:, 0], "-", color=_color(k), lw=2.0, label=name)
+            for point, marker in ((track[0], "o"), (track[-1], "*")):
+                axes.plot(point[1], point[0], marker, color=_color(k), ms=9, mec="k")
+                axes.add_patch(Circle((point[1], point[0]), safety_radius, fill=False,
+                                      ec=_color(k), lw=1.0))  # fmt: skip
+    for north, east, radius in np.asarray(circles if circles is not None else []).reshape(-1, 3):
+        axes.add_patch(Circle((east, north), radius, fc="0.3", ec="k", alpha=0.7))
+    for vertices in polygons:
+        axes.add_patch(Polygon(np.column_stack([vertices[:, 1], vertices[:, 0]]), fc="0.3",
+                               ec="k", alpha=0.7))  # fmt: skip
+    axes.set_aspect("equal")
+    axes.set_xlabel("east [m]")
+    axes.set_ylabel("north [m]")
+    axes.set_xlim(*g.east_bounds)
+    axes.set_ylim(*g.north_bounds)
+    axes.legend(loc="upper left", fontsize="small")
+    axes.set_title(title or "Pre-planned paths (dashed) and optimised trajectories")
+    return figure
+
+
+def plot_time_series(
+    time: FloatArray, names: Sequence[str], states: FloatArray, power: FloatArray
+) -> Figure:
+    """Surge/sway speed, yaw rate, propeller speeds and electrical power against time.
+
+    ``states`` has shape ``(n_vehicles, n_t, 8)``; ``power`` ``(n_vehicles, n_t)`` [W].
+    """
+    figure = Figure(figsize=(9.0, 9.0), layout="constrained")
+    axes = figure.subplots(4, 1, sharex=True)
+    for k, name in enumerate(names):
+        color = _color(k)
+        axes[0].plot(time, states[k, :, 3], color=color, label=f"{name} u")
+        axes[0].plot(time, states[k, :, 4], ":", color=color, label=f"{name} v")
+        axes[1].plot(time, states[k, :, 5], color=color, label=name)
+        axes[2].plot(time, states[k, :, 6], color=color, label=f"{name} port")
+        axes[2].plot(time, states[k, :, 7], "--", color=color, label=f"{name} starboard")
+        axes[3].plot(time, power[k], color=color, label=name)
+    labels = ("speed [m/s]", "yaw rate [rad/s]", "propeller [rev/s]", "electrical power [W]")
+    for ax, label in zip(axes, labels, strict=True):
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize="small", ncol=2)
+    axes[-1].set_xlabel("time [s]")
+    return figure
+
+
+def plot_separation(
+    time: FloatArray, separations: Mapping[str, FloatArray], minimum: float
+) -> Figure:
+    """Pairwise (and vehicle-obstacle) separation [m] against time with the limit ``minimum``."""
+    figure = Figure(figsize=(9.0, 4.0), layout="constrained")
+    axes = figure.add_subplot()
+    for k, (label, distance) in enumerate(separations.items()):
+        axes.plot(time, distance, color=_color(k), label=label)
+    axes.axhline(minimum, color="r", ls="--", label=f"2 r_c = {minimum:g} m")
+    axes.set_xlabel("time [s]")
+    axes.set_ylabel("separation [m]")
+    axes.set_yscale("log")
+    axes.grid(alpha=0.3, which="both")
+    axes.legend(fontsize="small")
+    return figure
