@@ -1,0 +1,118 @@
+"""``summary.json``: every number needed to verify a plan without rerunning it (SPEC §8)."""
+
+from __future__ import annotations
+
+import dataclasses
+from enum import Enum
+from typing import Any
+
+import numpy as np
+
+from auvplan import __version__
+from auvplan.mission.pipeline import MissionResult, OptimizedPlan
+
+
+def _record(record: Any) -> Any:
+    """A per-iteration history record as plain JSON values (enums by name)."""
+    if dataclasses.is_dataclass(record) and not isinstance(record, type):
+        return {
+            key: (value.name if isinstance(value, Enum) else value)
+            for key, value in dataclasses.asdict(record).items()
+        }
+    return record
+
+
+def _plan_summary(plan: OptimizedPlan, names: tuple[str, ...]) -> dict[str, Any]:
+    result = plan.result
+    return {
+        "terrain_weight": plan.terrain_weight,
+        "status": result.status.name,
+        "message": result.message,
+        "n_iter": result.n_iter,
+        "cost": result.cost,
+        "history": [_record(record) for record in result.history],
+        "vehicles": {
+            name: {
+                "energy_J": float(plan.energy[i]),
+                "mean_terrain_information": float(plan.terrain_information[i]),
+                "arrival_error_m": float(plan.arrival_error[i]),
+                "min_separation_m": plan.separations[name],
+            }
+            for i, name in enumerate(names)
+        },
+        "total_energy_J": float(np.sum(plan.energy)),
+    }
+
+
+def _pose(pose: np.ndarray) -> dict[str, float]:
+    return {"north": float(pose[0]), "east": float(pose[1]), "heading_rad": float(pose[2])}
+
+
+def mission_summary(result: MissionResult) -> dict[str, Any]:
+    """Build the ``summary.json`` document of a mission run."""
+    config = result.config
+    preplan = result.preplan
+    maps = preplan.maps
+    grid = preplan.bathymetry.geometry
+    summary: dict[str, Any] = {
+        "auvplan_version": __version__,
+        "mission": None if config.source is None else str(config.source),
+        "stage": result.stage.value,
+        "terrain": {
+            "name": preplan.bathymetry.name,
+            "shape": list(grid.shape),
+            "spacing_m": [grid.spacing_north, grid.spacing_east],
+            "cost_grid_shape": list(maps.cost_geometry.shape),
+            "cost_grid_spacing_m": [
+                maps.cost_geometry.spacing_north,
+                maps.cost_geometry.spacing_east,
+            ],
+            "map_parameters": dataclasses.asdict(maps.parameters),
+        },
+        "fleet": {
+            "safety_radius_m": config.fleet.safety_radius,
+            "edge_model": config.edge_model,
+            "deconfliction_method": config.deconfliction.method,
+        },
+        "vehicles": [],
+        "wall_time_s": dict(result.timings),
+    }
+    for i, name in enumerate(preplan.names):
+        route = preplan.routes[i]
+        vehicle: dict[str, Any] = {
+            "name": name,
+            "type": config.vehicles[i].type,
+            "start": _pose(preplan.starts[i]),
+            "goal": _pose(preplan.goals[i]),
+            "preplan": {
+                "cells": route.cells,
+                "graph_cost": route.cost,
+                "n_expanded": route.n_expanded,
+                "points_north_east_m": route.points,
+                "smoothed_length_m": float(np.sum(np.hypot(*np.diff(preplan.paths[i], axis=0).T))),
+            },
+        }
+        summary["vehicles"].append(vehicle)
+    stage2 = result.deconfliction
+    if stage2 is not None:
+        coordination = stage2.coordination
+        summary["deconfliction"] = {
+            "horizon_s": stage2.horizon,
+            "status": coordination.status.name,
+            "message": coordination.message,
+            "objective": coordination.objective,
+            "n_expanded": coordination.n_expanded,
+            "certified_min_separation_m": coordination.min_separation,
+        }
+        for i, vehicle in enumerate(summary["vehicles"]):
+            vehicle["timing"] = {
+                "nominal_speed_m_s": stage2.cruise_speeds[i],
+                "arrival_time_s": coordination.arrival_times[i],
+                "delay_s": coordination.delays[i],
+                "time_law": {"t_s": coordination.time, "progress_m": coordination.progress[i]},
+            }
+    if result.plan is not None:
+        summary["optimization"] = _plan_summary(result.plan, preplan.names)
+    if result.energy_only is not None:
+        summary["energy_only"] = _plan_summary(result.energy_only, preplan.names)
+    return summary
