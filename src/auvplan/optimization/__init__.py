@@ -1,10 +1,19 @@
 """Trajectory optimisation: discrete-time PRONTO with approximate-barrier constraints.
 
-The public names are listed in ``__all__``; see ``reference/pronto.md`` for the algorithm.
+Build a :class:`TrajectoryProblem` from CasADi Functions (continuous dynamics, running-cost
+rate, terminal cost, path constraints ``c >= 0``) and call :func:`solve_pronto`;
+:func:`solve_ipopt` solves the identical discretised problem with CasADi + IPOPT.
+The algorithm is documented in ``reference/pronto.md`` (§6, §7, §11).
 """
 
 from __future__ import annotations
 
+from auvplan.optimization.barrier import (
+    barrier_expression,
+    composed_barrier,
+    hockey_stick,
+    log_barrier,
+)
 from auvplan.optimization.discretization import (
     ConstraintModel,
     DiscreteModel,
@@ -13,12 +22,74 @@ from auvplan.optimization.discretization import (
     discretize_rk4,
     make_terminal_cost,
 )
+from auvplan.optimization.problem import PathConstraint, Trajectory, TrajectoryProblem
+from auvplan.optimization.pronto import (
+    ArmijoResult,
+    CostParts,
+    DerivativeCheck,
+    DirectionType,
+    Linearization,
+    LqDirection,
+    ProntoIteration,
+    ProntoModel,
+    ProntoOptions,
+    ProntoResult,
+    ProntoStatus,
+    StageWeights,
+    armijo_step,
+    build_model,
+    compute_costate,
+    converged,
+    convexify,
+    derivative_check,
+    design_regulator,
+    evaluate_cost,
+    linearize,
+    project,
+    project_guess,
+    second_order_weights,
+    solve_lq_direction,
+    solve_pronto,
+)
 
 __all__ = [
+    "ArmijoResult",
     "ConstraintModel",
+    "CostParts",
+    "DerivativeCheck",
+    "DirectionType",
     "DiscreteModel",
+    "Linearization",
+    "LqDirection",
+    "PathConstraint",
+    "ProntoIteration",
+    "ProntoModel",
+    "ProntoOptions",
+    "ProntoResult",
+    "ProntoStatus",
+    "StageWeights",
     "TerminalCost",
+    "Trajectory",
+    "TrajectoryProblem",
+    "armijo_step",
+    "barrier_expression",
+    "build_model",
+    "composed_barrier",
+    "compute_costate",
+    "converged",
+    "convexify",
+    "derivative_check",
+    "design_regulator",
     "discretize_constraints",
     "discretize_rk4",
+    "evaluate_cost",
+    "hockey_stick",
+    "linearize",
+    "log_barrier",
     "make_terminal_cost",
+    "project",
+    "project_guess",
+    "second_order_weights",
+    "solve_lq_direction",
+    "solve_pronto",
 ]

@@ -1,0 +1,159 @@
+"""Sequential recursions of discrete-time PRONTO, compiled with numba.
+
+Only the backward Riccati sweeps, the costate recursion and the forward LQ pass are
+sequential; everything else is batched. All arrays are C-contiguous float64, time-major.
+Equations: ``reference/pronto.md`` §6.1–§6.3.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from auvplan._typing import FloatArray
+
+
+@numba.njit(cache=True)
+def _cholesky(matrix: FloatArray) -> tuple[FloatArray, bool]:
+    """Lower Cholesky factor of a symmetric matrix; ``ok`` is False unless strictly PD."""
+    n = matrix.shape[0]
+    lower = np.zeros((n, n))
+    for j in range(n):
+        diag = matrix[j, j]
+        for k in range(j):
+            diag -= lower[j, k] * lower[j, k]
+        if not diag > 0.0:  # also catches NaN
+            return lower, False
+        lower[j, j] = np.sqrt(diag)
+        for i in range(j + 1, n):
+            value = matrix[i, j]
+            for k in range(j):
+                value -= lower[i, k] * lower[j, k]
+            lower[i, j] = value / lower[j, j]
+    return lower, True
+
+
+@numba.njit(cache=True)
+def _cholesky_solve(lower: FloatArray, rhs: FloatArray) -> FloatArray:
+    """Solve ``(L Lᵀ) X = rhs`` for a 2-D right-hand side."""
+    n, m = rhs.shape
+    out = rhs.copy()
+    for c in range(m):
+        for i in range(n):
+            value = out[i, c]
+            for k in range(i):
+                value -= lower[i, k] * out[k, c]
+            out[i, c] = value / lower[i, i]
+        for i in range(n - 1, -1, -1):
+            value = out[i, c]
+            for k in range(i + 1, n):
+                value -= lower[k, i] * out[k, c]
+            out[i, c] = value / lower[i, i]
+    return out
+
+
+@numba.njit(cache=True)
+def regulator_riccati(
+    a_mat: FloatArray, b_mat: FloatArray, q_r: FloatArray, r_r: FloatArray, p_final: FloatArray
+) -> tuple[FloatArray, bool]:
+    """Time-varying discrete LQR gains ``K_k = M⁻¹ Bᵀ P_{k+1} A`` (pronto.md §6.1).
+
+    Returns the gains ``(N, n_u, n_x)`` and ``ok`` (False if some ``M_k`` was not PD).
+    """
+    n_stages, n_x, n_u = b_mat.shape
+    gains = np.zeros((n_stages, n_u, n_x))
+    p_next = p_final.copy()
+    ok = True
+    for k in range(n_stages - 1, -1, -1):
+        a = a_mat[k]
+        b = b_mat[k]
+        pb = p_next @ b
+        m = r_r + b.T @ pb
+        lower, is_pd = _cholesky(0.5 * (m + m.T))
+        if not is_pd:
+            ok = False
+            break
+        g = pb.T @ a
+        gain = _cholesky_solve(lower, g)
+        gains[k] = gain
+        p = q_r + a.T @ p_next @ a - g.T @ gain
+        p_next = 0.5 * (p + p.T)
+    return gains, ok
+
+
+@numba.njit(cache=True)
+def closed_loop_costate(
+    a_mat: FloatArray,
+    b_mat: FloatArray,
+    gains: FloatArray,
+    l_x: FloatArray,
+    l_u: FloatArray,
+    lam_final: FloatArray,
+) -> FloatArray:
+    """Costate ``λ_k = a_k − K_kᵀ b_k + (A_k − B_k K_k)ᵀ λ_{k+1}``, ``λ_N = m_x`` (§6.2)."""
+    n_stages, n_x, _ = b_mat.shape
+    lam = np.zeros((n_stages + 1, n_x))
+    lam[n_stages] = lam_final
+    for k in range(n_stages - 1, -1, -1):
+        closed = a_mat[k] - b_mat[k] @ gains[k]
+        lam[k] = l_x[k] - gains[k].T @ l_u[k] + closed.T @ lam[k + 1]
+    return lam
+
+
+@numba.njit(cache=True)
+def lq_backward(
+    a_mat: FloatArray,
+    b_mat: FloatArray,
+    q_mat: FloatArray,
+    s_mat: FloatArray,
+    r_mat: FloatArray,
+    l_x: FloatArray,
+    l_u: FloatArray,
+    p_final: FloatArray,
+    r_final: FloatArray,
+) -> tuple[FloatArray, FloatArray, int]:
+    """Discrete Riccati with cross term for the LQ direction (§6.3).
+
+    Returns the feedback ``K^o (N, n_u, n_x)``, feed-forward ``v^o (N, n_u)`` and the stage
+    index at which ``M_k = R_k + B_kᵀ P B_k`` failed the Cholesky test (``-1`` if none).
+    """
+    n_stages, n_x, n_u = b_mat.shape
+    feedback = np.zeros((n_stages, n_u, n_x))
+    feedforward = np.zeros((n_stages, n_u))
+    p = p_final.copy()
+    r = r_final.copy()
+    for k in range(n_stages - 1, -1, -1):
+        a = a_mat[k]
+        b = b_mat[k]
+        pb = p @ b
+        m = r_mat[k] + b.T @ pb
+        lower, is_pd = _cholesky(0.5 * (m + m.T))
+        if not is_pd:
+            return feedback, feedforward, k
+        g_mat = s_mat[k].T + pb.T @ a
+        g_vec = l_u[k] + b.T @ r
+        rhs = np.empty((n_u, n_x + 1))
+        rhs[:, :n_x] = g_mat
+        rhs[:, n_x] = g_vec
+        sol = _cholesky_solve(lower, rhs)
+        gain = sol[:, :n_x].copy()
+        feedback[k] = gain
+        feedforward[k] = -sol[:, n_x]
+        p_new = q_mat[k] + a.T @ p @ a - g_mat.T @ gain
+        r = l_x[k] + a.T @ r - gain.T @ g_vec
+        p = 0.5 * (p_new + p_new.T)
+    return feedback, feedforward, -1
+
+
+@numba.njit(cache=True)
+def lq_forward(
+    a_mat: FloatArray, b_mat: FloatArray, feedback: FloatArray, feedforward: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Forward pass ``v_k = v^o_k − K^o_k z_k``, ``z_{k+1} = A_k z_k + B_k v_k``, ``z_0 = 0``."""
+    n_stages, n_x, n_u = b_mat.shape
+    z = np.zeros((n_stages + 1, n_x))
+    v = np.zeros((n_stages, n_u))
+    for k in range(n_stages):
+        v[k] = feedforward[k] - feedback[k] @ z[k]
+        z[k + 1] = a_mat[k] @ z[k] + b_mat[k] @ v[k]
+    return z, v

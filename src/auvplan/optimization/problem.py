@@ -1,0 +1,228 @@
+r"""Trajectory-optimisation problem definition: dynamics, costs, constraints, trajectories.
+
+The discrete problem solved by :func:`~auvplan.optimization.pronto.solve_pronto` and by the
+IPOPT bridge is
+
+.. math::
+
+    \min_{x, u}\; \sum_{k=0}^{N-1} \Big[ L(x_k, u_k, p_k)
+        + ε\, dt \sum_j b_j\big(c_j(x_k, u_k, p_k) / \text{scale}_j\big) \Big] + m(x_N)
+    \quad \text{s.t.}\quad x_{k+1} = F(x_k, u_k, p_k),\; x_0 = x0,
+
+with ``F`` one RK4 step and ``L`` the RK4 quadrature of the running-cost rate (see
+:mod:`auvplan.optimization.discretization`), ``b_j`` the approximate log barrier composed with
+the hockey stick (``kind="hockey"``) or not (``kind="plain"``), see
+:mod:`auvplan.optimization.barrier`. Path constraints are imposed at the nodes
+``k = 0..N-1`` (where an input exists); ``x_N`` is steered by the terminal cost.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+import casadi as ca
+import numpy as np
+
+from auvplan._typing import FloatArray
+from auvplan.errors import InputError
+
+__all__ = ["PathConstraint", "Trajectory", "TrajectoryProblem"]
+
+
+@dataclass(frozen=True)
+class PathConstraint:
+    """A path constraint ``c(x, u, p) >= 0`` (component-wise) handled by a barrier.
+
+    Attributes
+    ----------
+    function : casadi.Function
+        ``c(x[n_x], u[n_u], p[n_p]) -> (n_c,)``; feasible when every component is ``>= 0``.
+    kind : {"plain", "hockey"}
+        ``"hockey"`` composes the barrier with the hockey stick ``σ`` so it vanishes far
+        from the constraint (use for non-convex constraints such as separations);
+        ``"plain"`` uses ``β_δ(s)`` directly (convex constraints such as input bounds).
+    scale : float
+        Slack scale: the barrier sees ``s = c / scale``; choose it so that ``s ≈ 1`` is a
+        meaningful margin (unit of ``c``).
+    name : str
+        Label used in logs and results.
+    """
+
+    function: ca.Function
+    kind: Literal["plain", "hockey"] = "hockey"
+    scale: float = 1.0
+    name: str = "constraint"
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.function, ca.Function):
+            raise InputError(
+                f"PathConstraint.function must be a casadi.Function, got {self.function!r}"
+            )
+        if self.kind not in ("plain", "hockey"):
+            raise InputError(f"PathConstraint.kind must be 'plain' or 'hockey', got {self.kind!r}")
+        if not (np.isfinite(self.scale) and self.scale > 0.0):
+            raise InputError(f"PathConstraint.scale must be positive, got {self.scale!r}")
+
+    @property
+    def n_components(self) -> int:
+        """Number of constraint components ``n_c``."""
+        return int(self.function.numel_out(0))
+
+
+def _as_matrix(value: FloatArray, size: int, name: str) -> FloatArray:
+    array = np.asarray(value, dtype=np.float64)
+    if array.shape == (size,):
+        array = np.diag(array)
+    if array.shape != (size, size) or not np.all(np.isfinite(array)):
+        raise InputError(f"{name} must be ({size},) or ({size}, {size}) finite, got {array.shape}")
+    array = 0.5 * (array + array.T)
+    if np.min(np.linalg.eigvalsh(array)) <= 0.0:
+        raise InputError(f"{name} must be positive definite")
+    return array
+
+
+@dataclass(frozen=True)
+class TrajectoryProblem:
+    """Fixed-horizon optimal-control problem on a uniform RK4 grid.
+
+    Attributes
+    ----------
+    dynamics : casadi.Function
+        ``f(x[n_x], u[n_u], p[n_p]) -> xdot[n_x]`` (continuous time).
+    running_cost : casadi.Function
+        ``l(x, u, p) -> scalar``: cost rate (cost unit per second).
+    terminal_cost : casadi.Function
+        ``m(x[n_x]) -> scalar``.
+    initial_state : ndarray of shape (n_x,)
+        ``x0``.
+    dt : float
+        Step length [s].
+    n_steps : int
+        Number of stages ``N`` (horizon ``T = N dt``).
+    stage_parameters : ndarray of shape (n_steps, n_p)
+        Per-stage parameters ``p_k`` (held over the step); default: no parameters.
+    constraints : tuple of PathConstraint
+        Path constraints, imposed at nodes ``k = 0..N-1``.
+    regulator_Q : ndarray of shape (n_x, n_x) or (n_x,)
+        State weight of the projection regulator (diagonal when 1-D); default identity.
+    regulator_R : ndarray of shape (n_u, n_u) or (n_u,)
+        Input weight of the projection regulator; default identity.
+    """
+
+    dynamics: ca.Function
+    running_cost: ca.Function
+    terminal_cost: ca.Function
+    initial_state: FloatArray
+    dt: float
+    n_steps: int
+    stage_parameters: FloatArray | None = None
+    constraints: tuple[PathConstraint, ...] = ()
+    regulator_Q: FloatArray | None = field(default=None)
+    regulator_R: FloatArray | None = field(default=None)
+
+    def __post_init__(self) -> None:
+        for name in ("dynamics", "running_cost", "terminal_cost"):
+            if not isinstance(getattr(self, name), ca.Function):
+                raise InputError(f"{name} must be a casadi.Function")
+        n_x = int(self.dynamics.numel_in(0))
+        n_u = int(self.dynamics.numel_in(1))
+        n_p = int(self.dynamics.numel_in(2)) if self.dynamics.n_in() > 2 else -1
+        if self.dynamics.n_in() != 3 or n_p < 0:
+            raise InputError("dynamics must take exactly three inputs (x, u, p)")
+        if not (isinstance(self.n_steps, int | np.integer) and self.n_steps >= 1):
+            raise InputError(f"n_steps must be a positive integer, got {self.n_steps!r}")
+        if not (np.isfinite(self.dt) and self.dt > 0.0):
+            raise InputError(f"dt must be a positive number of seconds, got {self.dt!r}")
+        x0 = np.asarray(self.initial_state, dtype=np.float64).reshape(-1)
+        if x0.shape != (n_x,) or not np.all(np.isfinite(x0)):
+            raise InputError(f"initial_state must be finite with shape ({n_x},), got {x0.shape}")
+        object.__setattr__(self, "initial_state", x0)
+        params = (
+            np.zeros((self.n_steps, n_p))
+            if self.stage_parameters is None
+            else np.asarray(self.stage_parameters, dtype=np.float64)
+        )
+        if params.shape != (self.n_steps, n_p):
+            raise InputError(
+                f"stage_parameters must have shape ({self.n_steps}, {n_p}), got {params.shape}"
+            )
+        object.__setattr__(self, "stage_parameters", np.ascontiguousarray(params))
+        q_r = np.ones(n_x) if self.regulator_Q is None else self.regulator_Q
+        r_r = np.ones(n_u) if self.regulator_R is None else self.regulator_R
+        object.__setattr__(self, "regulator_Q", _as_matrix(q_r, n_x, "regulator_Q"))
+        object.__setattr__(self, "regulator_R", _as_matrix(r_r, n_u, "regulator_R"))
+        object.__setattr__(self, "constraints", tuple(self.constraints))
+        for constraint in self.constraints:
+            if not isinstance(constraint, PathConstraint):
+                raise InputError(f"constraints must be PathConstraint objects, got {constraint!r}")
+
+    @property
+    def n_states(self) -> int:
+        """State dimension ``n_x``."""
+        return int(self.dynamics.numel_in(0))
+
+    @property
+    def n_inputs(self) -> int:
+        """Input dimension ``n_u``."""
+        return int(self.dynamics.numel_in(1))
+
+    @property
+    def n_parameters(self) -> int:
+        """Stage-parameter dimension ``n_p``."""
+        return int(self.dynamics.numel_in(2))
+
+    @property
+    def parameters(self) -> FloatArray:
+        """Stage parameters as an array of shape ``(n_steps, n_p)``."""
+        assert self.stage_parameters is not None  # set in __post_init__
+        return self.stage_parameters
+
+    @property
+    def state_weight(self) -> FloatArray:
+        """Regulator state weight ``Q_r`` of shape ``(n_x, n_x)``."""
+        assert self.regulator_Q is not None
+        return self.regulator_Q
+
+    @property
+    def input_weight(self) -> FloatArray:
+        """Regulator input weight ``R_r`` of shape ``(n_u, n_u)``."""
+        assert self.regulator_R is not None
+        return self.regulator_R
+
+    @property
+    def time(self) -> FloatArray:
+        """Node times ``t_k = k dt`` [s], shape ``(n_steps + 1,)``."""
+        return np.arange(self.n_steps + 1, dtype=np.float64) * self.dt
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """States and inputs on the grid (zero-order-hold inputs).
+
+    Attributes
+    ----------
+    states : ndarray of shape (N + 1, n_x)
+        ``x_0 .. x_N``.
+    inputs : ndarray of shape (N, n_u)
+        ``u_0 .. u_{N-1}``.
+    """
+
+    states: FloatArray
+    inputs: FloatArray
+
+    def __post_init__(self) -> None:
+        states = np.ascontiguousarray(self.states, dtype=np.float64)
+        inputs = np.ascontiguousarray(self.inputs, dtype=np.float64)
+        if states.ndim != 2 or inputs.ndim != 2 or states.shape[0] != inputs.shape[0] + 1:
+            raise InputError(
+                f"Trajectory needs states (N+1, n_x) and inputs (N, n_u), got "
+                f"{states.shape} and {inputs.shape}"
+            )
+        object.__setattr__(self, "states", states)
+        object.__setattr__(self, "inputs", inputs)
+
+    @property
+    def n_steps(self) -> int:
+        """Number of stages ``N``."""
+        return int(self.inputs.shape[0])
