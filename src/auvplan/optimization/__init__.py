@@ -22,6 +22,7 @@ from auvplan.optimization.discretization import (
     discretize_rk4,
     make_terminal_cost,
 )
+from auvplan.optimization.ipopt import IpoptResult, IpoptStatus, solve_ipopt
 from auvplan.optimization.problem import PathConstraint, Trajectory, TrajectoryProblem
 from auvplan.optimization.pronto import (
     ArmijoResult,
@@ -59,6 +60,8 @@ __all__ = [
     "DerivativeCheck",
     "DirectionType",
     "DiscreteModel",
+    "IpoptResult",
+    "IpoptStatus",
     "Linearization",
     "LqDirection",
     "PathConstraint",
@@ -90,6 +93,7 @@ __all__ = [
     "project",
     "project_guess",
     "second_order_weights",
+    "solve_ipopt",
     "solve_lq_direction",
     "solve_pronto",
 ]
