@@ -1,0 +1,40 @@
+"""Temporal deconfliction of fixed paths in the coordination space (paper Sec. III-B).
+
+Given one fixed path per vehicle, find time laws (waits and slow-downs only) under which no
+two vehicles come closer than ``2 r_c``, certified in continuous time.
+"""
+
+from __future__ import annotations
+
+from auvplan.deconfliction.conflicts import ConflictTable, build_conflict_table
+from auvplan.deconfliction.coordination import deconflict
+from auvplan.deconfliction.problem import CoordinationProblem, headings_along, positions_along
+from auvplan.deconfliction.result import (
+    CoordinationResult,
+    CoordinationStatus,
+    SeparationCertificate,
+)
+from auvplan.deconfliction.schedule import (
+    arrival_times_of,
+    certify_separation,
+    retime_for_arrival,
+    timed_headings,
+    timed_positions,
+)
+
+__all__ = [
+    "ConflictTable",
+    "CoordinationProblem",
+    "CoordinationResult",
+    "CoordinationStatus",
+    "SeparationCertificate",
+    "arrival_times_of",
+    "build_conflict_table",
+    "certify_separation",
+    "deconflict",
+    "headings_along",
+    "positions_along",
+    "retime_for_arrival",
+    "timed_headings",
+    "timed_positions",
+]

@@ -1,0 +1,229 @@
+"""Numba kernels: pairwise forbidden intervals and 2-D monotone reachability.
+
+For an ordered pair ``(i, j)`` the forbidden set of the 2-D coordination grid is stored per
+row ``k_i`` as sorted, disjoint, inclusive index intervals ``[lo, hi]`` of ``k_j`` (CSR:
+``row_ptr[k_i] … row_ptr[k_i + 1]`` index into ``lo``/``hi``). A grid node is forbidden when
+``|p_i(s(k_i)) - p_j(s(k_j))| <= radius``; the caller passes the inflated radius.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from auvplan._typing import FloatArray, IntArray
+
+ROW_BLOCK = 64
+SEGMENT_BLOCK = 32
+INDEX_SLACK = 1e-9  # index units: rounding always widens a forbidden interval
+
+
+@numba.njit(cache=True)
+def _bounding_circle(points: FloatArray, first: int, stop: int) -> tuple[float, float, float]:
+    n_min = points[first, 0]
+    n_max = n_min
+    e_min = points[first, 1]
+    e_max = e_min
+    for r in range(first + 1, stop):
+        n_min = min(n_min, points[r, 0])
+        n_max = max(n_max, points[r, 0])
+        e_min = min(e_min, points[r, 1])
+        e_max = max(e_max, points[r, 1])
+    c_n = 0.5 * (n_min + n_max)
+    c_e = 0.5 * (e_min + e_max)
+    radius = 0.0
+    for r in range(first, stop):
+        radius = max(radius, np.hypot(points[r, 0] - c_n, points[r, 1] - c_e))
+    return c_n, c_e, radius
+
+
+@numba.njit(cache=True)
+def _grow(array: IntArray, size: int) -> IntArray:
+    bigger = np.empty(2 * size + 16, dtype=np.int64)
+    bigger[:size] = array[:size]
+    return bigger
+
+
+@numba.njit(cache=True)
+def pair_intervals(
+    points_i: FloatArray,
+    vertices_j: FloatArray,
+    arc_j: FloatArray,
+    step_j: float,
+    n_steps_j: int,
+    radius: float,
+) -> tuple[IntArray, IntArray, IntArray]:
+    """Forbidden ``k_j`` intervals for each grid point of vehicle ``i``.
+
+    Parameters
+    ----------
+    points_i : ndarray of shape (n_i + 1, 2)
+        Grid points of vehicle ``i`` [m].
+    vertices_j, arc_j : ndarray of shape (m_j, 2) and (m_j,)
+        Polyline of vehicle ``j`` and its cumulative arc length [m].
+    step_j : float
+        Arc-length grid step ``h_j`` [m]; ``s(k) = k h_j`` for ``k < n_j`` and ``L_j`` at ``n_j``.
+    n_steps_j : int
+        ``n_j``.
+    radius : float
+        Forbidden distance [m] (inclusive).
+
+    Returns
+    -------
+    row_ptr : ndarray of shape (n_i + 2,)
+        CSR row pointers (the extra entry repeats the end).
+    lo, hi : ndarray of shape (n_intervals,)
+        Inclusive ``k_j`` bounds.
+    """
+    n_rows = points_i.shape[0]
+    n_seg = vertices_j.shape[0] - 1
+    length_j = arc_j[-1]
+    n_sb = (n_seg + SEGMENT_BLOCK - 1) // SEGMENT_BLOCK
+    sb_n = np.empty(n_sb)
+    sb_e = np.empty(n_sb)
+    sb_r = np.empty(n_sb)
+    for b in range(n_sb):
+        first = b * SEGMENT_BLOCK
+        stop = min(n_seg, first + SEGMENT_BLOCK) + 1
+        sb_n[b], sb_e[b], sb_r[b] = _bounding_circle(vertices_j, first, stop)
+    row_ptr = np.zeros(n_rows + 2, dtype=np.int64)
+    capacity = 1024
+    out_lo = np.empty(capacity, dtype=np.int64)
+    out_hi = np.empty(capacity, dtype=np.int64)
+    count = 0
+    candidates = np.empty(n_seg, dtype=np.int64)
+    buf_lo = np.empty(n_seg + 1, dtype=np.int64)
+    buf_hi = np.empty(n_seg + 1, dtype=np.int64)
+    r2 = radius * radius
+    for block_start in range(0, n_rows, ROW_BLOCK):
+        block_stop = min(n_rows, block_start + ROW_BLOCK)
+        c_n, c_e, c_r = _bounding_circle(points_i, block_start, block_stop)
+        n_cand = 0
+        for b in range(n_sb):
+            if np.hypot(c_n - sb_n[b], c_e - sb_e[b]) <= c_r + sb_r[b] + radius:
+                for seg in range(b * SEGMENT_BLOCK, min(n_seg, (b + 1) * SEGMENT_BLOCK)):
+                    candidates[n_cand] = seg
+                    n_cand += 1
+        for r in range(block_start, block_stop):
+            row_ptr[r] = count
+            if n_cand == 0:
+                continue
+            p_n = points_i[r, 0]
+            p_e = points_i[r, 1]
+            n_buf = 0
+            for c in range(n_cand):
+                seg = candidates[c]
+                a_n = vertices_j[seg, 0]
+                a_e = vertices_j[seg, 1]
+                seg_len = arc_j[seg + 1] - arc_j[seg]
+                u_n = (vertices_j[seg + 1, 0] - a_n) / seg_len
+                u_e = (vertices_j[seg + 1, 1] - a_e) / seg_len
+                d_n = p_n - a_n
+                d_e = p_e - a_e
+                along = d_n * u_n + d_e * u_e
+                perp2 = max(d_n * d_n + d_e * d_e - along * along, 0.0)
+                if perp2 > r2:
+                    continue
+                half = np.sqrt(r2 - perp2)
+                t0 = max(along - half, 0.0)
+                t1 = min(along + half, seg_len)
+                if t0 > t1:
+                    continue
+                s0 = arc_j[seg] + t0
+                s1 = arc_j[seg] + t1
+                k_lo = max(int(np.ceil(s0 / step_j - INDEX_SLACK)), 0)
+                if s1 >= length_j * (1.0 - 1e-12):
+                    k_hi = n_steps_j
+                else:
+                    k_hi = min(int(np.floor(s1 / step_j + INDEX_SLACK)), n_steps_j - 1)
+                k_lo = min(k_lo, n_steps_j)
+                if k_lo > k_hi:
+                    continue
+                # insertion into the sorted buffer
+                pos = n_buf
+                while pos > 0 and buf_lo[pos - 1] > k_lo:
+                    buf_lo[pos] = buf_lo[pos - 1]
+                    buf_hi[pos] = buf_hi[pos - 1]
+                    pos -= 1
+                buf_lo[pos] = k_lo
+                buf_hi[pos] = k_hi
+                n_buf += 1
+            if n_buf == 0:
+                continue
+            cur_lo = buf_lo[0]
+            cur_hi = buf_hi[0]
+            for q in range(1, n_buf + 1):
+                if q < n_buf and buf_lo[q] <= cur_hi + 1:
+                    cur_hi = max(cur_hi, buf_hi[q])
+                    continue
+                if count >= capacity:
+                    out_lo = _grow(out_lo, count)
+                    out_hi = _grow(out_hi, count)
+                    capacity = out_lo.shape[0]
+                out_lo[count] = cur_lo
+                out_hi[count] = cur_hi
+                count += 1
+                if q < n_buf:
+                    cur_lo = buf_lo[q]
+                    cur_hi = buf_hi[q]
+    row_ptr[n_rows] = count
+    row_ptr[n_rows + 1] = count
+    return row_ptr, out_lo[:count].copy(), out_hi[:count].copy()
+
+
+@numba.njit(cache=True)
+def pair_reachability(
+    row_ptr: IntArray, lo: IntArray, hi: IntArray, n_i: int, n_j: int
+) -> tuple[bool, int, int]:
+    """Test whether ``(n_i, n_j)`` is reachable from ``(0, 0)`` by monotone moves on the free grid.
+
+    Moves are ``(+1, 0)``, ``(0, +1)`` and ``(+1, +1)``. Rows are swept once, each keeping
+    its reachable set as sorted intervals.
+
+    Returns
+    -------
+    reachable : bool
+    row, col : int
+        Where the sweep got stuck (the first blocked node on the frontier) when unreachable.
+    """
+    reach_lo = np.empty(n_j + 2, dtype=np.int64)
+    reach_hi = np.empty(n_j + 2, dtype=np.int64)
+    free_lo = np.empty(n_j + 2, dtype=np.int64)
+    free_hi = np.empty(n_j + 2, dtype=np.int64)
+    new_lo = np.empty(n_j + 2, dtype=np.int64)
+    new_hi = np.empty(n_j + 2, dtype=np.int64)
+    n_reach = 1
+    reach_lo[0] = 0
+    reach_hi[0] = 0  # entry point of row 0 (extended below like any entry)
+    for r in range(n_i + 1):
+        # free intervals of row r
+        n_free = 0
+        start = 0
+        for q in range(row_ptr[r], row_ptr[r + 1]):
+            if lo[q] > start:
+                free_lo[n_free] = start
+                free_hi[n_free] = lo[q] - 1
+                n_free += 1
+            start = hi[q] + 1
+        if start <= n_j:
+            free_lo[n_free] = start
+            free_hi[n_free] = n_j
+            n_free += 1
+        # entries: previous reachable set S and S + 1 (row 0: just the origin)
+        n_new = 0
+        e = 0
+        for f in range(n_free):
+            while e < n_reach and reach_hi[e] + (1 if r > 0 else 0) < free_lo[f]:
+                e += 1
+            if e < n_reach and reach_lo[e] <= free_hi[f]:
+                new_lo[n_new] = max(reach_lo[e], free_lo[f])
+                new_hi[n_new] = free_hi[f]
+                n_new += 1
+        if n_new == 0:
+            return False, r, reach_lo[0]
+        n_reach = n_new
+        reach_lo[:n_new] = new_lo[:n_new]
+        reach_hi[:n_new] = new_hi[:n_new]
+    if reach_hi[n_reach - 1] != n_j:
+        return False, n_i, reach_hi[n_reach - 1] + 1
+    return True, -1, -1

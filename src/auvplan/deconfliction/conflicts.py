@@ -1,0 +1,188 @@
+r"""Pairwise collision sets on the 2-D coordination grids, and what timing cannot solve.
+
+For a pair ``(i, j)`` the grid node ``(k_i, k_j)`` is *forbidden* when
+
+.. math::
+
+    \lVert p_i(s(k_i)) - p_j(s(k_j)) \rVert \le 2 r_c + \delta_{ij}, \qquad
+    \delta_{ij} = \tfrac12 (h_i + h_j),
+
+with ``h_i = v_i dt`` the per-step motion. The inflation ``δ_ij`` is what makes grid
+schedules safe *between* samples: if a vehicle moves at most ``h`` along its path during a
+step, the distance of a pair during a step from node ``a`` to node ``b`` is at least
+``(d_a + d_b - h_i - h_j) / 2 >= 2 r_c`` (see :func:`auvplan.deconfliction.certify_separation`).
+
+The forbidden set is stored per row ``k_i`` as sorted intervals of ``k_j`` (never as a dense
+bitmap), so a 6000 × 6000 pair grid costs a few kilobytes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from auvplan._typing import FloatArray, IntArray
+from auvplan.deconfliction._conflict_kernels import pair_intervals, pair_reachability
+from auvplan.deconfliction.problem import CoordinationProblem
+from auvplan.errors import InfeasibleError
+
+#: Relative widening of the inflated radius, so floating-point rounding stays conservative.
+RADIUS_ROUNDING = 1e-9
+
+
+@dataclass(frozen=True)
+class ConflictTable:
+    """Forbidden ``k_j`` intervals for ordered pairs ``(i, j)``, rows indexed by ``k_i``.
+
+    Parameters
+    ----------
+    n_vehicles : int
+        Number of vehicles.
+    pair_base : ndarray of shape (n_vehicles ** 2,)
+        Offset of pair ``(i, j)``'s rows in ``row_ptr`` (index ``i * n_vehicles + j``);
+        ``-1`` when the pair was not built.
+    row_ptr : ndarray
+        Concatenated CSR row pointers (absolute offsets into ``lo`` and ``hi``).
+    lo, hi : ndarray
+        Inclusive bounds of the forbidden intervals.
+    radius : ndarray of shape (n_vehicles, n_vehicles)
+        Inflated forbidden radius ``2 r_c + δ_ij`` [m] of each pair.
+    """
+
+    n_vehicles: int
+    pair_base: IntArray
+    row_ptr: IntArray
+    lo: IntArray
+    hi: IntArray
+    radius: FloatArray
+
+    def forbidden(self, i: int, j: int, k_i: int) -> list[tuple[int, int]]:
+        """Forbidden ``k_j`` intervals of row ``k_i`` of pair ``(i, j)`` (inclusive)."""
+        base = int(self.pair_base[i * self.n_vehicles + j])
+        if base < 0:
+            raise KeyError(f"pair ({i}, {j}) not in this table")
+        first, stop = self.row_ptr[base + k_i], self.row_ptr[base + k_i + 1]
+        pairs = zip(self.lo[first:stop], self.hi[first:stop], strict=True)
+        return [(int(a), int(b)) for a, b in pairs]
+
+
+def inflated_radius(problem: CoordinationProblem, i: int, j: int) -> float:
+    """Forbidden radius ``2 r_c + (h_i + h_j)/2`` [m] of pair ``(i, j)`` on the grid."""
+    step = problem.step_lengths
+    return float((problem.separation + 0.5 * (step[i] + step[j])) * (1.0 + RADIUS_ROUNDING))
+
+
+def build_conflict_table(
+    problem: CoordinationProblem, *, ordered_pairs: tuple[tuple[int, int], ...] | None = None
+) -> ConflictTable:
+    """Compute the forbidden intervals of the given ordered pairs (default: every ``i != j``).
+
+    Parameters
+    ----------
+    problem : CoordinationProblem
+        The paths and grid.
+    ordered_pairs : tuple of (int, int), optional
+        Pairs ``(i, j)`` whose rows (indexed by ``k_i``) are needed.
+
+    Returns
+    -------
+    ConflictTable
+    """
+    n = problem.n_vehicles
+    if ordered_pairs is None:
+        ordered_pairs = tuple((i, j) for i in range(n) for j in range(n) if i != j)
+    points = [problem.grid_points(i) for i in range(n)]
+    pair_base = np.full(n * n, -1, dtype=np.int64)
+    radius = np.zeros((n, n))
+    ptr_parts: list[IntArray] = []
+    lo_parts: list[IntArray] = []
+    hi_parts: list[IntArray] = []
+    n_rows_so_far = 0
+    n_intervals_so_far = 0
+    for i, j in ordered_pairs:
+        radius[i, j] = inflated_radius(problem, i, j)
+        row_ptr, lo, hi = pair_intervals(
+            points[i],
+            problem.paths[j],
+            problem.arc_lengths[j],
+            float(problem.step_lengths[j]),
+            int(problem.n_steps[j]),
+            float(radius[i, j]),
+        )
+        pair_base[i * n + j] = n_rows_so_far
+        ptr_parts.append(row_ptr + n_intervals_so_far)
+        lo_parts.append(lo)
+        hi_parts.append(hi)
+        n_rows_so_far += row_ptr.shape[0]
+        n_intervals_so_far += lo.shape[0]
+    empty = np.zeros(0, dtype=np.int64)
+    return ConflictTable(
+        n_vehicles=n,
+        pair_base=pair_base,
+        row_ptr=np.concatenate(ptr_parts) if ptr_parts else empty,
+        lo=np.concatenate(lo_parts) if lo_parts else empty,
+        hi=np.concatenate(hi_parts) if hi_parts else empty,
+        radius=radius,
+    )
+
+
+def _where(problem: CoordinationProblem, vehicle: int, k: int) -> str:
+    n_k = int(problem.n_steps[vehicle])
+    point = problem.grid_points(vehicle)[min(max(k, 0), n_k)]
+    label = "start" if k <= 0 else "goal" if k >= n_k else "path"
+    return f"vehicle {vehicle}'s {label} at (north, east) = ({point[0]:.1f}, {point[1]:.1f}) m"
+
+
+def check_endpoints(problem: CoordinationProblem) -> None:
+    """Raise if two starts or two goals are closer than ``2 r_c`` (no timing can help).
+
+    Raises
+    ------
+    InfeasibleError
+        Naming the pair and the places.
+    """
+    n = problem.n_vehicles
+    starts = np.array([path[0] for path in problem.paths])
+    goals = np.array([path[-1] for path in problem.paths])
+    for label, points in (("start", starts), ("goal", goals)):
+        for i in range(n):
+            for j in range(i + 1, n):
+                distance = float(np.hypot(*(points[i] - points[j])))
+                if distance < problem.separation:
+                    raise InfeasibleError(
+                        f"vehicles {i} and {j} both {'begin' if label == 'start' else 'end'} "
+                        f"within 2 r_c = {problem.separation:g} m of each other: "
+                        f"{label}s at (north, east) = ({points[i][0]:.1f}, {points[i][1]:.1f}) "
+                        f"and ({points[j][0]:.1f}, {points[j][1]:.1f}) m, {distance:.2f} m apart"
+                    )
+
+
+def check_pairwise_timing(problem: CoordinationProblem, table: ConflictTable) -> None:
+    """Raise if some pair alone cannot be timed apart on the grid.
+
+    A monotone path from ``(0, 0)`` to ``(n_i, n_j)`` through the free 2-D grid of each pair
+    is necessary for any N-vehicle schedule. It fails typically when a vehicle's start lies
+    within ``2 r_c`` of the other's path before the point the other must pass, or a goal on
+    the other's path after it (the vehicle would have to wait there forever).
+
+    Raises
+    ------
+    InfeasibleError
+        Naming the pair and the two places where they get stuck.
+    """
+    n = problem.n_vehicles
+    for i in range(n):
+        for j in range(i + 1, n):
+            base = int(table.pair_base[i * n + j])
+            n_i = int(problem.n_steps[i])
+            n_j = int(problem.n_steps[j])
+            row_ptr = table.row_ptr[base : base + n_i + 2]
+            reachable, row, col = pair_reachability(row_ptr, table.lo, table.hi, n_i, n_j)
+            if not reachable:
+                raise InfeasibleError(
+                    f"vehicles {i} and {j} cannot be separated by timing: "
+                    f"{_where(problem, i, row)} and {_where(problem, j, col)} are within "
+                    f"2 r_c = {problem.separation:g} m (plus grid margin "
+                    f"{table.radius[i, j] - problem.separation:.3g} m) on every schedule"
+                )
