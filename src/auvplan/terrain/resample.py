@@ -26,6 +26,9 @@ from auvplan.terrain.projection import LocalProjection
 #: projection so that a grid does not lose a row to round-off.
 _EDGE_TOLERANCE_CELLS = 0.01
 
+#: A node of a gridded point cloud is NaN when no sounding lies within this many spacings.
+_MAX_GAP_SPACINGS = 2.0
+
 
 def project_geographic_grid(
     depth: FloatArray,
@@ -169,8 +172,9 @@ def grid_scattered_points(
     BathymetryGrid
         Grid with origin ``(0, 0)`` at the south-west node ``(min north, min east)``. Values
         are linear interpolation on the Delaunay triangulation of the soundings
-        (:func:`scipy.interpolate.griddata`); nodes farther than one spacing from every
-        sounding, or outside their convex hull, are NaN.
+        (:func:`scipy.interpolate.griddata`); nodes farther than two spacings from every
+        sounding, or outside their convex hull, are NaN. (With the default spacing, a random
+        cloud has about 6 % of such gaps: P(no sounding within 2 s) = 2^-4 for a Poisson cloud.)
 
     Raises
     ------
@@ -205,7 +209,7 @@ def grid_scattered_points(
     )
     values = griddata(points, depth, (node_north, node_east), method="linear")
     gap, _ = tree.query(np.column_stack([node_north.ravel(), node_east.ravel()]))
-    values[(gap > spacing * (1.0 + 1e-9)).reshape(values.shape)] = np.nan
+    values[(gap > _MAX_GAP_SPACINGS * spacing).reshape(values.shape)] = np.nan
     shifted = None if projection is None else projection.shifted(north_min, east_min)
     return BathymetryGrid(
         np.asarray(values, dtype=np.float64), geometry, shifted, None, name, dict(attributes or {})
