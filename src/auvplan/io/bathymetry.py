@@ -169,6 +169,8 @@ def detect_format(path: Path) -> BathymetryFormat:
     """
     with path.open("rb") as stream:
         head = stream.read(4096)
+    if not head:
+        raise DataFormatError("empty file")
     if head.startswith((b"CDF\x01", b"CDF\x02", b"CDF\x05", b"\x89HDF\r\n\x1a\n")):
         return "netcdf"
     if head.startswith((b"II*\x00", b"MM\x00*", b"II+\x00", b"MM\x00+")):
