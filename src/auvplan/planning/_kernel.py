@@ -91,6 +91,28 @@ def _heuristic(
 
 
 @njit(cache=True)
+def heuristic_grid(
+    n_rows: int,
+    n_cols: int,
+    goal_row: int,
+    goal_col: int,
+    crossed: bool,
+    rate: float,
+    spacing_north: float,
+    spacing_east: float,
+) -> FloatArray:  # pragma: no cover - compiled
+    """The kernels' heuristic evaluated at every cell of an unpadded grid."""
+    diagonal = np.sqrt(spacing_north * spacing_north + spacing_east * spacing_east)
+    out = np.empty((n_rows, n_cols))
+    for row in range(n_rows):
+        for col in range(n_cols):
+            out[row, col] = _heuristic(
+                row, col, goal_row, goal_col, crossed, rate, spacing_north, spacing_east, diagonal
+            )
+    return out
+
+
+@njit(cache=True)
 def _trace_path(parent: IntArray, start: int, goal: int) -> IntArray:  # pragma: no cover
     """Flat cells from ``start`` to ``goal`` by following ``parent`` back from the goal."""
     n_path = 1

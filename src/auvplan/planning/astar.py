@@ -39,7 +39,7 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
-from auvplan.planning._kernel import astar_buckets, astar_heap, finite_range
+from auvplan.planning._kernel import astar_buckets, astar_heap, finite_range, heuristic_grid
 from auvplan.planning.problem import EdgeModel, PathResult, PlanningProblem, SearchStatus
 
 #: Largest number of buckets of the bucket queue before falling back to the binary heap.
@@ -83,6 +83,44 @@ def plan_astar(problem: PlanningProblem, *, edge_model: EdgeModel = EdgeModel.PA
     [[1, 0], [0, 1], [0, 2], [1, 3]]
     """
     return search_grid(problem, edge_model=edge_model, queue="auto")
+
+
+def heuristic_map(problem: PlanningProblem, *, edge_model: EdgeModel) -> FloatArray:
+    r"""The admissible, consistent A* heuristic at every cell (full strength, :math:`\alpha = 1`).
+
+    Parameters
+    ----------
+    problem : PlanningProblem
+        Grid and goal; :math:`c_{min}` is the smallest cost of a passable cell.
+    edge_model : EdgeModel
+        ``PAPER``: :math:`c_{min}` times the Chebyshev distance to the goal in cells.
+        ``CROSSED``: :math:`c_{min}` times the octile distance to the goal in metres.
+
+    Returns
+    -------
+    ndarray of shape (n_rows, n_cols)
+        Lower bound of the cost-to-go (dimensionless graph cost). The kernels use
+        :math:`\alpha` times this map (see the module docstring).
+
+    Examples
+    --------
+    >>> problem = PlanningProblem(np.full((2, 3), 2.0), None, (0, 0), (1, 2))
+    >>> heuristic_map(problem, edge_model=EdgeModel.PAPER)
+    array([[4., 2., 2.],
+           [4., 2., 0.]])
+    """
+    cost_min, _ = finite_range(np.where(problem.passable, problem.cost, np.inf).ravel())
+    n_rows, n_cols = problem.shape
+    return heuristic_grid(
+        n_rows,
+        n_cols,
+        int(problem.goal[0]),
+        int(problem.goal[1]),
+        edge_model is EdgeModel.CROSSED,
+        cost_min,
+        float(problem.spacing_north),
+        float(problem.spacing_east),
+    )
 
 
 def search_grid(
