@@ -1,0 +1,105 @@
+"""``auvplan vehicle``: headline characteristics of a vehicle type, and its validation figure."""
+
+from __future__ import annotations
+
+import argparse
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from auvplan.vehicle.trim import VehicleCharacteristics
+
+#: Units of the JSON fields (SI; propeller speeds in rev/s).
+UNITS = {
+    "n_max": "rev/s",
+    "bollard_thrust": "N",
+    "bollard_torque": "N m",
+    "bollard_power": "W",
+    "top_speed": "m/s",
+    "cruise_speed": "m/s",
+    "cruise_energy_per_metre": "J/m",
+    "hotel_power": "W",
+    "power_at_0_5": "W",
+    "power_at_1_0": "W",
+    "n_at_0_5": "rev/s",
+    "n_at_1_0": "rev/s",
+    "max_yaw_rate": "rad/s",
+}
+
+
+def register(subparsers: argparse._SubParsersAction[Any]) -> None:
+    """Add the ``vehicle`` verb to the command line."""
+    parser = subparsers.add_parser(
+        "vehicle",
+        help="report a vehicle type's characteristics (bollard pull, speeds, power)",
+        description="Load a vehicle type (packaged name such as 'medusa', or a vehicle TOML "
+        "file) and report bollard thrust and torque at maximum propeller speed, top speed, "
+        "energy-optimal cruise speed and its energy per metre, steady electrical power at "
+        "0.5 and 1.0 m/s, and maximum steady yaw rate.",
+    )
+    parser.add_argument(
+        "vehicle",
+        metavar="TYPE|FILE",
+        nargs="?",
+        default="medusa",
+        help="packaged vehicle type or vehicle file (default: medusa)",
+    )
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    parser.add_argument("--figure", metavar="PATH", help="write the validation figure (PNG, PDF)")
+    parser.add_argument(
+        "--order",
+        type=int,
+        metavar="K",
+        help="harmonics of the propeller series (default: the file's order, else all)",
+    )
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Compute and print the characteristics; returns the exit code."""
+    import json
+    from pathlib import Path
+
+    from auvplan.io.vehicles import load_vehicle
+    from auvplan.vehicle.dynamics import build_vehicle_model
+    from auvplan.vehicle.trim import vehicle_characteristics
+
+    params = load_vehicle(args.vehicle)
+    model = build_vehicle_model(params, propeller_order=args.order)
+    table = vehicle_characteristics(model)
+    if args.figure is not None:
+        from auvplan.viz.vehicle import plot_vehicle_validation
+
+        figure = plot_vehicle_validation(model)
+        path = Path(args.figure)
+        figure.savefig(path, dpi=120)
+    if args.json:
+        document = {"characteristics": table.to_dict(), "units": UNITS}
+        print(json.dumps(document, indent=2))
+    elif not args.quiet:
+        _print_table(table)
+    if args.figure is not None and not args.quiet and not args.json:
+        print(f"wrote                      {args.figure}")
+    return 0
+
+
+def _print_table(table: VehicleCharacteristics) -> None:
+    print(f"vehicle                    {table.name} (propeller order {table.propeller_order})")
+    print(
+        f"{f'bollard at {table.n_max:.1f} rev/s':<27}thrust {table.bollard_thrust:.2f} N, "
+        f"torque {table.bollard_torque:.3f} N m per propeller; "
+        f"electrical power {table.bollard_power:.0f} W"
+    )
+    print(f"top speed                  {table.top_speed:.3f} m/s (both propellers at n_max)")
+    print(
+        f"energy-optimal cruise      {table.cruise_speed:.3f} m/s, "
+        f"{table.cruise_energy_per_metre:.1f} J/m"
+    )
+    for speed, power, n in (
+        (0.5, table.power_at_0_5, table.n_at_0_5),
+        (1.0, table.power_at_1_0, table.n_at_1_0),
+    ):
+        print(
+            f"{f'steady power at {speed:.1f} m/s':<27}{power:.1f} W "
+            f"(hotel {table.hotel_power:.0f} W; n = {n:.1f} rev/s)"
+        )
+    print(f"max steady yaw rate        {table.max_yaw_rate:.3f} rad/s (turning on the spot)")
