@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import io
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
@@ -24,6 +24,9 @@ from auvplan.errors import AuvplanError, DataFormatError, InputError
 from auvplan.terrain.grid import BathymetryGrid, GridGeometry
 from auvplan.terrain.projection import LocalProjection
 from auvplan.terrain.resample import grid_scattered_points, project_geographic_grid
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 Vertical = Literal["auto", "elevation", "depth"]
 XyzCoordinates = Literal["auto", "geographic", "metric"]
@@ -262,10 +265,7 @@ def _read_netcdf(path: Path) -> _Raster:
     )
 
 
-def _pick_data_variable(dataset: object, lat_dim: object, lon_dim: object) -> str:
-    import xarray as xr
-
-    assert isinstance(dataset, xr.Dataset)
+def _pick_data_variable(dataset: xr.Dataset, lat_dim: Hashable, lon_dim: Hashable) -> str:
     candidates = [
         str(name)
         for name, variable in dataset.data_vars.items()
