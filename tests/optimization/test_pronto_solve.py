@@ -1,0 +1,140 @@
+"""solve_pronto against CasADi+IPOPT on the identical discretised problems."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from auvplan.optimization import (
+    ProntoIteration,
+    ProntoOptions,
+    ProntoStatus,
+    TrajectoryProblem,
+    build_model,
+    solve_ipopt,
+    solve_pronto,
+)
+
+from ._problems import (
+    crossing_problem,
+    obstacle_problem,
+    pendulum_problem,
+    unicycle_problem,
+    zero_guess,
+)
+
+
+def _quadratic_tail(
+    history: tuple[ProntoIteration, ...],
+    n_tail: int = 2,
+    constant: float = 10.0,
+    epsilon: float | None = None,
+) -> None:
+    """The last ``n_tail`` decrements of a barrier level satisfy ``d_{k+1} ≤ C d_k²``.
+
+    For a log barrier with weight ``w = ε dt`` the objective divided by ``w`` is the
+    self-concordant one, so the constant of quadratic convergence scales as ``1 / w``.
+    """
+    epsilon = history[-1].epsilon if epsilon is None else epsilon
+    final = [h for h in history if h.epsilon == epsilon]
+    decrements = [h.decrement for h in final]
+    assert len(decrements) >= n_tail + 1, decrements
+    for earlier, later in zip(decrements[-n_tail - 1 : -1], decrements[-n_tail:], strict=True):
+        assert later <= constant * earlier**2 or later < 1e-13, decrements
+
+
+def _constraint_slacks(
+    problem: TrajectoryProblem, states: np.ndarray, inputs: np.ndarray
+) -> np.ndarray:
+    model = build_model(problem)
+    assert model.constraints is not None
+    return model.constraints.values(states[:-1], inputs, problem.parameters) / model.slack_scales
+
+
+@pytest.mark.parametrize("make_problem", [unicycle_problem, pendulum_problem])
+def test_unconstrained_cost_equals_ipopt(make_problem) -> None:
+    problem = make_problem()
+    guess = zero_guess(problem)
+    result = solve_pronto(problem, guess, options=ProntoOptions(tol=1e-10))
+    assert result.status is ProntoStatus.CONVERGED, result.message
+    assert result.barrier_cost == 0.0
+    reference = solve_ipopt(problem, result.history and guess)
+    assert reference.success
+    assert result.cost == pytest.approx(reference.cost, rel=1e-6)
+    np.testing.assert_allclose(result.trajectory.states, reference.trajectory.states, atol=1e-4)
+    _quadratic_tail(result.history, constant=100.0)
+
+
+@pytest.mark.parametrize("make_problem", [obstacle_problem, crossing_problem])
+def test_constrained_cost_equals_ipopt_with_barrier_and_hard_constraints(make_problem) -> None:
+    problem = make_problem()
+    guess = zero_guess(problem)
+    result = solve_pronto(problem, guess)
+    assert result.status is ProntoStatus.CONVERGED, result.message
+    assert result.epsilon == pytest.approx(ProntoOptions().eps_final)
+    slacks = _constraint_slacks(problem, result.trajectory.states, result.trajectory.inputs)
+    assert np.min(slacks) > 0.0  # strictly feasible at the end
+    assert result.min_slack == pytest.approx(np.min(slacks))
+    # same local minimum: start IPOPT at the PRONTO solution
+    barrier = solve_ipopt(problem, result.trajectory, barrier=(result.epsilon, result.delta))
+    assert barrier.success
+    assert result.objective == pytest.approx(barrier.objective, rel=1e-4)
+    hard = solve_ipopt(problem, result.trajectory)
+    assert hard.success
+    assert (
+        np.min(_constraint_slacks(problem, hard.trajectory.states, hard.trajectory.inputs)) > -1e-8
+    )
+    # the barrier optimum is feasible, so it cannot beat the constrained optimum; at ε = 1e-4 it
+    # is close to it
+    assert result.cost >= hard.cost - 1e-8
+    assert result.cost == pytest.approx(hard.cost, rel=2e-3)
+    _quadratic_tail(result.history, n_tail=2, epsilon=1.0)
+    _quadratic_tail(result.history, n_tail=1, constant=10.0 / (result.epsilon * problem.dt))
+    levels = sorted({h.epsilon for h in result.history}, reverse=True)
+    assert levels == pytest.approx(list(ProntoOptions().epsilon_levels()))
+
+
+def test_infeasible_initial_trajectory_is_allowed() -> None:
+    """The zero guess of the crossing drives both vehicles through each other."""
+    problem = crossing_problem()
+    model = build_model(problem)
+    guess = zero_guess(problem)
+    desired = problem.parameters
+    guess_states = np.vstack([problem.initial_state, desired])
+    from auvplan.optimization import Trajectory
+
+    straight = Trajectory(guess_states, np.gradient(guess_states, problem.dt, axis=0)[:-1])
+    assert model.constraints is not None
+    initial_slack = np.min(
+        model.constraints.values(straight.states[:-1], straight.inputs, problem.parameters)
+    )
+    assert initial_slack < 0.0
+    result = solve_pronto(problem, straight)
+    assert result.success, result.message
+    assert result.min_slack > 0.0
+    assert result.history[0].min_slack < 0.0
+    assert guess.states.shape == result.trajectory.states.shape
+
+
+def test_callback_receives_records_and_can_stop() -> None:
+    problem = unicycle_problem()
+    seen: list[ProntoIteration] = []
+
+    def callback(record: ProntoIteration) -> None:
+        seen.append(record)
+        if len(seen) == 2:
+            raise StopIteration
+
+    result = solve_pronto(problem, zero_guess(problem), callback=callback)
+    assert result.status is ProntoStatus.MAX_ITER
+    assert not result.success
+    assert len(seen) == 2
+    assert seen == list(result.history)
+
+
+def test_max_iter_status() -> None:
+    problem = pendulum_problem()
+    result = solve_pronto(problem, zero_guess(problem), options=ProntoOptions(max_iter=2))
+    assert result.status is ProntoStatus.MAX_ITER
+    assert len(result.history) == 2
+    assert result.history[1].cost < result.history[0].cost
