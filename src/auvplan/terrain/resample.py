@@ -12,9 +12,6 @@ Two array-in, grid-out functions used by the bathymetry readers (:mod:`auvplan.i
 from __future__ import annotations
 
 import numpy as np
-from scipy.interpolate import griddata
-from scipy.ndimage import map_coordinates
-from scipy.spatial import cKDTree
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
@@ -128,6 +125,7 @@ def _native_spacing(
 
 def _bilinear_nan(values: FloatArray, row: FloatArray, col: FloatArray) -> FloatArray:
     """Bilinear interpolation at fractional ``(row, col)``; NaN if a weighted node is NaN."""
+    from scipy.ndimage import map_coordinates  # imported here: slow to import, rarely needed
     missing = ~np.isfinite(values)
     filled = np.where(missing, 0.0, values)
     coordinates = np.stack([row.ravel(), col.ravel()])
@@ -181,6 +179,9 @@ def grid_scattered_points(
     InputError
         If fewer than 3 distinct finite soundings remain or the spacing is not positive.
     """
+    from scipy.interpolate import griddata  # imported here: slow to import, rarely needed
+    from scipy.spatial import cKDTree
+
     north = np.asarray(north, dtype=np.float64)
     east = np.asarray(east, dtype=np.float64)
     depth = np.asarray(depth, dtype=np.float64)
