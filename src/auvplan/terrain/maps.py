@@ -132,22 +132,23 @@ def compute_gradient_magnitude(grid: BathymetryGrid) -> FloatArray:
 
 
 def _axis_derivative(depth: FloatArray, spacing: float, *, axis: int) -> FloatArray:
-    """Derivative along ``axis`` with the NaN-aware stencil of compute_gradient_magnitude."""
+    """Derivative along ``axis`` with the NaN-aware stencil of compute_gradient_magnitude.
+
+    The central difference is the mean of the backward and forward differences, so the
+    derivative is the mean of whichever of the two is finite (NaN if neither is).
+    """
     values = np.moveaxis(depth, axis, 0)
-    pad = np.full((1, values.shape[1]), np.nan)
-    before = np.concatenate([pad, values[:-1]])  # d_{i-1}
-    after = np.concatenate([values[1:], pad])  # d_{i+1}
-    has_before, has_after = np.isfinite(before), np.isfinite(after)
-    with np.errstate(invalid="ignore"):
-        central = (after - before) / (2.0 * spacing)
-        forward = (after - values) / spacing
-        backward = (values - before) / spacing
-    derivative = np.where(
-        has_before & has_after,
-        central,
-        np.where(has_after, forward, np.where(has_before, backward, np.nan)),
-    )
-    derivative[~np.isfinite(values)] = np.nan
+    step = np.diff(values, axis=0) / spacing  # step[i] = (d[i+1] - d[i]) / spacing
+    has_step = np.isfinite(step)
+    step[~has_step] = 0.0
+    total = np.zeros_like(values)
+    count = np.zeros(values.shape, dtype=np.float64)
+    total[1:] += step  # backward difference at i = step[i-1]
+    total[:-1] += step  # forward difference at i = step[i]
+    count[1:] += has_step
+    count[:-1] += has_step
+    with np.errstate(invalid="ignore", divide="ignore"):
+        derivative = total / count  # 0 / 0 -> NaN: no finite neighbour along this axis
     return np.asarray(np.moveaxis(derivative, 0, axis))
 
 
@@ -196,7 +197,8 @@ def compute_information_map(grid: BathymetryGrid, *, exponent: float = 1.0) -> F
     largest = float(magnitude[finite].max())
     if largest == 0.0:
         return np.where(finite, 0.0, np.nan)
-    return np.asarray((magnitude / largest) ** exponent)
+    information = magnitude / largest
+    return information if exponent == 1.0 else np.asarray(information**exponent)
 
 
 def compute_excitation_map(information: FloatArray, block: tuple[int, int]) -> FloatArray:
