@@ -2,7 +2,24 @@
 
 from __future__ import annotations
 
-from auvplan.planning.astar import plan_astar
+from auvplan.planning.astar import heuristic_map, plan_astar
+from auvplan.planning.obstacles import (
+    CircleObstacle,
+    PolygonObstacle,
+    distance_to_obstacle,
+    obstacle_mask,
+)
 from auvplan.planning.problem import EdgeModel, PathResult, PlanningProblem, SearchStatus
 
-__all__ = ["EdgeModel", "PathResult", "PlanningProblem", "SearchStatus", "plan_astar"]
+__all__ = [
+    "CircleObstacle",
+    "EdgeModel",
+    "PathResult",
+    "PlanningProblem",
+    "PolygonObstacle",
+    "SearchStatus",
+    "distance_to_obstacle",
+    "heuristic_map",
+    "obstacle_mask",
+    "plan_astar",
+]

@@ -1,0 +1,298 @@
+r"""Obstacles in world coordinates and their rasterisation onto a grid (no-go cells).
+
+A cell is the rectangle :math:`[n_c - \Delta_n/2, n_c + \Delta_n/2] \times [e_c - \Delta_e/2,
+e_c + \Delta_e/2]` around its centre. :func:`obstacle_mask` blocks every cell whose rectangle
+comes within ``clearance`` of an obstacle:
+
+* circle (centre :math:`p`, radius :math:`R`): :math:`d(p, \text{cell}) < R + \text{clearance}`;
+* polygon :math:`P`: :math:`d(P, \text{cell}) < \text{clearance}`, or the cell intersects
+  :math:`P` (distance 0).
+
+So a vehicle that stays in unblocked cells keeps at least ``clearance`` from every obstacle
+at every point of those cells. All computations are vectorised over the cells of the
+obstacle's (dilated) bounding box.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+from matplotlib.path import Path as MplPath
+
+from auvplan._typing import BoolArray, FloatArray
+from auvplan.errors import InputError
+from auvplan.terrain.grid import GridGeometry
+
+
+@dataclass(frozen=True)
+class CircleObstacle:
+    """A disc in the horizontal plane.
+
+    Parameters
+    ----------
+    north, east : float
+        Centre [m].
+    radius : float
+        Radius [m], ``> 0``.
+
+    Examples
+    --------
+    >>> CircleObstacle(10.0, 20.0, 5.0).radius
+    5.0
+    """
+
+    north: float
+    east: float
+    radius: float
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.north) and np.isfinite(self.east)):
+            raise InputError(f"circle centre must be finite, got ({self.north}, {self.east}) m")
+        if not (np.isfinite(self.radius) and self.radius > 0.0):
+            raise InputError(f"circle radius must be finite and > 0, got {self.radius!r} m")
+
+
+@dataclass(frozen=True, eq=False)
+class PolygonObstacle:
+    """A simple polygon in the horizontal plane.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (n_vertices, 2)
+        ``[north, east]`` [m] of the vertices in order (closing edge implied), ``n >= 3``,
+        finite, with non-zero area.
+
+    Examples
+    --------
+    >>> square = PolygonObstacle(np.array([[0.0, 0.0], [0.0, 2.0], [2.0, 2.0], [2.0, 0.0]]))
+    >>> square.vertices.shape
+    (4, 2)
+    """
+
+    vertices: FloatArray
+
+    def __post_init__(self) -> None:
+        vertices = np.asarray(self.vertices, dtype=np.float64)
+        if vertices.ndim != 2 or vertices.shape[1] != 2 or vertices.shape[0] < 3:
+            raise InputError(
+                f"polygon vertices must have shape (n >= 3, 2), got {np.shape(self.vertices)}"
+            )
+        if not np.all(np.isfinite(vertices)):
+            raise InputError("polygon vertices must be finite")
+        north, east = vertices[:, 0], vertices[:, 1]
+        area = 0.5 * (np.dot(north, np.roll(east, -1)) - np.dot(east, np.roll(north, -1)))
+        if abs(area) <= 1e-12 * max(1.0, float(np.ptp(vertices)) ** 2):
+            raise InputError(f"polygon has zero area (vertices {vertices.tolist()})")
+        object.__setattr__(self, "vertices", vertices)
+
+
+Obstacle = CircleObstacle | PolygonObstacle
+
+
+def distance_to_obstacle(
+    obstacle: CircleObstacle | PolygonObstacle, north: FloatArray, east: FloatArray
+) -> FloatArray:
+    r"""Signed distance [m] from points to an obstacle's boundary (negative inside).
+
+    Parameters
+    ----------
+    obstacle : CircleObstacle or PolygonObstacle
+        The obstacle.
+    north, east : ndarray
+        Point coordinates [m] (broadcast together).
+
+    Returns
+    -------
+    ndarray
+        :math:`\|p - c\| - R` for a circle; for a polygon the distance to the nearest edge,
+        negated inside.
+
+    Examples
+    --------
+    >>> distance_to_obstacle(CircleObstacle(0.0, 0.0, 1.0), np.array([3.0]), np.array([4.0]))
+    array([4.])
+    """
+    north, east = np.broadcast_arrays(
+        np.asarray(north, dtype=np.float64), np.asarray(east, dtype=np.float64)
+    )
+    if isinstance(obstacle, CircleObstacle):
+        return np.asarray(np.hypot(north - obstacle.north, east - obstacle.east) - obstacle.radius)
+    vertices = obstacle.vertices
+    distance = np.full(north.shape, np.inf)
+    for a, b in zip(vertices, np.roll(vertices, -1, axis=0), strict=True):
+        distance = np.minimum(distance, _point_segment_distance(north, east, a, b))
+    points = np.column_stack((north.ravel(), east.ravel()))
+    inside = MplPath(vertices).contains_points(points).reshape(north.shape)
+    return np.asarray(np.where(inside, -distance, distance))
+
+
+def obstacle_mask(
+    geometry: GridGeometry,
+    obstacles: Iterable[CircleObstacle | PolygonObstacle],
+    *,
+    clearance: float = 0.0,
+) -> BoolArray:
+    """Cells of ``geometry`` that come within ``clearance`` of any obstacle.
+
+    Parameters
+    ----------
+    geometry : GridGeometry
+        The grid.
+    obstacles : iterable of CircleObstacle or PolygonObstacle
+        Obstacles in the grid's world frame.
+    clearance : float
+        Extra distance [m] to keep from every obstacle, ``>= 0``.
+
+    Returns
+    -------
+    ndarray of bool, shape (n_rows, n_cols)
+        True on blocked cells.
+
+    Examples
+    --------
+    >>> grid = GridGeometry(3, 3, 1.0, 1.0)
+    >>> obstacle_mask(grid, [CircleObstacle(1.0, 1.0, 0.4)]).astype(int)
+    array([[0, 0, 0],
+           [0, 1, 0],
+           [0, 0, 0]])
+    >>> obstacle_mask(grid, [CircleObstacle(1.0, 1.0, 0.4)], clearance=0.2).astype(int)
+    array([[0, 1, 0],
+           [1, 1, 1],
+           [0, 1, 0]])
+    """
+    if not (np.isfinite(clearance) and clearance >= 0.0):
+        raise InputError(f"clearance must be finite and >= 0, got {clearance!r} m")
+    mask = np.zeros(geometry.shape, dtype=np.bool_)
+    for obstacle in obstacles:
+        if isinstance(obstacle, CircleObstacle):
+            low = np.array([obstacle.north, obstacle.east]) - obstacle.radius
+            high = np.array([obstacle.north, obstacle.east]) + obstacle.radius
+        elif isinstance(obstacle, PolygonObstacle):
+            low, high = obstacle.vertices.min(axis=0), obstacle.vertices.max(axis=0)
+        else:
+            raise InputError(f"unknown obstacle type {type(obstacle).__name__}")
+        rows = _overlapping(
+            geometry.north, 0.5 * geometry.spacing_north, low[0], high[0], clearance
+        )
+        cols = _overlapping(geometry.east, 0.5 * geometry.spacing_east, low[1], high[1], clearance)
+        if rows.stop <= rows.start or cols.stop <= cols.start:
+            continue
+        north = geometry.north[rows][:, np.newaxis]
+        east = geometry.east[cols][np.newaxis, :]
+        half_north, half_east = 0.5 * geometry.spacing_north, 0.5 * geometry.spacing_east
+        if isinstance(obstacle, CircleObstacle):
+            gap_north = np.maximum(np.abs(north - obstacle.north) - half_north, 0.0)
+            gap_east = np.maximum(np.abs(east - obstacle.east) - half_east, 0.0)
+            hit = np.hypot(gap_north, gap_east) < obstacle.radius + clearance
+        else:
+            north, east = np.broadcast_arrays(north, east)
+            distance = _polygon_rectangle_distance(
+                obstacle.vertices, north, east, half_north, half_east
+            )
+            hit = (distance < clearance) | (distance == 0.0)
+        mask[rows, cols] |= hit
+    return mask
+
+
+def _overlapping(
+    centres: FloatArray, half: float, low: float, high: float, clearance: float
+) -> slice:
+    """Slice of the (sorted) cell centres whose cells reach ``[low, high]`` dilated."""
+    inside = np.flatnonzero(
+        (centres + half >= low - clearance) & (centres - half <= high + clearance)
+    )
+    if inside.size == 0:
+        return slice(0, 0)
+    return slice(int(inside[0]), int(inside[-1]) + 1)
+
+
+def _point_segment_distance(
+    north: FloatArray, east: FloatArray, a: FloatArray, b: FloatArray
+) -> FloatArray:
+    """Distance [m] from points to the segment ``a -> b`` (``[north, east]``)."""
+    d_north, d_east = b[0] - a[0], b[1] - a[1]
+    length2 = d_north * d_north + d_east * d_east
+    t = (north - a[0]) * d_north + (east - a[1]) * d_east
+    t = np.clip(t / length2, 0.0, 1.0) if length2 > 0.0 else np.zeros_like(north)
+    return np.asarray(np.hypot(north - (a[0] + t * d_north), east - (a[1] + t * d_east)))
+
+
+def _point_rectangle_distance(
+    north: float,
+    east: float,
+    centre_north: FloatArray,
+    centre_east: FloatArray,
+    half_north: float,
+    half_east: float,
+) -> FloatArray:
+    """Distance [m] from one point to each axis-aligned rectangle (0 inside)."""
+    gap_north = np.maximum(np.abs(north - centre_north) - half_north, 0.0)
+    gap_east = np.maximum(np.abs(east - centre_east) - half_east, 0.0)
+    return np.asarray(np.hypot(gap_north, gap_east))
+
+
+def _segment_hits_rectangle(
+    a: FloatArray,
+    b: FloatArray,
+    centre_north: FloatArray,
+    centre_east: FloatArray,
+    half_north: float,
+    half_east: float,
+) -> BoolArray:
+    """Whether segment ``a -> b`` intersects each rectangle (Liang–Barsky clipping)."""
+    direction = (b[0] - a[0], b[1] - a[1])
+    t_low = np.zeros(centre_north.shape)
+    t_high = np.ones(centre_north.shape)
+    is_hit = np.ones(centre_north.shape, dtype=np.bool_)
+    for axis, centre, half in ((0, centre_north, half_north), (1, centre_east, half_east)):
+        for p, q in (
+            (-direction[axis], a[axis] - (centre - half)),
+            (direction[axis], (centre + half) - a[axis]),
+        ):
+            if p == 0.0:
+                is_hit &= q >= 0.0
+            elif p < 0.0:
+                t_low = np.maximum(t_low, q / p)
+            else:
+                t_high = np.minimum(t_high, q / p)
+    return np.asarray(is_hit & (t_low <= t_high))
+
+
+def _polygon_rectangle_distance(
+    vertices: FloatArray,
+    centre_north: FloatArray,
+    centre_east: FloatArray,
+    half_north: float,
+    half_east: float,
+) -> FloatArray:
+    """Distance [m] between a polygon (as a region) and each cell rectangle (0 if they meet).
+
+    Two disjoint convex sets are closest at a vertex of one of them, so for each polygon edge
+    the distance to a rectangle is 0 if they intersect, else the least of the edge-endpoint to
+    rectangle and rectangle-corner to edge distances. A rectangle whose centre lies inside
+    the polygon meets it.
+    """
+    distance = np.full(centre_north.shape, np.inf)
+    corners = [
+        (centre_north + s_north * half_north, centre_east + s_east * half_east)
+        for s_north in (-1.0, 1.0)
+        for s_east in (-1.0, 1.0)
+    ]
+    for a, b in zip(vertices, np.roll(vertices, -1, axis=0), strict=True):
+        edge = _point_rectangle_distance(
+            a[0], a[1], centre_north, centre_east, half_north, half_east
+        )
+        edge = np.minimum(
+            edge,
+            _point_rectangle_distance(b[0], b[1], centre_north, centre_east, half_north, half_east),
+        )
+        for corner_north, corner_east in corners:
+            edge = np.minimum(edge, _point_segment_distance(corner_north, corner_east, a, b))
+        edge[_segment_hits_rectangle(a, b, centre_north, centre_east, half_north, half_east)] = 0.0
+        distance = np.minimum(distance, edge)
+    points = np.column_stack((centre_north.ravel(), centre_east.ravel()))
+    inside = MplPath(vertices).contains_points(points).reshape(centre_north.shape)
+    distance[inside] = 0.0
+    return distance
