@@ -20,7 +20,7 @@ hockey stick; communication range ``1 − ‖p_i − p_j‖²/d_max²`` and prop
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Final
+from typing import Final, Literal
 
 import casadi as ca
 import numpy as np
@@ -51,7 +51,7 @@ class FleetConstraint:
 
     name: str
     function: ca.Function
-    kind: str
+    kind: Literal["plain", "hockey"]
     labels: tuple[str, ...]
 
 
@@ -170,7 +170,9 @@ def _constraints(
     n_vehicles = len(xs)
     blocks: list[FleetConstraint] = []
 
-    def add(name: str, rows: list[ca.SX], labels: list[str], kind: str) -> None:
+    def add(
+        name: str, rows: list[ca.SX], labels: list[str], kind: Literal["plain", "hockey"]
+    ) -> None:
         if rows:
             function = ca.Function(name, [x, c, p], [ca.vertcat(*rows)])
             blocks.append(FleetConstraint(name, function, kind, tuple(labels)))

@@ -33,6 +33,7 @@ from auvplan.deconfliction import (
     CoordinationResult,
     deconflict,
     retime_for_arrival,
+    timed_headings,
     timed_positions,
 )
 from auvplan.errors import InfeasibleError, InputError
@@ -58,7 +59,9 @@ from auvplan.planning import (
 )
 from auvplan.terrain import BathymetryGrid, MapParameters, TerrainMaps, compute_terrain_maps
 from auvplan.terrain.synthetic import synthetic_bank
-from auvplan.vehicle import VehicleModel, build_vehicle_model, rk4_simulate, top_speed, trim_surge
+from auvplan.vehicle import VehicleModel, build_vehicle_model
+from auvplan.vehicle.simulate import rk4_simulate
+from auvplan.vehicle.trim import top_speed, trim_surge
 
 logger = logging.getLogger(__name__)
 
@@ -366,7 +369,7 @@ def _model_for_type(vehicle_type: str) -> VehicleModel:
 def _trim_table(model: VehicleModel) -> tuple[FloatArray, FloatArray]:
     """Steady-surge propeller speed [rev/s] against surge speed [m/s], 0 … top speed."""
     speeds = np.linspace(0.0, top_speed(model), TRIM_SAMPLES)
-    revolutions = np.array([trim_surge(model, float(speed)).propeller_speed for speed in speeds])
+    revolutions = np.array([trim_surge(model, float(speed)).n for speed in speeds])
     return speeds, revolutions
 
 
@@ -411,7 +414,6 @@ def run_deconfliction(
             safety_radius=fleet.safety_radius,
             cruise_speeds=speeds,
             time_step=config.deconfliction.time_step,
-            max_speeds=limits,
         )
         coordination = deconflict(
             problem, method=config.deconfliction.method, weight=config.deconfliction.weight
@@ -434,14 +436,14 @@ def run_deconfliction(
     n_steps = round(horizon / dt)
     if not math.isclose(n_steps * dt, horizon, rel_tol=1e-9):
         raise InputError(f"solver.dt_s = {dt:g} s does not divide the horizon {horizon:g} s")
-    time = dt * np.arange(n_steps + 1)
+    time = dt * np.arange(n_steps + 1, dtype=np.float64)
     desired = _desired_states(problem, coordination, models, time, preplan)
     logger.info(
         "deconfliction (%s): horizon %.1f s, delays %s s, min separation %.2f m",
         config.deconfliction.method,
         horizon,
         np.array2string(np.asarray(coordination.delays), precision=1),
-        coordination.min_separation,
+        coordination.certificate.min_separation,
     )
     return DeconflictStage(horizon, speeds, problem, coordination, time, desired)
 
@@ -458,7 +460,8 @@ def _desired_states(
     preplan: PreplanStage,
 ) -> FloatArray:
     """Desired state ``(north, east, psi, u, 0, r, n, n)`` per vehicle on ``time``."""
-    positions, headings = timed_positions(coordination, problem, time)
+    positions = timed_positions(coordination, problem, time)
+    headings = timed_headings(coordination, problem, time)
     n_vehicles = positions.shape[0]
     desired = np.zeros((n_vehicles, time.size, 8))
     for i in range(n_vehicles):
@@ -535,7 +538,7 @@ def build_trajectory_problem(
         dynamics=functions.dynamics,
         running_cost=functions.running_cost,
         terminal_cost=functions.terminal_cost,
-        x0=x0,
+        initial_state=x0,
         dt=config.solver.dt,
         n_steps=deconfliction.time.size - 1,
         stage_parameters=np.ascontiguousarray(stage_parameters),
@@ -609,7 +612,7 @@ def _evaluate_plan(
     held = np.vstack([flat_inputs, flat_inputs[-1:]])
     power_map = functions.power.map(time.size)
     power = np.asarray(power_map(flat_states.T, held.T)).reshape(n_vehicles, time.size)
-    energy = np.trapezoid(power, time, axis=1)
+    energy = np.asarray(np.trapezoid(power, time, axis=1), dtype=np.float64)
     arrival = np.hypot(*(states[:, -1, :2] - preplan.goals[:, :2]).T)
     information = _information_along(preplan.maps, states)
 

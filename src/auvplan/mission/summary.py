@@ -102,7 +102,8 @@ def mission_summary(result: MissionResult) -> dict[str, Any]:
             "message": coordination.message,
             "objective": coordination.objective,
             "n_expanded": coordination.n_expanded,
-            "certified_min_separation_m": coordination.min_separation,
+            "certified_min_separation_m": coordination.certificate.min_separation,
+            "certificate": dataclasses.asdict(coordination.certificate),
         }
         for i, vehicle in enumerate(summary["vehicles"]):
             vehicle["timing"] = {
