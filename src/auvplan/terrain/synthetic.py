@@ -166,7 +166,7 @@ def _gullies(radius: FloatArray, azimuth: FloatArray, rng: np.random.Generator) 
     profile = (along / 0.5) * np.exp(1.0 - along / 0.5)
     cut = np.zeros_like(radius)
     for centre, depth in zip(centres, depths, strict=True):
-        trough = np.cos(0.5 * (azimuth - centre)) ** 60  # about ±10° wide at half depth
+        trough = np.cos(0.5 * (azimuth - centre)) ** 500  # about ±6° wide at half depth
         cut = np.maximum(cut, depth * trough * profile)
     return cut
 
