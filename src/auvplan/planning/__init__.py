@@ -10,6 +10,8 @@ from auvplan.planning.obstacles import (
     obstacle_mask,
 )
 from auvplan.planning.problem import EdgeModel, PathResult, PlanningProblem, SearchStatus
+from auvplan.planning.route import Route, blocked_cells, blocked_lookup, plan_route
+from auvplan.planning.smoothing import path_headings, path_length, smooth_path
 
 __all__ = [
     "CircleObstacle",
@@ -17,9 +19,16 @@ __all__ = [
     "PathResult",
     "PlanningProblem",
     "PolygonObstacle",
+    "Route",
     "SearchStatus",
+    "blocked_cells",
+    "blocked_lookup",
     "distance_to_obstacle",
     "heuristic_map",
     "obstacle_mask",
+    "path_headings",
+    "path_length",
     "plan_astar",
+    "plan_route",
+    "smooth_path",
 ]
