@@ -7,7 +7,8 @@ smoothing factor until
 1. the curve stays within ``max_deviation`` of the polyline and the polyline within
    ``max_deviation`` of the curve (a two-sided Hausdorff bound, checked conservatively on
    dense samples), and
-2. no dense sample of the curve lies in a no-go cell (``is_blocked``).
+2. no dense sample of the curve, nor of the straight chords between the returned samples,
+   lies in a no-go cell (``is_blocked``).
 
 If no smoothing factor passes (e.g. a path that squeezes diagonally between two blocked
 cells), the polyline itself is returned, resampled. The result passes exactly through the
@@ -143,9 +144,14 @@ def smooth_path(
                 points.T, u=chord, w=weights, s=smoothing, k=min(3, len(points) - 1), quiet=2
             )
             dense = _resample_spline(tck, chord[-1], points, resolution)
-            if _is_acceptable(dense, polyline_dense, max_deviation, resolution, is_blocked):
-                n_steps = max(1, round(path_length(dense) / spacing))
-                return _resample_spline(tck, chord[-1], points, resolution, n_steps=n_steps)
+            n_steps = max(1, round(path_length(dense) / spacing))
+            curve = _resample_spline(tck, chord[-1], points, resolution, n_steps=n_steps)
+            # the chords between output samples must avoid no-go cells too
+            chords = _resample_polyline(curve, resolution)
+            if _is_acceptable(
+                dense, polyline_dense, max_deviation, resolution, is_blocked
+            ) and not _hits(chords, is_blocked):
+                return curve
             smoothing *= 0.25
         logger.info("smooth_path: no smoothing factor passed the checks; returning the polyline")
     n_steps = max(1, round(path_length(points) / spacing))
@@ -229,4 +235,11 @@ def _is_acceptable(
         return False
     if cKDTree(curve).query(polyline)[0].max() > limit:
         return False
-    return is_blocked is None or not bool(np.any(is_blocked(curve[:, 0], curve[:, 1])))
+    return not _hits(curve, is_blocked)
+
+
+def _hits(
+    points: FloatArray, is_blocked: Callable[[FloatArray, FloatArray], BoolArray] | None
+) -> bool:
+    """Whether any point is no-go."""
+    return is_blocked is not None and bool(np.any(is_blocked(points[:, 0], points[:, 1])))
