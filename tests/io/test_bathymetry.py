@@ -360,3 +360,26 @@ def test_all_land_is_an_error(tmp_path: Path) -> None:
     with pytest.raises(DataFormatError, match="no water cell") as error:
         read_bathymetry(path, vertical="elevation")
     _assert_one_line(error, path)
+
+
+def test_netcdf_elevation_on_other_dimensions(tmp_path: Path) -> None:
+    path = tmp_path / "odd.nc"
+    xr.Dataset(
+        {"elevation": (("time",), [-1.0, -2.0])},
+        {"lat": ("lat", [1.0, 1.001]), "lon": ("lon", [2.0, 2.001])},
+    ).to_netcdf(path)
+    with pytest.raises(DataFormatError) as error:
+        read_bathymetry(path)
+    _assert_one_line(error, path)
+
+
+def test_netcdf_with_a_singleton_time_dimension(tmp_path: Path) -> None:
+    path = tmp_path / "timed.nc"
+    elevation = -np.arange(20.0, 26.0).reshape(1, 2, 3)
+    xr.Dataset(
+        {"z": (("time", "lat", "lon"), elevation)},
+        {"lat": [10.0, 10.001], "lon": [20.0, 20.001, 20.002], "time": [0.0]},
+    ).to_netcdf(path)
+    grid = read_bathymetry(path)
+    assert np.nanmin(grid.depth) >= 20.0
+    assert np.nanmax(grid.depth) <= 25.0

@@ -142,12 +142,18 @@ def _read(
     if not path.is_file():
         raise DataFormatError("not a regular file")
     kind = detect_format(path)
-    if kind == "netcdf":
-        raster = _read_netcdf(path)
-    elif kind in ("geotiff", "ascii"):
-        raster = _read_rasterio(path)
-    else:
-        raster = _read_xyz(path, xyz_coordinates)
+    try:
+        if kind == "netcdf":
+            raster = _read_netcdf(path)
+        elif kind in ("geotiff", "ascii"):
+            raster = _read_rasterio(path)
+        else:
+            raster = _read_xyz(path, xyz_coordinates)
+    except (ValueError, KeyError, TypeError, IndexError, RuntimeError) as error:
+        # Anything the libraries raise on a malformed file that the readers did not foresee.
+        if isinstance(error, AuvplanError):
+            raise
+        raise DataFormatError(f"malformed {kind} file ({_first_line(error)})") from None
     raster = replace(
         raster, attributes={"source_file": str(path), "format": kind, **raster.attributes}
     )
