@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import matplotlib.colors
 import numpy as np
 import pytest
 
@@ -115,3 +116,25 @@ def test_bad_input_on_a_real_grid(
     assert len(lines) == 1
     assert path.name in lines[0]
     assert not out.exists()
+
+
+def test_figure_has_four_map_panels_with_units_and_land_colour() -> None:
+    from auvplan.terrain import BathymetryGrid, compute_terrain_maps, synthetic_bank
+    from auvplan.viz.maps import LAND_COLOR, plot_terrain_maps
+
+    bank = synthetic_bank()
+    depth = bank.depth.copy()
+    depth[:10, :20] = np.nan  # land in the south-west corner
+    maps = compute_terrain_maps(BathymetryGrid(depth, bank.geometry, name="bank with land"))
+    figure = plot_terrain_maps(maps)
+    panels = [ax for ax in figure.axes if ax.get_images()]
+    assert len(panels) == 4
+    labels = {ax.get_ylabel() for ax in figure.axes if ax not in panels}
+    assert {"depth [m]", "information [-]", "excitation [-]", "cost [-]"} <= labels
+    for ax in panels:
+        assert ax.get_aspect() == 1.0
+        assert ax.get_xlim() == panels[0].get_xlim()  # shared axes
+        image = ax.get_images()[0]
+        assert np.ma.is_masked(image.get_array())
+        bad = image.get_cmap().get_bad()
+        assert np.allclose(bad[:3], matplotlib.colors.to_rgb(LAND_COLOR))
