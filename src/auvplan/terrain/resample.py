@@ -126,6 +126,7 @@ def _native_spacing(
 def _bilinear_nan(values: FloatArray, row: FloatArray, col: FloatArray) -> FloatArray:
     """Bilinear interpolation at fractional ``(row, col)``; NaN if a weighted node is NaN."""
     from scipy.ndimage import map_coordinates  # imported here: slow to import, rarely needed
+
     missing = ~np.isfinite(values)
     filled = np.where(missing, 0.0, values)
     coordinates = np.stack([row.ravel(), col.ravel()])
