@@ -1,6 +1,8 @@
 r"""Numba-compiled A* kernels on a padded, flattened 8-connected grid.
 
-The grid is padded with one ring of impassable cells, so a neighbour is always ``u + offset``
+Cells are flat indices into the padded grid (stored as int32 in the parent and bucket
+arrays, so grids are limited to :math:`2^{31} - 1` cells). The grid is padded with one ring of
+impassable cells, so a neighbour is always ``u + offset``
 and no bounds check is needed. Impassable cells (and the ring) have cost ``inf``.
 
 Edge weight of a move ``u -> v`` with step length :math:`\ell_k` [m]:
@@ -38,6 +40,7 @@ Two open lists, both exact (they close every cell with its optimal cost):
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 from numba import njit
 
 from auvplan._typing import BoolArray, FloatArray, IntArray
@@ -113,7 +116,9 @@ def heuristic_grid(
 
 
 @njit(cache=True)
-def _trace_path(parent: IntArray, start: int, goal: int) -> IntArray:  # pragma: no cover
+def _trace_path(
+    parent: npt.NDArray[np.int32], start: int, goal: int
+) -> IntArray:  # pragma: no cover
     """Flat cells from ``start`` to ``goal`` by following ``parent`` back from the goal."""
     n_path = 1
     v = goal
@@ -171,7 +176,7 @@ def astar_heap(
     diagonal = length[0]
     closed = _open_mask(cost)
     g = np.full(cost.size, np.inf)
-    parent = np.full(cost.size, -1, np.int64)
+    parent = np.full(cost.size, -1, np.int32)
     goal_row = goal // n_cols
     goal_col = goal - goal_row * n_cols
 
@@ -279,12 +284,12 @@ def astar_buckets(
     closed = _open_mask(cost)
     inv_width = 1.0 / width
     g = np.full(cost.size, np.inf)
-    parent = np.full(cost.size, -1, np.int64)
+    parent = np.full(cost.size, -1, np.int32)
     goal_row = goal // n_cols
     goal_col = goal - goal_row * n_cols
 
     capacity = 64
-    buckets = np.empty((n_buckets, capacity), np.int64)
+    buckets = np.empty((n_buckets, capacity), np.int32)
     counts = np.zeros(n_buckets, np.int64)
     start_row = start // n_cols
     h_start = _heuristic(
@@ -343,7 +348,7 @@ def astar_buckets(
                 )
                 target = int(f_v * inv_width) % n_buckets
                 if counts[target] == capacity:
-                    grown = np.empty((n_buckets, 2 * capacity), np.int64)
+                    grown = np.empty((n_buckets, 2 * capacity), np.int32)
                     grown[:, :capacity] = buckets
                     buckets = grown
                     capacity *= 2

@@ -23,8 +23,8 @@ their graph, because their heuristics are admissible and consistent:
 Speed: the open list is a bucket queue (Dial's algorithm with Dinitz's rule, see
 :mod:`auvplan.planning._kernel`) with O(1) pushes and pops. It is exact when the heuristic is
 scaled by :math:`\alpha < 1` (every reduced edge weight is then at least
-:math:`(1 - \alpha) c_{min} \ell_{min}`, the bucket width). We use :math:`\alpha = 0.85`
-(paper) and :math:`0.5` (crossed), lowered when the cost range would need more than
+:math:`(1 - \alpha) c_{min} \ell_{min}`, the bucket width). We use :math:`\alpha = 0.9`
+(paper) and :math:`0.75` (crossed), lowered when the cost range would need more than
 :data:`MAX_BUCKETS` buckets; when even :math:`\alpha = 0` (Dijkstra) would, a binary heap
 with the full heuristic (:math:`\alpha = 1`) is used. The choice changes the number of cells
 expanded, never the optimal cost. The kernels are compiled by numba and cached on disk; the
@@ -45,7 +45,7 @@ from auvplan.planning.problem import EdgeModel, PathResult, PlanningProblem, Sea
 #: Largest number of buckets of the bucket queue before falling back to the binary heap.
 MAX_BUCKETS: Final = 256
 #: Heuristic scale for the bucket queue per edge model (tuned on terrain cost maps).
-_ALPHA: Final = {EdgeModel.PAPER: 0.85, EdgeModel.CROSSED: 0.5}
+_ALPHA: Final = {EdgeModel.PAPER: 0.9, EdgeModel.CROSSED: 0.75}
 #: Relative safety margin on the bucket width against rounding in ``f = g + h``.
 _WIDTH_MARGIN: Final = 1e-9
 
@@ -137,6 +137,8 @@ def search_grid(
     if not isinstance(edge_model, EdgeModel):
         raise InputError(f"edge_model must be an EdgeModel, got {edge_model!r}")
     n_rows, n_cols = problem.shape
+    if (n_rows + 2) * (n_cols + 2) >= 2**31 - 1:
+        raise InputError(f"grid {n_rows} x {n_cols} is too large (more than 2**31 cells)")
     padded = _padded_cost(problem)
     width = n_cols + 2
     start = (problem.start[0] + 1) * width + problem.start[1] + 1
