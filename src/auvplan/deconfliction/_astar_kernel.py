@@ -8,9 +8,13 @@ step; it takes one time step. The path cost is lexicographic:
 2. ``waits`` — the number of (vehicle, step) pairs in which a vehicle not yet at its goal
    stands still (= the total delay in steps).
 
-The heuristic ``h(k) = max_i (n_i - k_i)`` bounds the remaining makespan; it is admissible
-and consistent for the lexicographic cost (with a zero second component), so ``weight = 1``
-returns the lexicographic optimum without reopening nodes. The priority is
+The heuristic ``h(k) = max_i (n_i - k_i)`` bounds the remaining makespan. It is raised to
+``max_{i<j} C_ij(k_i, k_j)``, the exact makespan-to-go of the pair ``(i, j)`` alone on its
+free 2-D grid (a relaxation of the N-vehicle problem, precomputed by a backward dynamic
+programme); nodes from which some pair cannot reach its goal are pruned. Both are admissible
+and consistent (the maximum of consistent heuristics is consistent) for the lexicographic
+cost (with a zero second component), so ``weight = 1`` returns the lexicographic optimum
+without reopening nodes. The priority is
 ``(steps + weight·h, waits, -steps)``. Collision checks are lazy: a node is tested pair by
 pair in the per-row interval lists when it is generated; the N-D grid is never stored.
 """
@@ -21,6 +25,7 @@ import numba
 import numpy as np
 
 from auvplan._typing import FloatArray, IntArray
+from auvplan.deconfliction._conflict_kernels import UNREACHABLE
 
 EMPTY = -1
 
@@ -64,6 +69,36 @@ def _is_free(
 
 
 @numba.njit(cache=True)
+def _heuristic(
+    k: IntArray,
+    n_steps: IntArray,
+    heur_base: IntArray,
+    heur_first: IntArray,
+    heur_offset: IntArray,
+    heur_excess: IntArray,
+) -> int:
+    """``max_i (n_i - k_i)``, raised to the exact pairwise cost-to-go where one is given."""
+    n = k.shape[0]
+    h = 0
+    for i in range(n):
+        h = max(h, n_steps[i] - k[i])
+    for i in range(n):
+        for j in range(i + 1, n):
+            base = heur_base[i * n + j]
+            if base < 0:
+                continue
+            row = base + k[i]
+            column = k[j] - heur_first[row]
+            if column < 0 or column >= heur_offset[row + 1] - heur_offset[row]:
+                continue
+            excess = heur_excess[heur_offset[row] + column]
+            if excess >= UNREACHABLE:
+                return -1
+            h = max(h, max(n_steps[i] - k[i], n_steps[j] - k[j]) + excess)
+    return h
+
+
+@numba.njit(cache=True)
 def _heap_less(f: FloatArray, w: IntArray, g: IntArray, a: int, b: int) -> bool:
     if f[a] != f[b]:
         return bool(f[a] < f[b])
@@ -87,6 +122,10 @@ def astar_coordination(
     row_ptr: IntArray,
     lo: IntArray,
     hi: IntArray,
+    heur_base: IntArray,
+    heur_first: IntArray,
+    heur_offset: IntArray,
+    heur_excess: IntArray,
     weight: float,
     max_expanded: int,
 ) -> tuple[int, IntArray, int]:
@@ -100,6 +139,9 @@ def astar_coordination(
         For ``i < j``: offset of pair ``(i, j)``'s rows in ``row_ptr``.
     row_ptr, lo, hi : ndarray
         Concatenated CSR interval lists (absolute offsets into ``lo``/``hi``).
+    heur_base, heur_first, heur_offset, heur_excess : ndarray
+        Pairwise cost-to-go excess (see ``pair_cost_to_go``); ``heur_base[i * N + j]`` is the
+        offset of pair ``(i, j)``'s rows, ``-1`` to use only ``max_i (n_i - k_i)``.
     weight : float
         Heuristic weight (>= 1).
     max_expanded : int
@@ -129,6 +171,7 @@ def astar_coordination(
     node_waits = np.empty(cap_nodes, dtype=np.int64)
     node_parent = np.empty(cap_nodes, dtype=np.int64)
     node_closed = np.zeros(cap_nodes, dtype=np.bool_)
+    node_h = np.empty(cap_nodes, dtype=np.int64)
     n_nodes = 0
     # hash table key -> node id
     cap_table = 1 << 17
@@ -152,13 +195,14 @@ def astar_coordination(
     if not _is_free(k, all_moved, pair_base, row_ptr, lo, hi):
         return 1, np.zeros((0, n), dtype=np.int64), 0
 
-    h0 = 0
-    for i in range(n):
-        h0 = max(h0, n_steps[i])
+    h0 = _heuristic(k, n_steps, heur_base, heur_first, heur_offset, heur_excess)
+    if h0 < 0:
+        return 1, np.zeros((0, n), dtype=np.int64), 0
     node_key[0] = 0
     node_steps[0] = 0
     node_waits[0] = 0
     node_parent[0] = -1
+    node_h[0] = h0
     n_nodes = 1
     slot = _find_slot(table_keys, 0, mask)
     table_keys[slot] = 0
@@ -231,10 +275,8 @@ def astar_coordination(
                 continue
             waits = node_waits[current] + (n_active - n_moving)
             key = 0
-            h = 0
             for i in range(n):
                 key += child[i] * stride[i]
-                h = max(h, n_steps[i] - child[i])
             slot = _find_slot(table_keys, key, mask)
             if table_keys[slot] == key:
                 other = table_node[slot]
@@ -248,7 +290,11 @@ def astar_coordination(
                 node_waits[other] = waits
                 node_parent[other] = current
                 target = other
+                h = node_h[other]
             else:
+                h = _heuristic(child, n_steps, heur_base, heur_first, heur_offset, heur_excess)
+                if h < 0:
+                    continue  # dead end: some pair can no longer reach its goal
                 if n_nodes >= cap_nodes:
                     new_cap = 2 * cap_nodes
                     grown_key = np.empty(new_cap, dtype=np.int64)
@@ -266,12 +312,16 @@ def astar_coordination(
                     grown_closed = np.zeros(new_cap, dtype=np.bool_)
                     grown_closed[:n_nodes] = node_closed[:n_nodes]
                     node_closed = grown_closed
+                    grown_h = np.empty(new_cap, dtype=np.int64)
+                    grown_h[:n_nodes] = node_h[:n_nodes]
+                    node_h = grown_h
                     cap_nodes = new_cap
                 target = n_nodes
                 node_key[target] = key
                 node_steps[target] = steps
                 node_waits[target] = waits
                 node_parent[target] = current
+                node_h[target] = h
                 n_nodes += 1
                 table_keys[slot] = key
                 table_node[slot] = target

@@ -227,3 +227,106 @@ def pair_reachability(
     if reach_hi[n_reach - 1] != n_j:
         return False, n_i, reach_hi[n_reach - 1] + 1
     return True, -1, -1
+
+
+UNREACHABLE = np.int64(1) << np.int64(40)
+
+
+@numba.njit(cache=True)
+def pair_cost_to_go(
+    row_ptr: IntArray, lo: IntArray, hi: IntArray, n_i: int, n_j: int
+) -> tuple[IntArray, IntArray, IntArray]:
+    r"""Exact two-vehicle cost-to-go (makespan) on the pair's free grid, stored by its excess.
+
+    Backward dynamic programme over rows ``a = n_i … 0``:
+    ``C(a, b) = 1 + min(C(a+1, b), C(a, b+1), C(a+1, b+1))`` over free successors, ``C = 0``
+    at the goal. Only the excess ``E = C - max(n_i - a, n_j - b)`` is kept, per row from its
+    first to its last non-zero entry (``UNREACHABLE`` where the goal cannot be reached;
+    forbidden nodes are stored as 0 because they are never queried).
+
+    Returns
+    -------
+    row_first : ndarray of shape (n_i + 1,)
+        First column ``b`` of the stored excess of each row.
+    row_offset : ndarray of shape (n_i + 2,)
+        Offsets of each row's values in ``excess`` (row ``a`` has ``row_offset[a+1] -
+        row_offset[a]`` values).
+    excess : ndarray
+        The stored excess values.
+    """
+    inf = UNREACHABLE
+    next_row = np.full(n_j + 1, inf, dtype=np.int64)
+    current = np.empty(n_j + 1, dtype=np.int64)
+    row_first = np.zeros(n_i + 1, dtype=np.int64)
+    row_len = np.zeros(n_i + 1, dtype=np.int64)
+    capacity = 4096
+    values = np.empty(capacity, dtype=np.int64)
+    count = 0
+    starts = np.empty(n_i + 1, dtype=np.int64)
+    for a in range(n_i, -1, -1):
+        q = row_ptr[a + 1] - 1  # walk the forbidden intervals backwards
+        first_nz = -1
+        last_nz = -1
+        for b in range(n_j, -1, -1):
+            while q >= row_ptr[a] and lo[q] > b:
+                q -= 1
+            is_forbidden = q >= row_ptr[a] and hi[q] >= b
+            if is_forbidden:
+                current[b] = inf
+                continue
+            if a == n_i and b == n_j:
+                current[b] = 0
+                continue
+            best = inf
+            if b < n_j:
+                best = min(best, current[b + 1])
+            if a < n_i:
+                best = min(best, next_row[b])
+                if b < n_j:
+                    best = min(best, next_row[b + 1])
+            cost = best + 1 if best < inf else inf
+            current[b] = cost
+            free_bound = max(n_i - a, n_j - b)
+            if cost != free_bound:
+                if last_nz < 0:
+                    last_nz = b
+                first_nz = b
+        # store the excess of row a
+        starts[a] = count
+        if last_nz >= 0:
+            length = last_nz - first_nz + 1
+            while count + length > capacity:
+                grown = np.empty(2 * capacity, dtype=np.int64)
+                grown[:count] = values[:count]
+                values = grown
+                capacity *= 2
+            for b in range(first_nz, last_nz + 1):
+                if current[b] >= inf:
+                    # forbidden (never queried) or dead end
+                    is_dead = True
+                    q2 = row_ptr[a]
+                    while q2 < row_ptr[a + 1] and hi[q2] < b:
+                        q2 += 1
+                    if q2 < row_ptr[a + 1] and lo[q2] <= b:
+                        is_dead = False
+                    values[count] = inf if is_dead else 0
+                else:
+                    values[count] = current[b] - max(n_i - a, n_j - b)
+                count += 1
+            row_first[a] = first_nz
+            row_len[a] = length
+        next_row, current = current, next_row
+    row_offset = np.empty(n_i + 2, dtype=np.int64)
+    for a in range(n_i + 1):
+        row_offset[a] = starts[a]
+    row_offset[n_i + 1] = count
+    # rows were written from a = n_i down to 0: offsets are decreasing; lengths are exact
+    out = np.empty(count, dtype=np.int64)
+    position = 0
+    offsets = np.empty(n_i + 2, dtype=np.int64)
+    for a in range(n_i + 1):
+        offsets[a] = position
+        out[position : position + row_len[a]] = values[starts[a] : starts[a] + row_len[a]]
+        position += row_len[a]
+    offsets[n_i + 1] = position
+    return row_first, offsets, out

@@ -23,7 +23,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from auvplan._typing import FloatArray, IntArray
-from auvplan.deconfliction._conflict_kernels import pair_intervals, pair_reachability
+from auvplan.deconfliction._conflict_kernels import (
+    pair_cost_to_go,
+    pair_intervals,
+    pair_reachability,
+)
 from auvplan.deconfliction.problem import CoordinationProblem
 from auvplan.errors import InfeasibleError
 
@@ -186,3 +190,61 @@ def check_pairwise_timing(problem: CoordinationProblem, table: ConflictTable) ->
                     f"2 r_c = {problem.separation:g} m (plus grid margin "
                     f"{table.radius[i, j] - problem.separation:.3g} m) on every schedule"
                 )
+
+
+@dataclass(frozen=True)
+class PairHeuristic:
+    """Exact makespan-to-go of every pair ``i < j`` alone, as an excess over the free bound.
+
+    The free bound is ``max(n_i - k_i, n_j - k_j)``; rows are stored from their first to
+    their last non-zero excess.
+
+    Parameters
+    ----------
+    pair_base : ndarray of shape (n_vehicles ** 2,)
+        Offset of pair ``(i, j)``'s rows in ``row_first`` (``row_offset`` uses the same base).
+    row_first : ndarray
+        First stored column ``k_j`` of each row.
+    row_offset : ndarray
+        Offsets of each row's values in ``excess`` (one extra entry per pair).
+    excess : ndarray
+        Excess values [time steps]; ``UNREACHABLE`` marks dead ends.
+    """
+
+    pair_base: IntArray
+    row_first: IntArray
+    row_offset: IntArray
+    excess: IntArray
+
+
+def build_pair_heuristic(problem: CoordinationProblem, table: ConflictTable) -> PairHeuristic:
+    """Backward dynamic programme on every pair's 2-D grid (see ``pair_cost_to_go``)."""
+    n = problem.n_vehicles
+    base = np.full(n * n, -1, dtype=np.int64)
+    firsts: list[IntArray] = []
+    offsets: list[IntArray] = []
+    values: list[IntArray] = []
+    n_rows = 0
+    n_values = 0
+    for i in range(n):
+        for j in range(i + 1, n):
+            n_i = int(problem.n_steps[i])
+            pair_rows = table.row_ptr[table.pair_base[i * n + j] :]
+            first, offset, excess = pair_cost_to_go(
+                pair_rows[: n_i + 2], table.lo, table.hi, n_i, int(problem.n_steps[j])
+            )
+            if excess.shape[0] == 0:
+                continue  # the pair never interacts: the individual bound is exact
+            base[i * n + j] = n_rows
+            firsts.append(np.append(first, 0))  # pad to the offsets' length
+            offsets.append(offset + n_values)
+            values.append(excess)
+            n_rows += n_i + 2
+            n_values += excess.shape[0]
+    empty = np.zeros(0, dtype=np.int64)
+    return PairHeuristic(
+        pair_base=base,
+        row_first=np.concatenate(firsts) if firsts else empty,
+        row_offset=np.concatenate(offsets) if offsets else empty,
+        excess=np.concatenate(values) if values else empty,
+    )
