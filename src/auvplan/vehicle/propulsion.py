@@ -232,14 +232,16 @@ def smooth_thrust_torque_expression(
     inflow = ca.sqrt(inflow_sq)
     cos_1 = v_p / inflow
     sin_1 = advance_speed / inflow
-    thrust_series = propeller.A_T[0] * speed_sq
-    torque_series = propeller.A_Q[0] * speed_sq
+    harmonics_t = ca.SX(0.0)
+    harmonics_q = ca.SX(0.0)
     cos_k, sin_k = cos_1, sin_1
     for k in range(1, order + 1):
         if k > 1:
             cos_k, sin_k = cos_k * cos_1 - sin_k * sin_1, sin_k * cos_1 + cos_k * sin_1
-        thrust_series += inflow_sq * (propeller.A_T[k] * cos_k + propeller.B_T[k] * sin_k)
-        torque_series += inflow_sq * (propeller.A_Q[k] * cos_k + propeller.B_Q[k] * sin_k)
+        harmonics_t += propeller.A_T[k] * cos_k + propeller.B_T[k] * sin_k
+        harmonics_q += propeller.A_Q[k] * cos_k + propeller.B_Q[k] * sin_k
+    thrust_series = propeller.A_T[0] * speed_sq + inflow_sq * harmonics_t
+    torque_series = propeller.A_Q[0] * speed_sq + inflow_sq * harmonics_q
     scale = 0.5 * rho * propeller.disc_area
     thrust = propeller.c_T * scale * thrust_series
     torque = propeller.c_Q * scale * propeller.diameter * torque_series
