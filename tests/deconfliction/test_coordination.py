@@ -1,0 +1,201 @@
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from _deconfliction_oracles import (
+    brute_force_optimum,
+    dense_min_separation,
+    distance_to_polyline,
+)
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from auvplan.deconfliction import (
+    CoordinationProblem,
+    CoordinationResult,
+    CoordinationStatus,
+    deconflict,
+    timed_headings,
+    timed_positions,
+)
+from auvplan.errors import InfeasibleError, InputError
+
+METHODS = [("astar", 1.0), ("astar", None), ("prioritized", None)]
+
+
+def check_schedule(problem: CoordinationProblem, result: CoordinationResult) -> None:
+    """Safe, on the paths, monotone, from start to goal, within cruise speed."""
+    assert result.success
+    assert result.certificate.holds
+    assert result.min_separation >= problem.separation - 1e-9
+    assert dense_min_separation(problem, result) >= result.min_separation - 1e-9
+    assert np.all(result.progress[:, 0] == 0.0)
+    np.testing.assert_array_equal(result.progress[:, -1], problem.path_lengths)
+    assert np.all(np.diff(result.progress, axis=1) >= 0.0)
+    speed = np.diff(result.progress, axis=1) / np.diff(result.time)
+    assert np.all(speed <= problem.cruise_speeds[:, None] * (1 + 1e-9))
+    times = np.linspace(0.0, result.time[-1], 37)
+    positions = timed_positions(result, problem, times)
+    assert positions.shape == (problem.n_vehicles, times.size, 2)
+    for i, path in enumerate(problem.paths):
+        assert max(distance_to_polyline(path, p) for p in positions[i]) < 1e-9
+    assert np.all(result.delays >= -1e-9)
+    np.testing.assert_allclose(result.arrival_times - problem.nominal_arrival_times, result.delays)
+
+
+def crossing(
+    angles_deg: list[float], half_length: float, time_step: float, safety_radius: float = 1.0
+) -> CoordinationProblem:
+    paths = []
+    for angle in np.radians(angles_deg):
+        direction = np.array([np.cos(angle), np.sin(angle)])  # north, east
+        paths.append(np.array([-half_length * direction, half_length * direction]))
+    return CoordinationProblem(tuple(paths), safety_radius, np.ones(len(paths)), time_step)
+
+
+@pytest.mark.parametrize(("method", "weight"), METHODS)
+def test_right_angle_crossing(method: str, weight: float | None) -> None:
+    problem = crossing([0.0, 90.0], half_length=12.0, time_step=0.5)
+    result = deconflict(problem, method=method, weight=weight)
+    check_schedule(problem, result)
+    # exactly one vehicle yields; the nominal schedule would collide at the centre
+    assert sorted(result.delays > 0.25) == [False, True]
+    if weight == 1.0:
+        assert result.status is CoordinationStatus.OPTIMAL
+        steps, waits = brute_force_optimum(problem)  # type: ignore[misc]
+        assert result.objective[0] == pytest.approx(steps * problem.time_step)
+        assert result.delays.sum() == pytest.approx(waits * problem.time_step)
+
+
+def test_head_on_solved_by_waiting() -> None:
+    # vehicle 1 runs west along vehicle 0's line, then leaves it northwards at east = 5 m;
+    # vehicle 1 starts on vehicle 0's path, so vehicle 0 must wait until 1 has turned off
+    east_bound = np.array([[0.0, -10.0], [0.0, 30.0]])
+    west_then_north = np.array([[0.0, 25.0], [0.0, 5.0], [20.0, 5.0]])
+    problem = CoordinationProblem((east_bound, west_then_north), 1.0, np.ones(2), 0.5)
+    nominal_gap = np.hypot(*(east_bound[0] + [0, 17.5] - west_then_north[0] - [0, -17.5]))
+    assert nominal_gap < problem.separation  # the nominal schedule collides head-on
+    for method, weight in METHODS:
+        result = deconflict(problem, method=method, weight=weight)
+        check_schedule(problem, result)
+        assert result.delays[0] > 5.0  # vehicle 0 waits for the other to leave the line
+        assert result.delays[1] < problem.time_step
+
+
+def test_overtaking_on_a_shared_segment_slows_the_faster_vehicle() -> None:
+    slow = np.array([[0.0, 0.0], [0.0, 40.0]])
+    fast = np.array([[0.0, -10.0], [0.0, 20.0], [20.0, 20.0]])
+    problem = CoordinationProblem((slow, fast), 1.0, np.array([0.5, 1.0]), 0.5)
+    for method, weight in METHODS:
+        result = deconflict(problem, method=method, weight=weight)
+        check_schedule(problem, result)
+        assert result.delays[0] < problem.time_step
+        # the fast vehicle cannot reach the turn at east = 20 m before the slow one is 2 r_c past it
+        assert result.delays[1] >= (20.0 + problem.separation) / 0.5 - 30.0 - 1e-9
+
+
+@pytest.fixture(scope="module")
+def four_way() -> CoordinationProblem:
+    return crossing([0.0, 45.0, 90.0, 135.0], half_length=6.0, time_step=1.5)
+
+
+def test_four_vehicles_at_one_point_optimal_on_the_grid(four_way: CoordinationProblem) -> None:
+    steps, waits = brute_force_optimum(four_way)  # type: ignore[misc]
+    assert waits > 0  # there are real conflicts
+    for heuristic in ("pairwise", "max"):
+        result = deconflict(four_way, weight=1.0, heuristic=heuristic)
+        check_schedule(four_way, result)
+        assert result.status is CoordinationStatus.OPTIMAL
+        assert result.objective[0] == pytest.approx(steps * four_way.time_step)
+        assert result.delays.sum() == pytest.approx(waits * four_way.time_step)
+    weighted = deconflict(four_way)  # weight sqrt(4) = 2: makespan within 2x the optimum
+    check_schedule(four_way, weighted)
+    assert weighted.status is CoordinationStatus.BOUNDED_SUBOPTIMAL
+    assert weighted.objective[0] <= 2.0 * steps * four_way.time_step + 1e-9
+    prioritized = deconflict(four_way, method="prioritized")
+    check_schedule(four_way, prioritized)
+    assert prioritized.status is CoordinationStatus.FEASIBLE
+    assert prioritized.objective[0] >= steps * four_way.time_step - 1e-9
+
+
+def test_headings_follow_the_path_tangent(four_way: CoordinationProblem) -> None:
+    result = deconflict(four_way, method="prioritized")
+    psi = timed_headings(result, four_way, np.array([0.0, 3.0, result.time[-1]]))
+    expected = np.radians([0.0, 45.0, 90.0, 135.0])
+    np.testing.assert_allclose(psi, np.repeat(expected[:, None], 3, axis=1), atol=1e-12)
+
+
+def test_infeasible_starts_and_goals_name_the_pair() -> None:
+    paths = (np.array([[0.0, 0.0], [10.0, 0.0]]), np.array([[0.0, 1.5], [-10.0, 20.0]]))
+    with pytest.raises(InfeasibleError, match=r"vehicles 0 and 1 both begin .*\(north, east\)"):
+        deconflict(CoordinationProblem(paths, 1.0, np.ones(2), 0.5))
+    paths = (np.array([[0.0, 0.0], [10.0, 0.0]]), np.array([[0.0, 20.0], [10.0, 1.0]]))
+    with pytest.raises(InfeasibleError, match=r"vehicles 0 and 1 both end"):
+        deconflict(CoordinationProblem(paths, 1.0, np.ones(2), 0.5), method="prioritized")
+
+
+@pytest.mark.parametrize("method", ["astar", "prioritized"])
+def test_head_on_swap_on_one_line_is_infeasible(method: str) -> None:
+    # each vehicle's goal lies on the other's path: no timing lets them pass
+    line = np.array([[0.0, 0.0], [0.0, 30.0]])
+    problem = CoordinationProblem((line, line[::-1].copy()), 1.0, np.ones(2), 0.5)
+    with pytest.raises(InfeasibleError) as info:
+        deconflict(problem, method=method)
+    message = str(info.value)
+    assert "vehicles 0 and 1 cannot be separated by timing" in message
+    assert "(north, east)" in message
+    assert "\n" not in message
+
+
+def test_goal_on_the_path_of_a_vehicle_that_must_wait_forever() -> None:
+    # vehicle 1 starts on vehicle 0's line and ends on it further ahead: vehicle 0 can
+    # neither pass it (head-on is impossible, same direction means 1 ends in 0's way)
+    blocker = np.array([[0.0, 10.0], [0.0, 20.0]])
+    runner = np.array([[0.0, 0.0], [0.0, 30.0]])
+    problem = CoordinationProblem((runner, blocker), 1.0, np.ones(2), 0.5)
+    with pytest.raises(InfeasibleError, match=r"vehicle 1's goal"):
+        deconflict(problem)
+
+
+def test_bad_options() -> None:
+    problem = crossing([0.0, 90.0], half_length=5.0, time_step=0.5)
+    with pytest.raises(InputError, match="method"):
+        deconflict(problem, method="rrt")
+    with pytest.raises(InputError, match="weight"):
+        deconflict(problem, weight=0.5)
+    with pytest.raises(InputError, match="weight"):
+        deconflict(problem, method="prioritized", weight=2.0)
+    with pytest.raises(InputError, match="heuristic"):
+        deconflict(problem, heuristic="euclid")
+
+
+def test_single_vehicle_is_its_nominal_schedule() -> None:
+    problem = CoordinationProblem((np.array([[0.0, 0.0], [3.0, 4.0]]),), 1.0, np.array([2.0]), 0.5)
+    for method in ("astar", "prioritized"):
+        result = deconflict(problem, method=method)
+        assert result.time[-1] == 2.5
+        assert math.isinf(result.min_separation)
+        assert result.delays[0] == pytest.approx(0.0)
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**32 - 1), method=st.sampled_from(["astar", "prioritized"]))
+def test_random_path_sets_are_safe_or_infeasible(seed: int, method: str) -> None:
+    rng = np.random.default_rng(seed)
+    n_vehicles = int(rng.integers(2, 4))
+    paths = tuple(
+        np.cumsum(np.vstack([rng.uniform(0, 20, 2), rng.uniform(-8, 8, size=(2, 2))]), axis=0)
+        for _ in range(n_vehicles)
+    )
+    problem = CoordinationProblem(paths, 1.0, rng.uniform(0.5, 1.5, n_vehicles), 1.0)
+    try:
+        result = deconflict(problem, method=method)
+    except InfeasibleError as error:
+        message = str(error)
+    else:
+        check_schedule(problem, result)
+        return
+    assert "vehicle" in message
+    assert "\n" not in message
