@@ -144,6 +144,10 @@ def trim_surge(model: VehicleModel, speed: float) -> SurgeTrim:
 def steady_motion(model: VehicleModel, n_ps: float, n_sb: float) -> SteadyMotion:
     """Steady body velocities ``(u, v, r)`` with both propeller speeds held fixed.
 
+    Solved from a few starting points (the first equilibrium found is returned; with an
+    unstable hull there can be more than one, e.g. an unstable straight-ish motion and a
+    stable tight turn).
+
     Parameters
     ----------
     model : VehicleModel
@@ -179,14 +183,18 @@ def steady_motion(model: VehicleModel, n_ps: float, n_sb: float) -> SteadyMotion
 
     mean_n = 0.5 * (n_ps + n_sb)
     guess_u = math.copysign(1.0, mean_n) * min(abs(mean_n) / 50.0, 1.5)
-    guess_r = 1.0 * (n_ps - n_sb) / (2.0 * model.params.n_max)
-    solution = root(residual, np.array([guess_u, 0.0, guess_r]), jac=residual_jacobian, tol=1e-12)
-    if not solution.success or np.max(np.abs(residual(solution.x))) > 1e-8:
-        raise SolverError(
-            f"steady motion for n = ({n_ps}, {n_sb}) rev/s did not converge: {solution.message}"
-        )
-    u, v, r = (float(value) for value in solution.x)
-    return SteadyMotion(u, v, r)
+    guess_r = (n_ps - n_sb) / (2.0 * model.params.n_max)
+    turn = math.copysign(1.0, guess_r) if guess_r != 0.0 else 1.0
+    # multi-start: with DSOR's MEDUSA hull (m_v > m_u) straight motion is directionally
+    # unstable above ~0.7 m/s and a small differential gives a tight steady turn
+    message = ""
+    for r0 in (guess_r, 0.1 * turn, 0.3 * turn, 0.6 * turn, 1.0 * turn, -0.3 * turn):
+        solution = root(residual, np.array([guess_u, 0.0, r0]), jac=residual_jacobian, tol=1e-12)
+        if solution.success and np.max(np.abs(residual(solution.x))) <= 1e-8:
+            u, v, r = (float(value) for value in solution.x)
+            return SteadyMotion(u, v, r)
+        message = str(solution.message)
+    raise SolverError(f"steady motion for n = ({n_ps}, {n_sb}) rev/s did not converge: {message}")
 
 
 def trim_turn(model: VehicleModel, speed: float, yaw_rate: float) -> TurnTrim:
