@@ -2,7 +2,8 @@ r"""Smoothing a staircase grid path into a C² curve, resampled at uniform arc l
 
 :func:`smooth_path` fits a parametric cubic smoothing spline (FITPACK ``splprep``; quadratic
 for three points) to the grid polyline, parametrised by chord length, and shrinks the
-smoothing factor until
+smoothing locally until (after dropping zig-zags smaller than half the bound with
+Douglas–Peucker)
 
 1. the curve stays within ``max_deviation`` of the polyline and the polyline within
    ``max_deviation`` of the curve (a two-sided Hausdorff bound, checked conservatively on
@@ -19,6 +20,7 @@ first and last polyline points and has equal arc-length steps of ``L / n`` with
 from __future__ import annotations
 
 import logging
+import warnings
 from collections.abc import Callable
 
 import numpy as np
@@ -30,8 +32,10 @@ from auvplan.errors import InputError
 
 logger = logging.getLogger(__name__)
 
-#: Number of times the smoothing factor is divided by 4 before giving up on smoothing.
-_N_TRIALS = 12
+#: Number of spline fits tried before falling back to the polyline.
+_N_TRIALS = 40
+#: Largest data weight of the spline fit (also the weight of the two end points).
+_MAX_WEIGHT = 1e3
 
 
 def path_length(points: FloatArray) -> float:
@@ -113,9 +117,12 @@ def smooth_path(
     Notes
     -----
     FITPACK's smoothing condition is :math:`\sum_i w_i^2 \|p_i - s(u_i)\|^2 \le S`, with
-    chord-length parameters :math:`u_i`. We start at :math:`S = n\,\delta^2`
-    (:math:`\delta` = ``max_deviation``), weight the end points by :math:`10^3` so that the
-    curve starts and ends on them, and divide :math:`S` by 4 until the checks pass.
+    chord-length parameters :math:`u_i` of the data points: the polyline simplified by
+    Douglas–Peucker (tolerance :math:`\delta / 2`, :math:`\delta` = ``max_deviation``) and
+    resampled every :math:`\delta`. We start at :math:`S = n \delta^2` with unit weights (end
+    points :math:`10^3`, so that the curve starts and ends on them) and, where a check fails,
+    multiply the weights of the nearest data points by 4 (dividing :math:`S` by 4 once they
+    reach :math:`10^3`), so the curve is pulled towards the polyline only where it must be.
 
     Examples
     --------
@@ -133,29 +140,106 @@ def smooth_path(
     if not (np.isfinite(max_deviation) and max_deviation > 0.0):
         raise InputError(f"max_deviation must be finite and > 0, got {max_deviation!r} m")
     resolution = 0.1 * min(max_deviation, spacing)
-    polyline_dense = _resample_polyline(points, resolution)
-    if len(points) >= 3:
-        chord = np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))))
-        weights = np.ones(len(points))
-        weights[[0, -1]] = 1e3
-        smoothing = len(points) * max_deviation**2
-        for _ in range(_N_TRIALS):
+    grid_path = points
+    # fit to the simplified polyline, resampled every max_deviation so that the spline has
+    # data along the straight stretches (not only at their corners)
+    fit_points = _resample_polyline(_simplify(grid_path, 0.5 * max_deviation), max_deviation)
+    if len(fit_points) >= 3:
+        curve = _fit_within_bounds(
+            fit_points,
+            _resample_polyline(grid_path, resolution),
+            spacing,
+            max_deviation,
+            resolution,
+            is_blocked,
+        )
+        if curve is not None:
+            return curve
+        logger.info("smooth_path: no spline passed the checks; returning the polyline")
+    n_steps = max(1, round(path_length(grid_path) / spacing))
+    return _resample_polyline(grid_path, 0.0, n_steps=n_steps)
+
+
+def _fit_within_bounds(
+    fit_points: FloatArray,
+    polyline_dense: FloatArray,
+    spacing: float,
+    max_deviation: float,
+    resolution: float,
+    is_blocked: Callable[[FloatArray, FloatArray], BoolArray] | None,
+) -> FloatArray | None:
+    """Smoothing spline refined locally until it passes the checks, or ``None``.
+
+    Where the curve violates a check, the weights of the nearest data points are multiplied by
+    4 (up to :data:`_MAX_WEIGHT`), which pulls the curve towards the polyline there only; when
+    those weights are already at the cap, the global smoothing factor is divided by 4.
+    """
+    chord = np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(fit_points, axis=0), axis=1))))
+    weights = np.ones(len(fit_points))
+    weights[[0, -1]] = _MAX_WEIGHT
+    smoothing = len(fit_points) * max_deviation**2
+    data_tree = cKDTree(fit_points)
+    polyline_tree = cKDTree(polyline_dense)
+    limit = max_deviation - resolution  # see _violations
+    for _ in range(_N_TRIALS):
+        with warnings.catch_warnings():  # FITPACK's "s too small" notice: checked below
+            warnings.simplefilter("ignore", RuntimeWarning)
             tck, _u = splprep(
-                points.T, u=chord, w=weights, s=smoothing, k=min(3, len(points) - 1), quiet=2
+                fit_points.T,
+                u=chord,
+                w=weights,
+                s=smoothing,
+                k=min(3, len(fit_points) - 1),
+                quiet=2,
             )
-            dense = _resample_spline(tck, chord[-1], points, resolution)
-            n_steps = max(1, round(path_length(dense) / spacing))
-            curve = _resample_spline(tck, chord[-1], points, resolution, n_steps=n_steps)
-            # the chords between output samples must avoid no-go cells too
-            chords = _resample_polyline(curve, resolution)
-            if _is_acceptable(
-                dense, polyline_dense, max_deviation, resolution, is_blocked
-            ) and not _hits(chords, is_blocked):
-                return curve
+        dense = _resample_spline(tck, chord[-1], fit_points, resolution)
+        n_steps = max(1, round(path_length(dense) / spacing))
+        curve = _resample_spline(tck, chord[-1], fit_points, resolution, n_steps=n_steps)
+        # the straight chords between output samples must avoid no-go cells too
+        chords = _resample_polyline(curve, resolution)
+        bad = np.vstack(
+            (
+                dense[polyline_tree.query(dense)[0] > limit],
+                polyline_dense[cKDTree(dense).query(polyline_dense)[0] > limit],
+                _blocked_points(dense, is_blocked),
+                _blocked_points(chords, is_blocked),
+            )
+        )
+        if len(bad) == 0:
+            return curve
+        near = np.unique(data_tree.query(bad, k=min(3, len(fit_points)))[1])
+        if np.all(weights[near] >= _MAX_WEIGHT):
             smoothing *= 0.25
-        logger.info("smooth_path: no smoothing factor passed the checks; returning the polyline")
-    n_steps = max(1, round(path_length(points) / spacing))
-    return _resample_polyline(points, 0.0, n_steps=n_steps)
+        weights[near] = np.minimum(4.0 * weights[near], _MAX_WEIGHT)
+    return None
+
+
+def _simplify(points: FloatArray, tolerance: float) -> FloatArray:
+    """Douglas–Peucker: keep the vertices needed to stay within ``tolerance`` [m] of the polyline.
+
+    Removes the grid's zig-zags smaller than the tolerance before the spline fit, so that a
+    global smoothing factor is not held back by them. The deviation check in
+    :func:`smooth_path` still uses the original polyline.
+    """
+    keep = np.zeros(len(points), dtype=np.bool_)
+    keep[[0, -1]] = True
+    stack = [(0, len(points) - 1)]
+    while stack:
+        first, last = stack.pop()
+        if last - first < 2:
+            continue
+        inner = points[first + 1 : last]
+        a, b = points[first], points[last]
+        ab = b - a
+        length2 = float(ab @ ab)
+        t = np.clip((inner - a) @ ab / length2, 0.0, 1.0) if length2 > 0.0 else 0.0
+        distance = np.linalg.norm(inner - (a + np.multiply.outer(t, ab)), axis=1)
+        worst = int(np.argmax(distance))
+        if distance[worst] > tolerance:
+            split = first + 1 + worst
+            keep[split] = True
+            stack.extend(((first, split), (split, last)))
+    return points[keep]
 
 
 def _clean(points: FloatArray) -> FloatArray:
@@ -220,26 +304,15 @@ def _resample_spline(
     return out
 
 
-def _is_acceptable(
-    curve: FloatArray,
-    polyline: FloatArray,
-    max_deviation: float,
-    resolution: float,
-    is_blocked: Callable[[FloatArray, FloatArray], BoolArray] | None,
-) -> bool:
-    """Two-sided deviation bound (on dense samples, conservative) and no blocked samples."""
-    # a sample-to-samples distance over-estimates the point-to-curve distance; points between
-    # samples are within resolution / 2 of one, hence the limit max_deviation - resolution
-    limit = max_deviation - resolution
-    if cKDTree(polyline).query(curve)[0].max() > limit:
-        return False
-    if cKDTree(curve).query(polyline)[0].max() > limit:
-        return False
-    return not _hits(curve, is_blocked)
-
-
-def _hits(
+def _blocked_points(
     points: FloatArray, is_blocked: Callable[[FloatArray, FloatArray], BoolArray] | None
-) -> bool:
-    """Whether any point is no-go."""
-    return is_blocked is not None and bool(np.any(is_blocked(points[:, 0], points[:, 1])))
+) -> FloatArray:
+    """The rows of ``points`` that are no-go (none when ``is_blocked`` is ``None``).
+
+    Deviations are measured from dense samples to dense samples: that over-estimates the
+    point-to-curve distance, and points between samples are within ``resolution / 2`` of one,
+    hence the acceptance limit ``max_deviation - resolution``.
+    """
+    if is_blocked is None:
+        return np.empty((0, 2))
+    return np.asarray(points[np.asarray(is_blocked(points[:, 0], points[:, 1]), dtype=bool)])
