@@ -123,6 +123,13 @@ def test_shape_mismatch(grid: GridGeometry) -> None:
         plan_route(np.ones((3, 3)), grid, (0.0, 120.0), (1.0, 121.0))
 
 
+def test_bad_cost_values_name_the_vehicle(grid: GridGeometry, cost: np.ndarray) -> None:
+    cost = cost.copy()
+    cost[0, 0] = -1.0
+    with pytest.raises(InputError, match="auv3: cost must be > 0"):
+        plan_route(cost, grid, (0.0, 120.0), (1.0, 121.0), name="auv3")
+
+
 def test_blocked_lookup_matches_cells(grid: GridGeometry, cost: np.ndarray) -> None:
     blocked = blocked_cells(cost, grid)
     is_blocked = blocked_lookup(grid, blocked)

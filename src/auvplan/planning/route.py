@@ -193,14 +193,17 @@ def plan_route(
         cells[label] = _endpoint_cell(
             label, point, geometry, blocked_nan, mask, obstacles, clearance, name
         )
-    problem = PlanningProblem(
-        cost,
-        mask,
-        cells["start"],
-        cells["goal"],
-        geometry.spacing_north,
-        geometry.spacing_east,
-    )
+    try:
+        problem = PlanningProblem(
+            cost,
+            mask,
+            cells["start"],
+            cells["goal"],
+            geometry.spacing_north,
+            geometry.spacing_east,
+        )
+    except InputError as error:
+        raise InputError(f"{name}: {error}") from error
     result = plan_astar(problem, edge_model=edge_model)
     if not result.success:
         raise InfeasibleError(
