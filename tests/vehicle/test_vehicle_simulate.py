@@ -70,6 +70,16 @@ def test_rk4_matches_adaptive_reference_on_a_manoeuvre(model: VehicleModel) -> N
     assert errors[0.1] < errors[0.5] / 5
 
 
+def test_swapped_inputs_give_the_mirrored_trajectory(model: VehicleModel) -> None:
+    inputs = manoeuvre_inputs()
+    states = rk4_simulate(model, np.zeros(8), inputs, MANOEUVRE_DT)
+    mirrored = rk4_simulate(model, np.zeros(8), inputs[:, ::-1], MANOEUVRE_DT)
+    np.testing.assert_allclose(mirrored[:, [0, 3]], states[:, [0, 3]], atol=1e-9)
+    np.testing.assert_allclose(mirrored[:, [1, 2, 4, 5]], -states[:, [1, 2, 4, 5]], atol=1e-9)
+    np.testing.assert_allclose(mirrored[:, [6, 7]], states[:, [7, 6]], atol=1e-9)
+    assert states[:, 1].max() > 1.0  # the manoeuvre does go east (starboard turn first)
+
+
 def test_rk4_rollout_equals_repeated_steps(model: VehicleModel, rng: np.random.Generator) -> None:
     inputs = rng.uniform(-0.3, 0.3, (6, 2))
     x0 = np.array([1.0, 2.0, 0.3, 0.5, 0.0, 0.1, 30.0, 25.0])

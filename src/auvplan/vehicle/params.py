@@ -241,11 +241,11 @@ class VehicleParams:
     name: str
     """Vehicle type name [-]."""
     hull: HullParams
-    """Hull parameters."""
+    """Hull parameters [units per field of HullParams]."""
     propeller: PropellerParams
-    """Propeller (both thrusters)."""
+    """Propeller of both thrusters [units per field of PropellerParams]."""
     motor: MotorParams
-    """Motor (both thrusters)."""
+    """Motor of both thrusters [units per field of MotorParams]."""
     l: float  # noqa: E741  (the paper's symbol)
     """Half the lateral spacing of the two thrusters [m]."""
     hotel_power: float
