@@ -125,22 +125,15 @@ class Row:
     n_cells: int
 
 
-def median_time(
-    run: Callable[[], tuple[np.ndarray, float]], repeats: int
-) -> tuple[float, float, tuple[np.ndarray, float]]:
-    """Median CPU time and wall time [s] of ``run`` after one warm-up call, and its output.
+def time_once(run: Callable[[], tuple[np.ndarray, float]]) -> tuple[float, float]:
+    """CPU time and wall time [s] of one call of ``run``.
 
-    CPU time (``time.process_time``, all tools are single-threaded and in-process) is the
-    fair measure on a shared machine; wall time is shown alongside.
+    CPU time (``time.process_time``; all tools are single-threaded and in-process) is the
+    fairer measure on a shared machine; wall time is shown alongside.
     """
-    cpu, wall = [], []
-    out = run()  # warm-up (numba compile / cache load, imports)
-    for _ in range(repeats):
-        cpu_start, wall_start = time.process_time(), time.perf_counter()
-        out = run()
-        cpu.append(time.process_time() - cpu_start)
-        wall.append(time.perf_counter() - wall_start)
-    return statistics.median(cpu), statistics.median(wall), out
+    cpu_start, wall_start = time.process_time(), time.perf_counter()
+    run()
+    return time.process_time() - cpu_start, time.perf_counter() - wall_start
 
 
 def tools(cost: np.ndarray) -> list[tuple[str, str, Callable[[], tuple[np.ndarray, float]]]]:
@@ -161,12 +154,32 @@ def tools(cost: np.ndarray) -> list[tuple[str, str, Callable[[], tuple[np.ndarra
 
 
 def measure(sizes: list[int], repeats: int) -> list[Row]:
+    """Median times per tool; repeats are interleaved across tools so load noise hits all."""
     rows = []
     for n in sizes:
         cost = terrain_cost(n)
-        for model, tool, run in tools(cost):
-            cpu, wall, (path, path_cost) = median_time(run, repeats)
-            rows.append(Row(n, model, tool, cpu, wall, path_cost, len(path)))
+        candidates = tools(cost)
+        outputs = [run() for _, _, run in candidates]  # warm-up: numba cache, imports
+        cpu: list[list[float]] = [[] for _ in candidates]
+        wall: list[list[float]] = [[] for _ in candidates]
+        for _ in range(repeats):
+            for i, (_, _, run) in enumerate(candidates):
+                cpu_s, wall_s = time_once(run)
+                cpu[i].append(cpu_s)
+                wall[i].append(wall_s)
+        for i, (model, tool, _) in enumerate(candidates):
+            path, path_cost = outputs[i]
+            rows.append(
+                Row(
+                    n,
+                    model,
+                    tool,
+                    statistics.median(cpu[i]),
+                    statistics.median(wall[i]),
+                    path_cost,
+                    len(path),
+                )
+            )
     return rows
 
 
@@ -219,7 +232,10 @@ def main() -> None:
     parser.add_argument("--sizes", type=int, nargs="+", default=[1000, 2000])
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args()
-    print(f"median of {args.repeats} runs after a warm-up; ratio = CPU time ours / theirs")
+    print(
+        f"median of {args.repeats} interleaved runs after a warm-up; "
+        "ratio = median CPU time ours / theirs"
+    )
     print_table(measure(args.sizes, args.repeats))
 
 

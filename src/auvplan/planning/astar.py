@@ -136,6 +136,8 @@ def search_grid(
     """
     if not isinstance(edge_model, EdgeModel):
         raise InputError(f"edge_model must be an EdgeModel, got {edge_model!r}")
+    if queue not in ("auto", "buckets", "heap"):
+        raise InputError(f"queue must be 'auto', 'buckets' or 'heap', got {queue!r}")
     n_rows, n_cols = problem.shape
     if (n_rows + 2) * (n_cols + 2) >= 2**31 - 1:
         raise InputError(f"grid {n_rows} x {n_cols} is too large (more than 2**31 cells)")
