@@ -27,8 +27,9 @@ scaled by :math:`\alpha < 1` (every reduced edge weight is then at least
 (paper) and :math:`0.75` (crossed), lowered when the cost range would need more than
 :data:`MAX_BUCKETS` buckets; when even :math:`\alpha = 0` (Dijkstra) would, a binary heap
 with the full heuristic (:math:`\alpha = 1`) is used. The choice changes the number of cells
-expanded, never the optimal cost. The kernels are compiled by numba and cached on disk; the
-first call in a fresh environment compiles them (a few seconds).
+expanded (and which of several equally cheap paths is returned), never the optimal cost.
+The kernels are compiled by numba and cached on disk; the first call in a fresh environment
+compiles them (a few seconds).
 """
 
 from __future__ import annotations
