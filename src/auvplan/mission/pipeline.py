@@ -54,6 +54,9 @@ from auvplan.planning import (
     EdgeModel,
     PolygonObstacle,
     Route,
+    blocked_cells,
+    blocked_lookup,
+    path_length,
     plan_route,
     smooth_path,
 )
@@ -311,16 +314,15 @@ def _smooth(
     obstacles: tuple[CircleObstacle | PolygonObstacle, ...],
     clearance: float,
 ) -> FloatArray:
+    """The route as a smooth curve within half a cell of it, never through no-go cells."""
     geometry = maps.cost_geometry
     cell = min(geometry.spacing_north, geometry.spacing_east)
+    blocked = blocked_cells(maps.shifted_cost, geometry, obstacles=obstacles, clearance=clearance)
     return smooth_path(
         route.points,
-        spacing=0.5 * cell,
+        spacing=0.25 * cell,
         max_deviation=0.5 * cell,
-        cost=maps.shifted_cost,
-        geometry=geometry,
-        obstacles=obstacles,
-        clearance=clearance,
+        is_blocked=blocked_lookup(geometry, blocked),
     )
 
 
@@ -385,7 +387,7 @@ def run_deconfliction(
     at ``T`` (:func:`auvplan.deconfliction.retime_for_arrival`).
     """
     fleet = config.fleet
-    lengths = np.array([_path_length(path) for path in preplan.paths])
+    lengths = np.array([path_length(path) for path in preplan.paths])
     limits = np.array([SPEED_MARGIN * top_speed(model) for model in models])
     dt = config.solver.dt
     if fleet.horizon is not None:
@@ -446,10 +448,6 @@ def run_deconfliction(
         coordination.certificate.min_separation,
     )
     return DeconflictStage(horizon, speeds, problem, coordination, time, desired)
-
-
-def _path_length(path: FloatArray) -> float:
-    return float(np.sum(np.hypot(*np.diff(path, axis=0).T)))
 
 
 def _desired_states(

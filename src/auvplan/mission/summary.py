@@ -10,6 +10,7 @@ import numpy as np
 
 from auvplan import __version__
 from auvplan.mission.pipeline import MissionResult, OptimizedPlan
+from auvplan.planning import path_length
 
 
 def _record(record: Any) -> Any:
@@ -89,7 +90,7 @@ def mission_summary(result: MissionResult) -> dict[str, Any]:
                 "graph_cost": route.cost,
                 "n_expanded": route.n_expanded,
                 "points_north_east_m": route.points,
-                "smoothed_length_m": float(np.sum(np.hypot(*np.diff(preplan.paths[i], axis=0).T))),
+                "smoothed_length_m": path_length(preplan.paths[i]),
             },
         }
         summary["vehicles"].append(vehicle)
