@@ -48,7 +48,10 @@ def test_every_output_file_is_present(demo_output: Path) -> None:
 
 def test_resimulation_reproduces_trajectories(demo_output: Path) -> None:
     """Re-simulating c_ps, c_sb with an adaptive integrator stays within 0.5 m."""
-    model = build_vehicle_model(load_vehicle("medusa"))
+    summary = json.loads((demo_output / "summary.json").read_text())
+    model = build_vehicle_model(
+        load_vehicle("medusa"), propeller_order=summary["solver"]["propeller_order"]
+    )
     for track in _read_trajectories(demo_output / "trajectories.csv").values():
         time, states, inputs = track[:, 0], track[:, 1:9], track[:, 9:11]
         reference = simulate_adaptive(model, states[0], inputs[:-1], (time[0], time[-1]))

@@ -359,12 +359,16 @@ def _obstacles(
 
 
 def _vehicle_models(config: MissionConfig) -> tuple[VehicleModel, ...]:
-    return tuple(_model_for_type(vehicle.type) for vehicle in config.vehicles)
+    order = config.solver.propeller_order
+    return tuple(_model_for_type(vehicle.type, order) for vehicle in config.vehicles)
 
 
 @cache
-def _model_for_type(vehicle_type: str) -> VehicleModel:
-    return build_vehicle_model(load_vehicle(vehicle_type))
+def _model_for_type(vehicle_type: str, propeller_order: int | None) -> VehicleModel:
+    params = load_vehicle(vehicle_type)
+    if propeller_order is not None:
+        propeller_order = min(propeller_order, params.propeller.max_order)
+    return build_vehicle_model(params, propeller_order=propeller_order)
 
 
 @cache

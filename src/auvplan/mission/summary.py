@@ -75,6 +75,7 @@ def mission_summary(result: MissionResult) -> dict[str, Any]:
             "edge_model": config.edge_model,
             "deconfliction_method": config.deconfliction.method,
         },
+        "solver": dataclasses.asdict(config.solver),
         "vehicles": [],
         "wall_time_s": dict(result.timings),
     }
