@@ -84,6 +84,7 @@ def build_fleet_functions(
     goals: FloatArray,
     *,
     safety_radius: float,
+    separation_margin: float,
     max_propeller_speeds: FloatArray,
     obstacles: FloatArray,
     comm_pairs: list[tuple[int, int, float]],
@@ -103,6 +104,9 @@ def build_fleet_functions(
         Goal ``north, east`` [m] and heading [rad] (already unwrapped next to the arrival heading).
     safety_radius : float
         ``r_c`` [m]; pairs keep ``>= 2 r_c``.
+    separation_margin : float
+        Added to ``2 r_c`` and to ``r_c + r_o`` [m] in the constraints, which are imposed at
+        the grid nodes only: it covers the largest dip of a distance between two nodes.
     max_propeller_speeds : ndarray of shape (n_vehicles,)
         ``n_max`` [rev/s] per vehicle.
     obstacles : ndarray of shape (n_obstacles, 3)
@@ -144,8 +148,9 @@ def build_fleet_functions(
         )
 
     constraints = _constraints(
-        x, c, p, xs, names, safety_radius, max_propeller_speeds, obstacles, comm_pairs
-    )
+        x, c, p, xs, names, safety_radius, separation_margin, max_propeller_speeds, obstacles,
+        comm_pairs,
+    )  # fmt: skip
     return FleetProblemFunctions(
         n_vehicles=n_vehicles,
         dynamics=ca.Function("fleet_f", [x, c, p], [xdot]),
@@ -163,6 +168,7 @@ def _constraints(
     xs: list[ca.SX],
     names: list[str],
     safety_radius: float,
+    margin: float,
     max_propeller_speeds: FloatArray,
     obstacles: FloatArray,
     comm_pairs: list[tuple[int, int, float]],
@@ -183,14 +189,17 @@ def _constraints(
     pairs = [(i, j) for i in range(n_vehicles) for j in range(i + 1, n_vehicles)]
     add(
         "collision",
-        [squared_distance(i, xs[j][0], xs[j][1]) / (2 * safety_radius) ** 2 - 1 for i, j in pairs],
+        [
+            squared_distance(i, xs[j][0], xs[j][1]) / (2 * safety_radius + margin) ** 2 - 1
+            for i, j in pairs
+        ],
         [f"{names[i]}-{names[j]}" for i, j in pairs],
         "hockey",
     )
     add(
         "obstacle",
         [
-            squared_distance(i, north, east) / (safety_radius + radius) ** 2 - 1
+            squared_distance(i, north, east) / (safety_radius + radius + margin) ** 2 - 1
             for i in range(n_vehicles)
             for north, east, radius in np.asarray(obstacles).reshape(-1, 3)
         ],

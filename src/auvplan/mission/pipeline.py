@@ -41,6 +41,7 @@ from auvplan.io.bathymetry import read_bathymetry
 from auvplan.io.vehicles import load_vehicle
 from auvplan.mission.config import MissionConfig, Position
 from auvplan.mission.fleet import FleetProblemFunctions, build_fleet_functions
+from auvplan.mission.verify import replay_closed_loop
 from auvplan.optimization import (
     PathConstraint,
     ProntoOptions,
@@ -63,7 +64,6 @@ from auvplan.planning import (
 from auvplan.terrain import BathymetryGrid, MapParameters, TerrainMaps, compute_terrain_maps
 from auvplan.terrain.synthetic import synthetic_bank
 from auvplan.vehicle import VehicleModel, build_vehicle_model
-from auvplan.vehicle.simulate import rk4_simulate
 from auvplan.vehicle.trim import top_speed, trim_surge
 
 logger = logging.getLogger(__name__)
@@ -127,8 +127,10 @@ class OptimizedPlan:
     ``arrival_error`` ``(n_vehicles,)`` [m], ``terrain_information`` ``(n_vehicles,)`` mean
     information-map value along the trajectory; ``separations[name][other]`` the minimum
     distance [m] to each other vehicle (centre to centre) and circular obstacle (to its edge),
-    on a grid ``CHECK_REFINEMENT`` times finer than the solver's (RK4 resimulation), whose
-    time series are ``fine_distances`` (labels ``"a / b"``) on ``fine_time``.
+    when the plan is flown with its tracking regulator on a grid ``CHECK_REFINEMENT`` times
+    finer than the solver's (:func:`auvplan.mission.verify.replay_closed_loop`), whose time
+    series are ``fine_distances`` (labels ``"a / b"``) on ``fine_time``; ``tracking_error``
+    ``(n_vehicles,)`` is that replay's largest distance [m] from the plan at the solver nodes.
     """
 
     result: ProntoResult
@@ -142,6 +144,7 @@ class OptimizedPlan:
     separations: dict[str, dict[str, float]]
     fine_time: FloatArray
     fine_distances: dict[str, FloatArray]
+    tracking_error: FloatArray
 
 
 @dataclass(frozen=True)
@@ -501,6 +504,19 @@ def _goal_poses(preplan: PreplanStage, desired: FloatArray) -> FloatArray:
     return goals
 
 
+def _separation_margin(config: MissionConfig, desired: FloatArray) -> float:
+    """Margin [m] on ``2 r_c`` for constraints imposed at the solver nodes only.
+
+    Two vehicles closing at relative speed ``w`` that are ``D`` apart at two consecutive nodes
+    come at most ``(w dt)² / (8 D)`` closer in between (straight-line relative motion); ``w``
+    is bounded by 1.5 x twice the fastest desired speed. At least 1 % of ``2 r_c`` is kept.
+    """
+    separation = 2.0 * config.fleet.safety_radius
+    relative_speed = 3.0 * float(np.max(desired[:, :, 3]))
+    dip = (relative_speed * config.solver.dt) ** 2 / (8.0 * separation)
+    return max(dip, 0.01 * separation)
+
+
 def build_trajectory_problem(
     config: MissionConfig,
     preplan: PreplanStage,
@@ -525,6 +541,7 @@ def build_trajectory_problem(
         names,
         _goal_poses(preplan, desired),
         safety_radius=config.fleet.safety_radius,
+        separation_margin=_separation_margin(config, desired),
         max_propeller_speeds=np.array([model.params.n_max for model in models]),
         obstacles=circles,
         comm_pairs=comm_pairs,
@@ -618,8 +635,26 @@ def _evaluate_plan(
     arrival = np.hypot(*(states[:, -1, :2] - preplan.goals[:, :2]).T)
     information = _information_along(preplan.maps, states)
 
-    fine_time, fine_positions = _resimulate_positions(
-        models, states[:, 0, :], inputs, deconfliction.time[1] - deconfliction.time[0]
+    dt = float(time[1] - time[0])
+    gains = result.regulator_gains
+    flown = np.stack(
+        [
+            replay_closed_loop(
+                model,
+                states[i],
+                inputs[i],
+                gains[:, 2 * i : 2 * i + 2, 8 * i : 8 * i + 8],
+                dt,
+                refinement=CHECK_REFINEMENT,
+            )
+            for i, model in enumerate(models)
+        ]
+    )
+    fine_time = dt / CHECK_REFINEMENT * np.arange(flown.shape[1], dtype=np.float64)
+    fine_positions = flown[:, :, :2]
+    tracking_error = np.max(
+        np.hypot(*(flown[:, ::CHECK_REFINEMENT, :2] - states[:, :, :2]).transpose(2, 0, 1)),
+        axis=1,
     )
     fine_distances: dict[str, FloatArray] = {}
     separations: dict[str, dict[str, float]] = {name: {} for name in preplan.names}
@@ -649,20 +684,8 @@ def _evaluate_plan(
         separations=separations,
         fine_time=fine_time,
         fine_distances=fine_distances,
+        tracking_error=tracking_error,
     )
-
-
-def _resimulate_positions(
-    models: tuple[VehicleModel, ...], x0: FloatArray, inputs: FloatArray, dt: float
-) -> tuple[FloatArray, FloatArray]:
-    """RK4 resimulation on a grid ``CHECK_REFINEMENT`` times finer (inputs held per step)."""
-    fine_dt = dt / CHECK_REFINEMENT
-    n_fine = inputs.shape[1] * CHECK_REFINEMENT
-    positions = np.empty((len(models), n_fine + 1, 2))
-    for i, model in enumerate(models):
-        fine_inputs = np.repeat(inputs[i], CHECK_REFINEMENT, axis=0)
-        positions[i] = rk4_simulate(model, x0[i], fine_inputs, fine_dt)[:, :2]
-    return fine_dt * np.arange(n_fine + 1), positions
 
 
 def _information_along(maps: TerrainMaps, states: FloatArray) -> FloatArray:

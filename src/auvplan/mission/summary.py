@@ -37,6 +37,7 @@ def _plan_summary(plan: OptimizedPlan, names: tuple[str, ...]) -> dict[str, Any]
                 "energy_J": float(plan.energy[i]),
                 "mean_terrain_information": float(plan.terrain_information[i]),
                 "arrival_error_m": float(plan.arrival_error[i]),
+                "tracking_error_m": float(plan.tracking_error[i]),
                 "min_separation_m": plan.separations[name],
             }
             for i, name in enumerate(names)
