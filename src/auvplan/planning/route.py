@@ -88,6 +88,14 @@ def blocked_cells(
     Returns
     -------
     ndarray of bool, shape (n_rows, n_cols)
+
+    Examples
+    --------
+    >>> grid = GridGeometry(2, 3, 1.0, 1.0)
+    >>> cost = np.array([[1.0, np.nan, 1.0], [1.0, 1.0, 1.0]])
+    >>> blocked_cells(cost, grid, obstacles=[CircleObstacle(1.0, 2.0, 0.3)]).astype(int)
+    array([[0, 1, 0],
+           [0, 0, 1]])
     """
     _check_shape(cost, geometry)
     return np.asarray(
