@@ -54,7 +54,7 @@ def terrain_cost(n: int, seed: int = SEED) -> np.ndarray:
         centre = rng.uniform(0.2 * n, 0.8 * n, 2)
         radius = rng.uniform(0.02 * n, 0.06 * n)
         cost[np.hypot(rows - centre[0], cols - centre[1]) < radius] = np.inf
-    return cost
+    return np.asarray(cost, dtype=np.float64)
 
 
 def endpoints(n: int) -> tuple[tuple[int, int], tuple[int, int]]:

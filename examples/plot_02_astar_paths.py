@@ -27,11 +27,12 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.patches import Circle, Polygon
+from matplotlib.patches import Circle, Patch, Polygon
 
 from auvplan.planning import (
     CircleObstacle,
     EdgeModel,
+    Obstacle,
     PolygonObstacle,
     blocked_cells,
     blocked_lookup,
@@ -43,7 +44,7 @@ from auvplan.terrain import MapParameters, compute_terrain_maps, synthetic_bank
 
 maps = compute_terrain_maps(synthetic_bank(seed=7), MapParameters(block=(2, 2)))
 cost, geometry = maps.shifted_cost, maps.cost_geometry
-obstacles = [
+obstacles: list[Obstacle] = [
     CircleObstacle(north=200.0, east=300.0, radius=35.0),
     PolygonObstacle(np.array([[60.0, 520.0], [250.0, 560.0], [250.0, 590.0], [60.0, 600.0]])),
 ]
@@ -62,10 +63,11 @@ extent = (*geometry.east_bounds, *geometry.north_bounds)
 for ax, model in zip(axes, EdgeModel, strict=True):
     image = ax.imshow(cost, origin="lower", extent=extent, cmap="viridis_r")
     for obstacle in obstacles:
-        if isinstance(obstacle, CircleObstacle):
-            patch = Circle((obstacle.east, obstacle.north), obstacle.radius)
-        else:
-            patch = Polygon(obstacle.vertices[:, ::-1])
+        patch: Patch = (
+            Circle((obstacle.east, obstacle.north), obstacle.radius)
+            if isinstance(obstacle, CircleObstacle)
+            else Polygon(obstacle.vertices[:, ::-1])
+        )
         patch.set(facecolor="0.85", edgecolor="k", hatch="//")
         ax.add_patch(patch)
     for (name, (start, goal)), color in zip(

@@ -61,12 +61,12 @@ def build_graph(
 
 def dijkstra_cost(graph: csr_matrix, n_cols: int, start: tuple[int, int]) -> np.ndarray:
     """Optimal cost from ``start`` to every node (inf if unreachable)."""
-    return dijkstra(graph, directed=True, indices=start[0] * n_cols + start[1])
+    return np.asarray(dijkstra(graph, directed=True, indices=start[0] * n_cols + start[1]))
 
 
 def cost_to_go(graph: csr_matrix, n_cols: int, goal: tuple[int, int]) -> np.ndarray:
     """Optimal cost from every node to ``goal`` (Dijkstra on the reversed graph)."""
-    return dijkstra(graph.T.tocsr(), directed=True, indices=goal[0] * n_cols + goal[1])
+    return np.asarray(dijkstra(graph.T.tocsr(), directed=True, indices=goal[0] * n_cols + goal[1]))
 
 
 def path_cost(

@@ -10,6 +10,7 @@ import pytest
 from auvplan.errors import InputError
 from auvplan.planning.obstacles import (
     CircleObstacle,
+    Obstacle,
     PolygonObstacle,
     distance_to_obstacle,
     obstacle_mask,
@@ -84,7 +85,7 @@ def _inside(vertices: np.ndarray, north: np.ndarray, east: np.ndarray) -> np.nda
 def _segment_distances(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     ab = b - a
     t = np.clip((points - a) @ ab / (ab @ ab), 0.0, 1.0)
-    return np.linalg.norm(points - (a + t[:, None] * ab), axis=1)
+    return np.asarray(np.linalg.norm(points - (a + t[:, None] * ab), axis=1))
 
 
 def _sampled_distance(
@@ -114,7 +115,10 @@ def test_mask_matches_sampling_oracle(seed: int) -> None:
     radii = rng.uniform(1.0, 4.0, 6)
     centre = np.array([3.0, 9.0])
     vertices = centre + np.column_stack((radii * np.cos(angles), radii * np.sin(angles)))
-    obstacles = [PolygonObstacle(vertices), CircleObstacle(8.0, 4.0, rng.uniform(0.3, 2.0))]
+    obstacles: list[Obstacle] = [
+        PolygonObstacle(vertices),
+        CircleObstacle(8.0, 4.0, rng.uniform(0.3, 2.0)),
+    ]
     clearance = float(rng.choice([0.0, 0.3, 1.1]))
     mask = obstacle_mask(grid, obstacles, clearance=clearance)
     n_samples = 31

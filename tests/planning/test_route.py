@@ -10,6 +10,7 @@ from auvplan.errors import InfeasibleError, InputError
 from auvplan.planning import (
     CircleObstacle,
     EdgeModel,
+    Obstacle,
     PolygonObstacle,
     blocked_cells,
     blocked_lookup,
@@ -34,7 +35,7 @@ def cost(rng: np.random.Generator) -> np.ndarray:
 def test_route_is_optimal_and_avoids_obstacles(
     grid: GridGeometry, cost: np.ndarray, model: EdgeModel
 ) -> None:
-    obstacles = [
+    obstacles: list[Obstacle] = [
         CircleObstacle(40.0, 160.0, 8.0),
         PolygonObstacle(np.array([[0.0, 190.0], [20.0, 200.0], [0.0, 210.0]])),
     ]

@@ -138,4 +138,4 @@ def test_validation(points: np.ndarray, kwargs: dict[str, float], match: str) ->
     options = {"spacing": 1.0, "max_deviation": 0.5}
     options.update(kwargs)
     with pytest.raises(InputError, match=match):
-        smooth_path(points, **options)
+        smooth_path(points, spacing=options["spacing"], max_deviation=options["max_deviation"])

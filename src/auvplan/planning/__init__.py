@@ -5,6 +5,7 @@ from __future__ import annotations
 from auvplan.planning.astar import heuristic_map, plan_astar
 from auvplan.planning.obstacles import (
     CircleObstacle,
+    Obstacle,
     PolygonObstacle,
     distance_to_obstacle,
     obstacle_mask,
@@ -16,6 +17,7 @@ from auvplan.planning.smoothing import path_headings, path_length, smooth_path
 __all__ = [
     "CircleObstacle",
     "EdgeModel",
+    "Obstacle",
     "PathResult",
     "PlanningProblem",
     "PolygonObstacle",

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import TypeAlias
 
 import numpy as np
 from matplotlib.path import Path as MplPath
@@ -88,7 +89,8 @@ class PolygonObstacle:
         object.__setattr__(self, "vertices", vertices)
 
 
-Obstacle = CircleObstacle | PolygonObstacle
+#: Any obstacle (annotate mixed lists as ``list[Obstacle]``).
+Obstacle: TypeAlias = CircleObstacle | PolygonObstacle
 
 
 def distance_to_obstacle(
