@@ -1,0 +1,392 @@
+"""PRONTO vs CasADi+IPOPT (MUMPS, exact Hessian) on identical discretised problems.
+
+Run once and print the comparison table::
+
+    .venv/bin/python benchmarks/bench_pronto.py            # toy problems + MEDUSA crossing
+    .venv/bin/python benchmarks/bench_pronto.py --quick    # toy problems only
+    .venv/bin/python benchmarks/bench_pronto.py --profile  # + cProfile of the MEDUSA solve
+
+Also usable with asv (classes with ``setup``, ``time_*`` and ``track_*``).
+
+Both solvers get the same problem (same RK4 grid, same stage cost, same constraints) and the
+same initial trajectory: the PRONTO projection of the initial guess (a dynamically feasible
+trajectory, possibly violating the constraints). IPOPT solves (a) the hard-constrained problem
+and (b) the barrier-augmented problem at PRONTO's final ``(ε, δ)``; costs are compared with
+(a) for the original objective and with (b) for the barrier-augmented one.
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import io
+import pstats
+import sys
+import time
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from auvplan.optimization import (
+    PathConstraint,
+    ProntoOptions,
+    ProntoResult,
+    Trajectory,
+    TrajectoryProblem,
+    build_model,
+    project_guess,
+    solve_ipopt,
+    solve_pronto,
+)
+
+# ---------------------------------------------------------------------------------------------
+# problems
+
+
+def _unicycle_dynamics() -> tuple[ca.SX, ca.SX, ca.SX, ca.Function]:
+    x = ca.SX.sym("x", 4)
+    u = ca.SX.sym("u", 2)
+    p = ca.SX.sym("p", 0)
+    f = ca.Function(
+        "unicycle", [x, u, p], [ca.vertcat(x[3] * ca.cos(x[2]), x[3] * ca.sin(x[2]), u[0], u[1])]
+    )
+    return x, u, p, f
+
+
+def unicycle_obstacle(n_steps: int = 400) -> tuple[TrajectoryProblem, ProntoOptions]:
+    """Unicycle past a circular obstacle (hockey-stick barrier), 20 s horizon."""
+    x, u, p, f = _unicycle_dynamics()
+    dt = 20.0 / n_steps
+    goal = np.array([10.0, 0.0, 0.0, 0.0])
+    cost = ca.Function("l", [x, u, p], [ca.sumsqr(u) + 0.1 * x[3] ** 2])
+    m = ca.Function("m", [x], [50.0 * ca.sumsqr(x - goal)])
+    obstacle = ca.Function(
+        "obstacle", [x, u, p], [((x[0] - 5.0) ** 2 + (x[1] - 0.3) ** 2) / 1.5**2 - 1.0]
+    )
+    problem = TrajectoryProblem(
+        f,
+        cost,
+        m,
+        np.zeros(4),
+        dt,
+        n_steps,
+        constraints=(PathConstraint(obstacle, "hockey", 1.0, "obstacle"),),
+    )
+    return problem, ProntoOptions()
+
+
+def pendulum_swing_up(n_steps: int = 400) -> tuple[TrajectoryProblem, ProntoOptions]:
+    """Pendulum swing-up (unconstrained, strongly nonlinear), 8 s horizon."""
+    x = ca.SX.sym("x", 2)
+    u = ca.SX.sym("u", 1)
+    p = ca.SX.sym("p", 0)
+    f = ca.Function(
+        "pendulum", [x, u, p], [ca.vertcat(x[1], -9.81 * ca.sin(x[0]) - 0.1 * x[1] + u)]
+    )
+    cost = ca.Function("l", [x, u, p], [0.05 * ca.sumsqr(u) + 0.01 * x[1] ** 2])
+    m = ca.Function("m", [x], [20.0 * ((x[0] - np.pi) ** 2 + 0.1 * x[1] ** 2)])
+    problem = TrajectoryProblem(
+        f,
+        cost,
+        m,
+        np.zeros(2),
+        8.0 / n_steps,
+        n_steps,
+        regulator_Q=np.array([10.0, 1.0]),
+        regulator_R=np.array([0.1]),
+    )
+    return problem, ProntoOptions(tol=1e-8)
+
+
+def kinematic_crossing(n_steps: int = 600) -> tuple[TrajectoryProblem, ProntoOptions]:
+    """Two kinematic vehicles whose desired straight paths cross at the same time."""
+    x = ca.SX.sym("x", 4)
+    u = ca.SX.sym("u", 4)
+    p = ca.SX.sym("p", 4)
+    f = ca.Function("pair", [x, u, p], [u])
+    cost = ca.Function("l", [x, u, p], [0.5 * ca.sumsqr(u) + 0.5 * ca.sumsqr(x - p)])
+    dt = 60.0 / n_steps
+    s = np.arange(n_steps) / n_steps
+    desired = np.stack([-30 + 60 * s, 0 * s, 0 * s + 0.5, -30 + 60 * s], axis=1)
+    goal = np.array([30.0, 0.0, 0.5, 30.0])
+    m = ca.Function("m", [x], [5.0 * ca.sumsqr(x - goal)])
+    separation = ca.Function(
+        "separation", [x, u, p], [((x[0] - x[2]) ** 2 + (x[1] - x[3]) ** 2) / 5.0**2 - 1.0]
+    )
+    problem = TrajectoryProblem(
+        f,
+        cost,
+        m,
+        np.array([-30.0, 0.0, 0.5, -30.0]),
+        dt,
+        n_steps,
+        stage_parameters=desired,
+        constraints=(PathConstraint(separation, "hockey", 1.0, "separation"),),
+    )
+    return problem, ProntoOptions()
+
+
+def medusa_crossing(
+    horizon: float = 600.0, dt: float = 0.5, safety_radius: float = 5.0
+) -> tuple[TrajectoryProblem, ProntoOptions, Trajectory]:
+    """Two MEDUSA vehicles crossing (16 states, 4 inputs), separation ``≥ 2 r_c``.
+
+    Cost rate: electrical power of both vehicles [W] + quadratic tracking of straight
+    desired paths that cross at ``T/2`` + small input penalty; terminal cost to the goals.
+    """
+    from auvplan.io.vehicles import load_vehicle
+    from auvplan.vehicle import build_vehicle_model
+    from auvplan.vehicle.trim import trim_surge
+
+    vehicle = build_vehicle_model(load_vehicle("medusa"))
+    n_steps = round(horizon / dt)
+    starts = np.array([[0.0, -50.0], [0.0, 50.0]])
+    goals = np.array([[300.0, 50.0], [300.0, -50.0]])
+    x = ca.SX.sym("x", 16)
+    c = ca.SX.sym("c", 4)
+    p = ca.SX.sym("p", 4)  # desired (north, east) of both vehicles at t_k
+    xs, cs = [x[:8], x[8:]], [c[:2], c[2:]]
+    f = ca.Function(
+        "fleet",
+        [x, c, p],
+        [ca.vertcat(*(vehicle.dynamics(xi, ci) for xi, ci in zip(xs, cs, strict=True)))],
+    )
+    tracking = 0.05 * (ca.sumsqr(x[0:2] - p[0:2]) + ca.sumsqr(x[8:10] - p[2:4]))
+    power = sum(vehicle.power(xi, ci) for xi, ci in zip(xs, cs, strict=True))
+    cost = ca.Function("l", [x, c, p], [power + tracking + 1.0 * ca.sumsqr(c)])
+    terminal = 50.0 * (ca.sumsqr(x[0:2] - goals[0]) + ca.sumsqr(x[8:10] - goals[1]))
+    m = ca.Function("m", [x], [terminal])
+    separation = ca.Function(
+        "separation",
+        [x, c, p],
+        [((x[0] - x[8]) ** 2 + (x[1] - x[9]) ** 2) / (2 * safety_radius) ** 2 - 1.0],
+    )
+    time_fraction = np.arange(n_steps) / n_steps
+    desired = np.concatenate(
+        [starts[i] + np.outer(time_fraction, goals[i] - starts[i]) for i in range(2)], axis=1
+    )
+    length = float(np.linalg.norm(goals[0] - starts[0]))
+    speed = length / horizon
+    n_trim = trim_surge(vehicle, speed).n
+    # heading from north clockwise: atan2(east, north)
+    headings = [
+        float(np.arctan2(goals[i][1] - starts[i][1], goals[i][0] - starts[i][0])) for i in range(2)
+    ]
+    x0 = np.concatenate(
+        [[*starts[i], headings[i], speed, 0.0, 0.0, n_trim, n_trim] for i in range(2)]
+    )
+    q_r = np.tile([1e-2, 1e-2, 10.0, 10.0, 10.0, 10.0, 1e-3, 1e-3], 2)
+    problem = TrajectoryProblem(
+        f,
+        cost,
+        m,
+        x0,
+        dt,
+        n_steps,
+        stage_parameters=desired,
+        constraints=(PathConstraint(separation, "hockey", 1.0, "separation"),),
+        regulator_Q=q_r,
+        regulator_R=np.full(4, 1.0),
+    )
+    states = np.empty((n_steps + 1, 16))
+    full_time = np.arange(n_steps + 1) / n_steps
+    for i in range(2):
+        block = slice(8 * i, 8 * i + 8)
+        states[:, block] = x0[block]
+        states[:, 8 * i : 8 * i + 2] = starts[i] + np.outer(full_time, goals[i] - starts[i])
+    guess = Trajectory(states, np.zeros((n_steps, 4)))
+    options = ProntoOptions(tol=1e-3, inner_tol=1e-1, eps_initial=10.0, eps_final=1e-2)
+    return problem, options, guess
+
+
+# ---------------------------------------------------------------------------------------------
+# comparison
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """One row of the table."""
+
+    name: str
+    n_x: int
+    n_u: int
+    n_steps: int
+    pronto: ProntoResult
+    pronto_time: float
+    ipopt_hard_cost: float
+    ipopt_hard_iter: int
+    ipopt_hard_time: float
+    ipopt_hard_status: str
+    ipopt_barrier_objective: float
+    ipopt_barrier_iter: int
+    ipopt_barrier_time: float
+
+
+def _zero_guess(problem: TrajectoryProblem) -> Trajectory:
+    return Trajectory(
+        np.tile(problem.initial_state, (problem.n_steps + 1, 1)),
+        np.zeros((problem.n_steps, problem.n_inputs)),
+    )
+
+
+def compare(
+    name: str,
+    problem: TrajectoryProblem,
+    options: ProntoOptions,
+    guess: Trajectory | None = None,
+    *,
+    with_barrier_ipopt: bool = True,
+) -> Comparison:
+    """Solve with PRONTO and IPOPT from the same projected initial trajectory."""
+    guess = _zero_guess(problem) if guess is None else guess
+    model = build_model(problem)
+    initial, _ = project_guess(model, guess, options)
+    solve_pronto(problem, initial, options=options)  # warm-up: CasADi maps, numba
+    start = time.perf_counter()
+    pronto = solve_pronto(problem, initial, options=options)
+    pronto_time = time.perf_counter() - start
+    hard = solve_ipopt(problem, initial)
+    barrier_objective, barrier_iter, barrier_time = float("nan"), 0, float("nan")
+    if problem.constraints and with_barrier_ipopt:
+        barrier = solve_ipopt(problem, initial, barrier=(pronto.epsilon, pronto.delta))
+        barrier_objective, barrier_iter, barrier_time = (
+            barrier.objective,
+            barrier.n_iter,
+            barrier.wall_time,
+        )
+    return Comparison(
+        name=name,
+        n_x=problem.n_states,
+        n_u=problem.n_inputs,
+        n_steps=problem.n_steps,
+        pronto=pronto,
+        pronto_time=pronto_time,
+        ipopt_hard_cost=hard.cost,
+        ipopt_hard_iter=hard.n_iter,
+        ipopt_hard_time=hard.wall_time,
+        ipopt_hard_status=hard.message,
+        ipopt_barrier_objective=barrier_objective,
+        ipopt_barrier_iter=barrier_iter,
+        ipopt_barrier_time=barrier_time,
+    )
+
+
+def format_table(rows: list[Comparison]) -> str:
+    """Markdown table of the comparisons."""
+    header = (
+        "| problem | n_x | n_u | N | PRONTO it | PRONTO s | status | IPOPT it | IPOPT s | "
+        "speed-up | cost PRONTO | cost IPOPT (hard) | rel. diff | barrier obj. rel. diff "
+        "(IPOPT it, s) |\n|" + "---|" * 14
+    )
+    lines = [header]
+    for row in rows:
+        pr = row.pronto
+        rel = (pr.cost - row.ipopt_hard_cost) / abs(row.ipopt_hard_cost)
+        barrier = "-"
+        if np.isfinite(row.ipopt_barrier_objective):
+            rel_b = (pr.objective - row.ipopt_barrier_objective) / abs(row.ipopt_barrier_objective)
+            barrier = f"{rel_b:+.1e} ({row.ipopt_barrier_iter}, {row.ipopt_barrier_time:.2f})"
+        lines.append(
+            f"| {row.name} | {row.n_x} | {row.n_u} | {row.n_steps} | {len(pr.history)} | "
+            f"{row.pronto_time:.2f} | {pr.status.value} | {row.ipopt_hard_iter} | "
+            f"{row.ipopt_hard_time:.2f} | {row.ipopt_hard_time / row.pronto_time:.1f}x | "
+            f"{pr.cost:.6g} | {row.ipopt_hard_cost:.6g} | {rel:+.1e} | {barrier} |"
+        )
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------------------------------
+# asv-style classes
+
+
+class ToyProblems:
+    """asv: PRONTO on the toy problems (time and iteration counts)."""
+
+    params = ("pendulum", "unicycle_obstacle", "kinematic_crossing")
+    param_names = ("problem",)
+
+    def setup(self, name: str) -> None:
+        builder = {
+            "pendulum": pendulum_swing_up,
+            "unicycle_obstacle": unicycle_obstacle,
+            "kinematic_crossing": kinematic_crossing,
+        }[name]
+        self.problem, self.options = builder()
+        self.guess = _zero_guess(self.problem)
+        solve_pronto(self.problem, self.guess, options=self.options)
+
+    def time_pronto(self, name: str) -> None:
+        solve_pronto(self.problem, self.guess, options=self.options)
+
+    def track_pronto_iterations(self, name: str) -> int:
+        return len(solve_pronto(self.problem, self.guess, options=self.options).history)
+
+    def track_pronto_cost(self, name: str) -> float:
+        return solve_pronto(self.problem, self.guess, options=self.options).cost
+
+
+class MedusaCrossing:
+    """asv: the 2-vehicle MEDUSA crossing (T = 600 s, dt = 0.5 s)."""
+
+    timeout = 600.0
+
+    def setup(self) -> None:
+        self.problem, self.options, guess = medusa_crossing()
+        self.guess, _ = project_guess(build_model(self.problem), guess, self.options)
+        solve_pronto(self.problem, self.guess, options=self.options)
+
+    def time_pronto(self) -> None:
+        solve_pronto(self.problem, self.guess, options=self.options)
+
+    def track_pronto_iterations(self) -> int:
+        return len(solve_pronto(self.problem, self.guess, options=self.options).history)
+
+    def time_ipopt(self) -> None:
+        solve_ipopt(self.problem, self.guess)
+
+
+def _profile(problem: TrajectoryProblem, guess: Trajectory, options: ProntoOptions) -> str:
+    profiler = cProfile.Profile()
+    profiler.enable()
+    solve_pronto(problem, guess, options=options)
+    profiler.disable()
+    stream = io.StringIO()
+    pstats.Stats(profiler, stream=stream).sort_stats("tottime").print_stats(15)
+    return stream.getvalue()
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="toy problems only")
+    parser.add_argument("--profile", action="store_true", help="profile the MEDUSA solve")
+    args = parser.parse_args(argv)
+    rows = []
+    for name, builder in (
+        ("pendulum swing-up", pendulum_swing_up),
+        ("unicycle + obstacle", unicycle_obstacle),
+        ("kinematic 2-vehicle crossing", kinematic_crossing),
+    ):
+        problem, options = builder()
+        rows.append(compare(name, problem, options))
+        print(format_table(rows[-1:]).splitlines()[-1], flush=True)
+    if not args.quick:
+        problem, options, guess = medusa_crossing()
+        rows.append(compare("MEDUSA 2-vehicle crossing", problem, options, guess))
+        print(format_table(rows[-1:]).splitlines()[-1], flush=True)
+        if args.profile:
+            initial, _ = project_guess(build_model(problem), guess, options)
+            print(_profile(problem, initial, options))
+    print()
+    print(format_table(rows))
+    for row in rows:
+        history = row.pronto.history
+        print(
+            f"\n{row.name}: -Dh·ζ per iteration: " + " ".join(f"{h.decrement:.1e}" for h in history)
+        )
+        print("  direction: " + "".join(h.direction.value[0] for h in history))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
