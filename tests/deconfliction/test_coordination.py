@@ -8,6 +8,7 @@ from _deconfliction_oracles import (
     brute_force_optimum,
     dense_min_separation,
     distance_to_polyline,
+    grid_collides,
 )
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -199,3 +200,60 @@ def test_random_path_sets_are_safe_or_infeasible(seed: int, method: str) -> None
         return
     assert "vehicle" in message
     assert "\n" not in message
+
+
+def earliest_arrival_brute_force(
+    problem: CoordinationProblem, first_schedule: np.ndarray, vehicle: int, other: int
+) -> int | None:
+    """Breadth-first search over (k, t) for ``vehicle`` given ``other``'s grid schedule."""
+    n_k = int(problem.n_steps[vehicle])
+    horizon = first_schedule.size + n_k + 200
+
+    def other_at(t: int) -> int:
+        return int(first_schedule[min(t, first_schedule.size - 1)])
+
+    def free(k: int, t: int) -> bool:
+        nodes = [0, 0]
+        nodes[vehicle], nodes[other] = k, other_at(t)
+        return not grid_collides(problem, tuple(nodes))
+
+    reachable = {0} if free(0, 0) else set()
+    for t in range(horizon):
+        if n_k in reachable and all(free(n_k, u) for u in range(t, first_schedule.size + 1)):
+            return t
+        reachable = {k2 for k in reachable for k2 in (k, k + 1) if k2 <= n_k and free(k2, t + 1)}
+    return None
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_prioritized_second_vehicle_arrives_as_early_as_possible(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    paths = (
+        np.array([[0.0, -9.0], [0.0, 9.0]]),
+        np.array([[-8.0, rng.uniform(-3, 3)], [8.0, rng.uniform(-3, 3)]]),
+    )
+    problem = CoordinationProblem(paths, 1.0, np.array([1.0, rng.uniform(0.8, 1.2)]), 0.5)
+    result = deconflict(problem, method="prioritized")
+    check_schedule(problem, result)
+    first = int(np.argmax(problem.n_steps))  # the longer vehicle is planned first, unhindered
+    second = 1 - first
+    steps = np.rint(result.progress[first] / problem.step_lengths[first]).astype(int)
+    steps = np.minimum(steps, problem.n_steps[first])
+    assert result.delays[first] < problem.time_step
+    expected = earliest_arrival_brute_force(problem, steps, second, first)
+    assert expected is not None
+    assert result.arrival_times[second] == pytest.approx(expected * problem.time_step)
+
+
+def test_coarsening_returns_the_coarse_schedule_on_the_fine_grid() -> None:
+    problem = crossing([0.0, 90.0], half_length=12.0, time_step=0.1)
+    coarse = CoordinationProblem(problem.paths, 1.0, problem.cruise_speeds, 0.5)
+    for method, weight in METHODS:
+        result = deconflict(problem, method=method, weight=weight, coarsening=5)
+        reference = deconflict(coarse, method=method, weight=weight)
+        check_schedule(problem, result)
+        assert result.time[1] == pytest.approx(0.1)
+        np.testing.assert_allclose(result.progress[:, ::5], reference.progress)
+        assert result.min_separation >= reference.min_separation - 1e-12
+    with pytest.raises(InputError, match="coarsening"):
+        deconflict(problem, coarsening=0)

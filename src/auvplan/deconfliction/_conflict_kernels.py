@@ -244,55 +244,87 @@ def pair_cost_to_go(
     first to its last non-zero entry (``UNREACHABLE`` where the goal cannot be reached;
     forbidden nodes are stored as 0 because they are never queried).
 
+    Only a window of each row is computed: if ``E = 0`` on row ``a + 1`` left of ``N_lo`` and
+    right of ``N_hi`` (the span of its forbidden and non-zero cells), and row ``a`` has no
+    forbidden cell outside ``[F_lo, F_hi]``, then ``E(a, b) = 0`` for
+    ``b < min(N_lo, F_lo) - 1`` (the diagonal move is free and optimal) and for
+    ``b > max(N_hi, F_hi)``. Rows without obstacles nearby cost nothing.
+
     Returns
     -------
     row_first : ndarray of shape (n_i + 1,)
         First column ``b`` of the stored excess of each row.
     row_offset : ndarray of shape (n_i + 2,)
-        Offsets of each row's values in ``excess`` (row ``a`` has ``row_offset[a+1] -
-        row_offset[a]`` values).
+        Offsets of each row's values in ``excess``.
     excess : ndarray
         The stored excess values.
     """
     inf = UNREACHABLE
-    next_row = np.full(n_j + 1, inf, dtype=np.int64)
-    current = np.empty(n_j + 1, dtype=np.int64)
+    next_row = np.zeros(n_j + 1, dtype=np.int64)
+    current = np.zeros(n_j + 1, dtype=np.int64)
+    forbidden = np.zeros(n_j + 1, dtype=np.bool_)
     row_first = np.zeros(n_i + 1, dtype=np.int64)
     row_len = np.zeros(n_i + 1, dtype=np.int64)
+    starts = np.zeros(n_i + 1, dtype=np.int64)
     capacity = 4096
     values = np.empty(capacity, dtype=np.int64)
     count = 0
-    starts = np.empty(n_i + 1, dtype=np.int64)
+    next_lo = n_j + 1  # window of row a + 1 (empty)
+    next_hi = -1
+    span_lo = n_j + 1  # span of forbidden / non-zero cells of row a + 1
+    span_hi = -1
     for a in range(n_i, -1, -1):
-        q = row_ptr[a + 1] - 1  # walk the forbidden intervals backwards
+        f_first = row_ptr[a]
+        f_stop = row_ptr[a + 1]
+        w_lo = span_lo
+        w_hi = span_hi
+        if f_stop > f_first:
+            w_lo = min(w_lo, lo[f_first])
+            w_hi = max(w_hi, hi[f_stop - 1])
+        w_lo = max(w_lo - 1, 0)
+        w_hi = min(w_hi, n_j)
+        starts[a] = count
+        if w_hi < w_lo:
+            next_lo, next_hi = n_j + 1, -1
+            span_lo, span_hi = n_j + 1, -1
+            continue
+        for b in range(w_lo, w_hi + 1):
+            forbidden[b] = False
+        for q in range(f_first, f_stop):
+            for b in range(max(lo[q], w_lo), min(hi[q], w_hi) + 1):
+                forbidden[b] = True
         first_nz = -1
         last_nz = -1
-        for b in range(n_j, -1, -1):
-            while q >= row_ptr[a] and lo[q] > b:
-                q -= 1
-            is_forbidden = q >= row_ptr[a] and hi[q] >= b
-            if is_forbidden:
+        for b in range(w_hi, w_lo - 1, -1):
+            if forbidden[b]:
                 current[b] = inf
+                first_nz = b
+                if last_nz < 0:
+                    last_nz = b
                 continue
             if a == n_i and b == n_j:
                 current[b] = 0
                 continue
             best = inf
             if b < n_j:
-                best = min(best, current[b + 1])
+                right = current[b + 1] if b + 1 <= w_hi else max(n_i - a, n_j - b - 1)
+                best = min(best, right)
             if a < n_i:
-                best = min(best, next_row[b])
+                below = next_row[b] if next_lo <= b <= next_hi else max(n_i - a - 1, n_j - b)
+                best = min(best, below)
                 if b < n_j:
-                    best = min(best, next_row[b + 1])
+                    diagonal = (
+                        next_row[b + 1]
+                        if next_lo <= b + 1 <= next_hi
+                        else max(n_i - a - 1, n_j - b - 1)
+                    )
+                    best = min(best, diagonal)
             cost = best + 1 if best < inf else inf
             current[b] = cost
-            free_bound = max(n_i - a, n_j - b)
-            if cost != free_bound:
+            if cost != max(n_i - a, n_j - b):
+                first_nz = b
                 if last_nz < 0:
                     last_nz = b
-                first_nz = b
-        # store the excess of row a
-        starts[a] = count
         if last_nz >= 0:
             length = last_nz - first_nz + 1
             while count + length > capacity:
@@ -301,29 +333,23 @@ def pair_cost_to_go(
                 values = grown
                 capacity *= 2
             for b in range(first_nz, last_nz + 1):
-                if current[b] >= inf:
-                    # forbidden (never queried) or dead end
-                    is_dead = True
-                    q2 = row_ptr[a]
-                    while q2 < row_ptr[a + 1] and hi[q2] < b:
-                        q2 += 1
-                    if q2 < row_ptr[a + 1] and lo[q2] <= b:
-                        is_dead = False
-                    values[count] = inf if is_dead else 0
+                if forbidden[b]:
+                    values[count] = 0  # never queried
+                elif current[b] >= inf:
+                    values[count] = inf  # dead end
                 else:
                     values[count] = current[b] - max(n_i - a, n_j - b)
                 count += 1
             row_first[a] = first_nz
             row_len[a] = length
+            span_lo, span_hi = first_nz, last_nz
+        else:
+            span_lo, span_hi = n_j + 1, -1
+        next_lo, next_hi = w_lo, w_hi
         next_row, current = current, next_row
-    row_offset = np.empty(n_i + 2, dtype=np.int64)
-    for a in range(n_i + 1):
-        row_offset[a] = starts[a]
-    row_offset[n_i + 1] = count
-    # rows were written from a = n_i down to 0: offsets are decreasing; lengths are exact
     out = np.empty(count, dtype=np.int64)
-    position = 0
     offsets = np.empty(n_i + 2, dtype=np.int64)
+    position = 0
     for a in range(n_i + 1):
         offsets[a] = position
         out[position : position + row_len[a]] = values[starts[a] : starts[a] + row_len[a]]
