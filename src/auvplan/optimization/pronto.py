@@ -133,6 +133,11 @@ class ProntoOptions:
     terminal_regulator : {"dare", "weight"}
         Terminal matrix of the projection regulator: discrete ARE at the last stage (falls
         back to ``Q_r`` when it fails), or ``Q_r``.
+    n_threads : int
+        Threads for the batched stage evaluations (CasADi ``map(N, "thread", n)``); 1 = serial.
+    fallback_model : {"newton", "cost"}
+        Which weights the convexified fallback clips: the exact Newton weights (default; no
+        extra evaluation) or the cost Hessians only (quasi-Newton, one more Hessian pass).
     """
 
     tol: float = 1e-6
@@ -150,6 +155,8 @@ class ProntoOptions:
     max_infeasible_restarts: int = 10
     eigenvalue_floor: float = 1e-8
     terminal_regulator: Literal["dare", "weight"] = "dare"
+    n_threads: int = 1
+    fallback_model: Literal["newton", "cost"] = "newton"
 
     def __post_init__(self) -> None:
         checks = {
@@ -167,6 +174,8 @@ class ProntoOptions:
             "delta_feasible_max": self.delta_feasible_max > 0,
             "eigenvalue_floor": self.eigenvalue_floor > 0,
             "terminal_regulator": self.terminal_regulator in ("dare", "weight"),
+            "n_threads": self.n_threads >= 1,
+            "fallback_model": self.fallback_model in ("newton", "cost"),
         }
         for name, ok in checks.items():
             if not ok:
@@ -313,26 +322,35 @@ class ProntoModel:
         return self.constraints is not None and self.constraints.n_c > 0
 
 
-_MODEL_CACHE: dict[int, tuple[TrajectoryProblem, ProntoModel]] = {}
+_MODEL_CACHE: dict[tuple[int, int], tuple[TrajectoryProblem, ProntoModel]] = {}
 
 
-def build_model(problem: TrajectoryProblem) -> ProntoModel:
+def build_model(problem: TrajectoryProblem, *, n_threads: int = 1) -> ProntoModel:
     """Discretise a problem (RK4 map, stage cost, constraints, terminal cost); cached per problem.
 
     Parameters
     ----------
     problem : TrajectoryProblem
         The problem.
+    n_threads : int, optional
+        Threads for the batched stage evaluations (1 = serial).
 
     Returns
     -------
     ProntoModel
         Batched evaluators.
     """
-    cached = _MODEL_CACHE.get(id(problem))
+    key = (id(problem), n_threads)
+    cached = _MODEL_CACHE.get(key)
     if cached is not None and cached[0] is problem:
         return cached[1]
-    discrete = discretize_rk4(problem.dynamics, problem.running_cost, problem.dt)
+    discrete = discretize_rk4(
+        problem.dynamics,
+        problem.running_cost,
+        problem.dt,
+        parallelization="thread" if n_threads > 1 else "serial",
+        n_threads=n_threads,
+    )
     terminal = make_terminal_cost(problem.terminal_cost, problem.n_states)
     constraints = None
     scales: list[float] = []
@@ -357,7 +375,7 @@ def build_model(problem: TrajectoryProblem) -> ProntoModel:
     )
     if len(_MODEL_CACHE) > 16:
         _MODEL_CACHE.clear()
-    _MODEL_CACHE[id(problem)] = (problem, model)
+    _MODEL_CACHE[key] = (problem, model)
     return model
 
 
@@ -1000,7 +1018,9 @@ def _iterate_level(
         direction = solve_lq_direction(
             lin,
             weights,
-            quasi_weights=_QuasiWeights(model, trajectory, lin),
+            quasi_weights=(
+                _QuasiWeights(model, trajectory, lin) if options.fallback_model == "cost" else None
+            ),
             steepest_weights=steepest,
             eigenvalue_floor=options.eigenvalue_floor,
         )
@@ -1111,7 +1131,7 @@ def solve_pronto(
     options = options if options is not None else ProntoOptions()
     _check_guess(problem, guess)
     start = time.perf_counter()
-    model = build_model(problem)
+    model = build_model(problem, n_threads=options.n_threads)
     trajectory, gains = project_guess(model, guess, options)
     state = _State(trajectory, gains, options.delta_initial)
     levels = options.epsilon_levels() if model.has_constraints else (0.0,)
