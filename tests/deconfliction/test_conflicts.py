@@ -7,7 +7,7 @@ import pytest
 
 from auvplan.deconfliction import CoordinationProblem, build_conflict_table
 from auvplan.deconfliction._conflict_kernels import (
-    UNREACHABLE,
+    DEAD_END,
     pair_cost_to_go,
     pair_reachability,
 )
@@ -80,15 +80,18 @@ def test_pair_cost_to_go_and_reachability_match_brute_force(seed: int) -> None:
     expected = brute_cost_to_go(forbidden)
     n_i, n_j = (int(n) for n in problem.n_steps)
     rows = table.row_ptr[: n_i + 2]
-    first, offset, excess = pair_cost_to_go(rows, table.lo, table.hi, n_i, n_j)
+    first, start, length, values, count = pair_cost_to_go(
+        rows, table.lo, table.hi, n_i, n_j, np.empty(8, dtype=np.uint16), 0
+    )
+    assert count == int(length.sum())
     for a in range(n_i + 1):
         for b in range(n_j + 1):
             if forbidden[a, b]:
                 continue
             column = b - first[a]
-            stored = excess[offset[a] + column] if 0 <= column < offset[a + 1] - offset[a] else 0
+            stored = int(values[start[a] + column]) if 0 <= column < length[a] else 0
             if np.isinf(expected[a, b]):
-                assert stored >= UNREACHABLE
+                assert stored == DEAD_END
             else:
                 assert max(n_i - a, n_j - b) + stored == expected[a, b]
     reachable, _, _ = pair_reachability(rows, table.lo, table.hi, n_i, n_j)

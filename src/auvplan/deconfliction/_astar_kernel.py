@@ -23,9 +23,10 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+import numpy.typing as npt
 
 from auvplan._typing import FloatArray, IntArray
-from auvplan.deconfliction._conflict_kernels import UNREACHABLE
+from auvplan.deconfliction._conflict_kernels import DEAD_END
 
 EMPTY = -1
 
@@ -74,8 +75,9 @@ def _heuristic(
     n_steps: IntArray,
     heur_base: IntArray,
     heur_first: IntArray,
-    heur_offset: IntArray,
-    heur_excess: IntArray,
+    heur_start: IntArray,
+    heur_len: IntArray,
+    heur_excess: npt.NDArray[np.uint16],
 ) -> int:
     """``max_i (n_i - k_i)``, raised to the exact pairwise cost-to-go where one is given."""
     n = k.shape[0]
@@ -89,10 +91,10 @@ def _heuristic(
                 continue
             row = base + k[i]
             column = k[j] - heur_first[row]
-            if column < 0 or column >= heur_offset[row + 1] - heur_offset[row]:
+            if column < 0 or column >= heur_len[row]:
                 continue
-            excess = heur_excess[heur_offset[row] + column]
-            if excess >= UNREACHABLE:
+            excess = np.int64(heur_excess[heur_start[row] + column])
+            if excess == DEAD_END:
                 return -1
             h = max(h, max(n_steps[i] - k[i], n_steps[j] - k[j]) + excess)
     return h
@@ -124,8 +126,9 @@ def astar_coordination(
     hi: IntArray,
     heur_base: IntArray,
     heur_first: IntArray,
-    heur_offset: IntArray,
-    heur_excess: IntArray,
+    heur_start: IntArray,
+    heur_len: IntArray,
+    heur_excess: npt.NDArray[np.uint16],
     weight: float,
     max_expanded: int,
 ) -> tuple[int, IntArray, int]:
@@ -139,7 +142,7 @@ def astar_coordination(
         For ``i < j``: offset of pair ``(i, j)``'s rows in ``row_ptr``.
     row_ptr, lo, hi : ndarray
         Concatenated CSR interval lists (absolute offsets into ``lo``/``hi``).
-    heur_base, heur_first, heur_offset, heur_excess : ndarray
+    heur_base, heur_first, heur_start, heur_len, heur_excess : ndarray
         Pairwise cost-to-go excess (see ``pair_cost_to_go``); ``heur_base[i * N + j]`` is the
         offset of pair ``(i, j)``'s rows, ``-1`` to use only ``max_i (n_i - k_i)``.
     weight : float
@@ -195,7 +198,7 @@ def astar_coordination(
     if not _is_free(k, all_moved, pair_base, row_ptr, lo, hi):
         return 1, np.zeros((0, n), dtype=np.int64), 0
 
-    h0 = _heuristic(k, n_steps, heur_base, heur_first, heur_offset, heur_excess)
+    h0 = _heuristic(k, n_steps, heur_base, heur_first, heur_start, heur_len, heur_excess)
     if h0 < 0:
         return 1, np.zeros((0, n), dtype=np.int64), 0
     node_key[0] = 0
@@ -292,7 +295,9 @@ def astar_coordination(
                 target = other
                 h = node_h[other]
             else:
-                h = _heuristic(child, n_steps, heur_base, heur_first, heur_offset, heur_excess)
+                h = _heuristic(
+                    child, n_steps, heur_base, heur_first, heur_start, heur_len, heur_excess
+                )
                 if h < 0:
                     continue  # dead end: some pair can no longer reach its goal
                 if n_nodes >= cap_nodes:

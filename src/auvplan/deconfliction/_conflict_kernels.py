@@ -8,8 +8,11 @@ row ``k_i`` as sorted, disjoint, inclusive index intervals ``[lo, hi]`` of ``k_j
 
 from __future__ import annotations
 
+from typing import Final
+
 import numba
 import numpy as np
+import numpy.typing as npt
 
 from auvplan._typing import FloatArray, IntArray
 
@@ -229,20 +232,33 @@ def pair_reachability(
     return True, -1, -1
 
 
-UNREACHABLE = np.int64(1) << np.int64(40)
+UNREACHABLE: Final[int] = 1 << 40
+#: Stored excess values are uint16: ``DEAD_END`` marks nodes that cannot reach the goal and
+#: larger excesses are capped at ``EXCESS_CAP`` (``min`` of consistent heuristics stays
+#: consistent, so capping keeps the heuristic admissible and consistent).
+DEAD_END: Final[int] = 65535
+EXCESS_CAP: Final[int] = 65534
 
 
 @numba.njit(cache=True)
 def pair_cost_to_go(
-    row_ptr: IntArray, lo: IntArray, hi: IntArray, n_i: int, n_j: int
-) -> tuple[IntArray, IntArray, IntArray]:
+    row_ptr: IntArray,
+    lo: IntArray,
+    hi: IntArray,
+    n_i: int,
+    n_j: int,
+    values: npt.NDArray[np.uint16],
+    count: int,
+) -> tuple[IntArray, IntArray, IntArray, npt.NDArray[np.uint16], int]:
     r"""Exact two-vehicle cost-to-go (makespan) on the pair's free grid, stored by its excess.
 
     Backward dynamic programme over rows ``a = n_i … 0``:
     ``C(a, b) = 1 + min(C(a+1, b), C(a, b+1), C(a+1, b+1))`` over free successors, ``C = 0``
-    at the goal. Only the excess ``E = C - max(n_i - a, n_j - b)`` is kept, per row from its
-    first to its last non-zero entry (``UNREACHABLE`` where the goal cannot be reached;
-    forbidden nodes are stored as 0 because they are never queried).
+    at the goal. Only the excess ``E = C - max(n_i - a, n_j - b)`` is kept (as uint16, capped
+    at ``EXCESS_CAP``), per row from its first to its last non-zero entry (``DEAD_END`` where
+    the goal cannot be reached; forbidden nodes are stored as 0: they are never queried).
+    Values are appended to ``values`` from ``count`` on (the buffer grows when needed), so
+    that all pairs share one buffer.
 
     Only a window of each row is computed: if ``E = 0`` on row ``a + 1`` left of ``N_lo`` and
     right of ``N_hi`` (the span of its forbidden and non-zero cells), and row ``a`` has no
@@ -254,10 +270,14 @@ def pair_cost_to_go(
     -------
     row_first : ndarray of shape (n_i + 1,)
         First column ``b`` of the stored excess of each row.
-    row_offset : ndarray of shape (n_i + 2,)
-        Offsets of each row's values in ``excess``.
-    excess : ndarray
-        The stored excess values.
+    row_start : ndarray of shape (n_i + 1,)
+        Position of each row's first value in ``values``.
+    row_len : ndarray of shape (n_i + 1,)
+        Number of stored values of each row.
+    values : ndarray of uint16
+        The (possibly grown) buffer.
+    count : int
+        Number of used entries of ``values``.
     """
     inf = UNREACHABLE
     next_row = np.zeros(n_j + 1, dtype=np.int64)
@@ -266,9 +286,7 @@ def pair_cost_to_go(
     row_first = np.zeros(n_i + 1, dtype=np.int64)
     row_len = np.zeros(n_i + 1, dtype=np.int64)
     starts = np.zeros(n_i + 1, dtype=np.int64)
-    capacity = 4096
-    values = np.empty(capacity, dtype=np.int64)
-    count = 0
+    capacity = values.shape[0]
     next_lo = n_j + 1  # window of row a + 1 (empty)
     next_hi = -1
     span_lo = n_j + 1  # span of forbidden / non-zero cells of row a + 1
@@ -328,17 +346,17 @@ def pair_cost_to_go(
         if last_nz >= 0:
             length = last_nz - first_nz + 1
             while count + length > capacity:
-                grown = np.empty(2 * capacity, dtype=np.int64)
+                grown = np.empty(2 * capacity + length, dtype=np.uint16)
                 grown[:count] = values[:count]
                 values = grown
-                capacity *= 2
+                capacity = values.shape[0]
             for b in range(first_nz, last_nz + 1):
                 if forbidden[b]:
                     values[count] = 0  # never queried
                 elif current[b] >= inf:
-                    values[count] = inf  # dead end
+                    values[count] = DEAD_END
                 else:
-                    values[count] = current[b] - max(n_i - a, n_j - b)
+                    values[count] = min(current[b] - max(n_i - a, n_j - b), EXCESS_CAP)
                 count += 1
             row_first[a] = first_nz
             row_len[a] = length
@@ -347,12 +365,4 @@ def pair_cost_to_go(
             span_lo, span_hi = n_j + 1, -1
         next_lo, next_hi = w_lo, w_hi
         next_row, current = current, next_row
-    out = np.empty(count, dtype=np.int64)
-    offsets = np.empty(n_i + 2, dtype=np.int64)
-    position = 0
-    for a in range(n_i + 1):
-        offsets[a] = position
-        out[position : position + row_len[a]] = values[starts[a] : starts[a] + row_len[a]]
-        position += row_len[a]
-    offsets[n_i + 1] = position
-    return row_first, offsets, out
+    return row_first, starts, row_len, values, count

@@ -21,6 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from auvplan._typing import FloatArray, IntArray
 from auvplan.deconfliction._conflict_kernels import (
@@ -202,19 +203,24 @@ class PairHeuristic:
     Parameters
     ----------
     pair_base : ndarray of shape (n_vehicles ** 2,)
-        Offset of pair ``(i, j)``'s rows in ``row_first`` (``row_offset`` uses the same base).
+        Offset of pair ``(i, j)``'s rows in the row arrays; ``-1`` when the pair never
+        interacts (its free bound is exact).
     row_first : ndarray
         First stored column ``k_j`` of each row.
-    row_offset : ndarray
-        Offsets of each row's values in ``excess`` (one extra entry per pair).
-    excess : ndarray
-        Excess values [time steps]; ``UNREACHABLE`` marks dead ends.
+    row_start : ndarray
+        Position of each row's first value in ``excess``.
+    row_len : ndarray
+        Number of stored values of each row.
+    excess : ndarray of uint16
+        Excess values [time steps], capped at ``EXCESS_CAP``; ``DEAD_END`` marks nodes from
+        which the pair cannot reach its goals.
     """
 
     pair_base: IntArray
     row_first: IntArray
-    row_offset: IntArray
-    excess: IntArray
+    row_start: IntArray
+    row_len: IntArray
+    excess: npt.NDArray[np.uint16]
 
 
 def build_pair_heuristic(problem: CoordinationProblem, table: ConflictTable) -> PairHeuristic:
@@ -222,29 +228,37 @@ def build_pair_heuristic(problem: CoordinationProblem, table: ConflictTable) -> 
     n = problem.n_vehicles
     base = np.full(n * n, -1, dtype=np.int64)
     firsts: list[IntArray] = []
-    offsets: list[IntArray] = []
-    values: list[IntArray] = []
+    starts: list[IntArray] = []
+    lengths: list[IntArray] = []
+    values = np.empty(1 << 20, dtype=np.uint16)
+    count = 0
     n_rows = 0
-    n_values = 0
     for i in range(n):
         for j in range(i + 1, n):
             n_i = int(problem.n_steps[i])
             pair_rows = table.row_ptr[table.pair_base[i * n + j] :]
-            first, offset, excess = pair_cost_to_go(
-                pair_rows[: n_i + 2], table.lo, table.hi, n_i, int(problem.n_steps[j])
+            before = count
+            first, start, length, values, count = pair_cost_to_go(
+                pair_rows[: n_i + 2],
+                table.lo,
+                table.hi,
+                n_i,
+                int(problem.n_steps[j]),
+                values,
+                count,
             )
-            if excess.shape[0] == 0:
+            if count == before:
                 continue  # the pair never interacts: the individual bound is exact
             base[i * n + j] = n_rows
-            firsts.append(np.append(first, 0))  # pad to the offsets' length
-            offsets.append(offset + n_values)
-            values.append(excess)
-            n_rows += n_i + 2
-            n_values += excess.shape[0]
+            firsts.append(first)
+            starts.append(start)
+            lengths.append(length)
+            n_rows += n_i + 1
     empty = np.zeros(0, dtype=np.int64)
     return PairHeuristic(
         pair_base=base,
         row_first=np.concatenate(firsts) if firsts else empty,
-        row_offset=np.concatenate(offsets) if offsets else empty,
-        excess=np.concatenate(values) if values else empty,
+        row_start=np.concatenate(starts) if starts else empty,
+        row_len=np.concatenate(lengths) if lengths else empty,
+        excess=values[:count],
     )

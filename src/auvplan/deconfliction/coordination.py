@@ -170,7 +170,13 @@ def _solve_astar(
         pair = build_pair_heuristic(problem, table)
     else:
         none = np.zeros(0, dtype=np.int64)
-        pair = PairHeuristic(np.full(problem.n_vehicles**2, -1, dtype=np.int64), none, none, none)
+        pair = PairHeuristic(
+            np.full(problem.n_vehicles**2, -1, dtype=np.int64),
+            none,
+            none,
+            none,
+            np.zeros(0, dtype=np.uint16),
+        )
     code, path, n_expanded = astar_coordination(
         problem.n_steps,
         table.pair_base,
@@ -179,7 +185,8 @@ def _solve_astar(
         table.hi,
         pair.pair_base,
         pair.row_first,
-        pair.row_offset,
+        pair.row_start,
+        pair.row_len,
         pair.excess,
         weight,
         max_expanded,
