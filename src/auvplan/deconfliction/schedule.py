@@ -149,6 +149,16 @@ def timed_positions(
     -------
     ndarray of shape (n_vehicles, n_t, 2)
         Times before 0 or after the last sample are clamped (vehicles wait at start / goal).
+
+    Examples
+    --------
+    >>> from auvplan.deconfliction import deconflict
+    >>> problem = CoordinationProblem(
+    ...     (np.array([[-5.0, 0.0], [5.0, 0.0]]), np.array([[0.0, -5.0], [0.0, 5.0]])),
+    ...     safety_radius=1.0, cruise_speeds=np.ones(2), time_step=0.5)
+    >>> result = deconflict(problem, method="prioritized")
+    >>> timed_positions(result, problem, np.array([0.0, result.time[-1]])).tolist()
+    [[[-5.0, 0.0], [5.0, 0.0]], [[0.0, -5.0], [0.0, 5.0]]]
     """
     times = np.asarray(times, dtype=np.float64)
     return np.stack(
