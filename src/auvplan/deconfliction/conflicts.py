@@ -36,7 +36,7 @@ from auvplan.errors import InfeasibleError
 RADIUS_ROUNDING = 1e-9
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ConflictTable:
     """Forbidden ``k_j`` intervals for ordered pairs ``(i, j)``, rows indexed by ``k_i``.
 
@@ -193,7 +193,7 @@ def check_pairwise_timing(problem: CoordinationProblem, table: ConflictTable) ->
                 )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class PairHeuristic:
     """Exact makespan-to-go of every pair ``i < j`` alone, as an excess over the free bound.
 

@@ -31,7 +31,7 @@ from auvplan.errors import InputError
 MAX_STEPS_PER_VEHICLE = 10_000_000
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CoordinationProblem:
     """Fixed paths of a fleet, to be timed apart.
 
@@ -86,14 +86,15 @@ class CoordinationProblem:
                 raise InputError(f"path {index} contains non-finite coordinates")
             segment = np.hypot(*np.diff(path, axis=0).T)
             keep = np.concatenate(([True], segment > 0.0))
-            path = np.ascontiguousarray(path[keep])
+            path = np.array(path[keep], dtype=np.float64, order="C")
+            path.flags.writeable = False
             if path.shape[0] < 2:
                 raise InputError(f"path {index} has zero length (start equals goal)")
             cleaned.append(path)
             arcs.append(np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T)))))
         if not (np.isfinite(self.safety_radius) and self.safety_radius > 0.0):
             raise InputError(f"safety_radius must be > 0 m, got {self.safety_radius}")
-        speeds = np.asarray(self.cruise_speeds, dtype=np.float64)
+        speeds = np.array(self.cruise_speeds, dtype=np.float64)
         if speeds.shape != (n_vehicles,):
             raise InputError(
                 f"cruise_speeds must have shape ({n_vehicles},), got {np.shape(self.cruise_speeds)}"
@@ -102,6 +103,7 @@ class CoordinationProblem:
             raise InputError(f"cruise_speeds must be > 0 m/s, got {speeds.tolist()}")
         if not (np.isfinite(self.time_step) and self.time_step > 0.0):
             raise InputError(f"time_step must be > 0 s, got {self.time_step}")
+        speeds.flags.writeable = False
         lengths = np.array([arc[-1] for arc in arcs])
         steps = speeds * self.time_step
         # the small tolerance keeps L = 60.0, h = 0.01 at 6000 steps, not 6001 by rounding

@@ -52,7 +52,7 @@ class SeparationCertificate:
         return self.min_separation >= self.required - 1e-9
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CoordinationResult:
     """Time laws along fixed paths that keep every pair at least ``2 r_c`` apart.
 
