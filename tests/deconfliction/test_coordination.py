@@ -257,3 +257,56 @@ def test_coarsening_returns_the_coarse_schedule_on_the_fine_grid() -> None:
         assert result.min_separation >= reference.min_separation - 1e-12
     with pytest.raises(InputError, match="coarsening"):
         deconflict(problem, coarsening=0)
+
+
+def vectorised_dense_min_separation(
+    problem: CoordinationProblem, result: CoordinationResult, n_per_step: int
+) -> float:
+    fine = np.linspace(0.0, result.time[-1], (result.time.size - 1) * n_per_step + 1)
+    points = []
+    for i, path in enumerate(problem.paths):
+        arc = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))))
+        s = np.interp(fine, result.time, result.progress[i])
+        points.append(
+            np.column_stack([np.interp(s, arc, path[:, 0]), np.interp(s, arc, path[:, 1])])
+        )
+    return min(
+        float(np.hypot(*(points[i] - points[j]).T).min())
+        for i in range(problem.n_vehicles)
+        for j in range(i + 1, problem.n_vehicles)
+    )
+
+
+def star_of_vehicles(n_vehicles: int, duration: float, time_step: float) -> CoordinationProblem:
+    rng = np.random.default_rng(n_vehicles)
+    paths = []
+    for i in range(n_vehicles):
+        heading = np.pi * i / n_vehicles + rng.uniform(-0.1, 0.1)
+        before = duration * rng.uniform(0.45, 0.55)
+        s = np.linspace(-before, duration - before, int(duration) + 1)
+        bend = 0.02 * duration * np.sin(np.pi * (s + before) / duration) * rng.uniform(-1, 1)
+        paths.append(
+            np.column_stack(
+                [
+                    s * np.cos(heading) - bend * np.sin(heading),
+                    s * np.sin(heading) + bend * np.cos(heading),
+                ]
+            )
+        )
+    return CoordinationProblem(tuple(paths), 2.5, np.ones(n_vehicles), time_step)
+
+
+def test_eight_vehicles_through_one_point_prioritized() -> None:
+    problem = star_of_vehicles(8, 60.0, 0.05)
+    result = deconflict(problem, method="prioritized")
+    assert result.certificate.holds
+    assert vectorised_dense_min_separation(problem, result, 5) >= problem.separation - 1e-9
+    assert result.delays.max() > 5.0  # the centre is crowded: real waits were needed
+
+
+@pytest.mark.slow
+def test_sixteen_vehicles_ten_minutes_at_the_papers_grid() -> None:
+    problem = star_of_vehicles(16, 600.0, 0.01)
+    result = deconflict(problem, method="prioritized")
+    assert result.certificate.holds
+    assert vectorised_dense_min_separation(problem, result, 3) >= problem.separation - 1e-9
