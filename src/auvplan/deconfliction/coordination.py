@@ -201,7 +201,7 @@ def _solve_astar(
     if code == 2:
         raise SolverError(
             f"A* expanded max_expanded={max_expanded} nodes without reaching the goal; "
-            "raise weight or use method='prioritized'"
+            "raise weight or coarsening, or use method='prioritized'"
         )
     return np.ascontiguousarray(path.T), int(n_expanded)
 
