@@ -23,34 +23,31 @@ from auvplan.optimization.discretization import (
     make_terminal_cost,
 )
 from auvplan.optimization.ipopt import IpoptResult, IpoptStatus, solve_ipopt
+from auvplan.optimization.linesearch import ArmijoResult, armijo_step, converged
+from auvplan.optimization.lq import DirectionType, LqDirection, convexify, solve_lq_direction
 from auvplan.optimization.problem import PathConstraint, Trajectory, TrajectoryProblem
 from auvplan.optimization.pronto import (
-    ArmijoResult,
-    CostParts,
     DerivativeCheck,
-    DirectionType,
-    Linearization,
-    LqDirection,
     ProntoIteration,
-    ProntoModel,
     ProntoOptions,
     ProntoResult,
     ProntoStatus,
+    derivative_check,
+    project_guess,
+    solve_pronto,
+)
+from auvplan.optimization.stages import (
+    CostParts,
+    Linearization,
+    ProntoModel,
     StageWeights,
-    armijo_step,
     build_model,
     compute_costate,
-    converged,
-    convexify,
-    derivative_check,
     design_regulator,
     evaluate_cost,
     linearize,
     project,
-    project_guess,
     second_order_weights,
-    solve_lq_direction,
-    solve_pronto,
 )
 
 __all__ = [

@@ -1,0 +1,179 @@
+"""LQ search direction of PRONTO: discrete Riccati with cross term and the fallback ladder.
+
+Newton (exact weights) → convexified (per-stage eigenvalue clipping) → steepest (constant
+positive-definite model); ``reference/pronto.md`` §4.2 and §6.3.
+"""
+
+from __future__ import annotations
+
+import enum
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from auvplan._typing import FloatArray
+from auvplan.errors import SolverError
+from auvplan.optimization import _kernels
+from auvplan.optimization.stages import Linearization, StageWeights
+
+__all__ = ["DirectionType", "LqDirection", "convexify", "solve_lq_direction"]
+
+logger = logging.getLogger(__name__)
+
+
+class DirectionType(enum.Enum):
+    """Which quadratic model produced the search direction (the fallback ladder)."""
+
+    NEWTON = "newton"
+    CONVEXIFIED = "convexified"
+    STEEPEST = "steepest"
+
+
+def convexify(weights: StageWeights, floor: float) -> StageWeights:
+    """Clip the eigenvalues of every ``[[Q, S], [Sᵀ, R]]`` and of ``P_N`` at ``floor``.
+
+    Returns
+    -------
+    StageWeights
+        Positive-definite weights (projection onto ``{W ⪰ floor·I}`` per stage).
+    """
+    n_x = weights.Q.shape[1]
+    top = np.concatenate([weights.Q, weights.S], axis=2)
+    bottom = np.concatenate([np.swapaxes(weights.S, 1, 2), weights.R], axis=2)
+    stacked = np.concatenate([top, bottom], axis=1)
+    stacked = 0.5 * (stacked + np.swapaxes(stacked, 1, 2))
+    values, vectors = np.linalg.eigh(stacked)
+    clipped = np.einsum("kij,kj,klj->kil", vectors, np.maximum(values, floor), vectors)
+    p_values, p_vectors = np.linalg.eigh(0.5 * (weights.P_N + weights.P_N.T))
+    p_clipped = (p_vectors * np.maximum(p_values, floor)) @ p_vectors.T
+    return StageWeights(
+        np.ascontiguousarray(clipped[:, :n_x, :n_x]),
+        np.ascontiguousarray(clipped[:, :n_x, n_x:]),
+        np.ascontiguousarray(clipped[:, n_x:, n_x:]),
+        p_clipped,
+    )
+
+
+@dataclass(frozen=True)
+class LqDirection:
+    """Search direction ``ζ = (z, v)`` from the LQ subproblem.
+
+    Attributes
+    ----------
+    z : ndarray of shape (N + 1, n_x)
+        State direction (``z_0 = 0``).
+    v : ndarray of shape (N, n_u)
+        Input direction.
+    slope : float
+        ``Dh·ζ`` (negative for a descent direction).
+    model_curvature : float
+        Second derivative of the model that produced ζ, along ζ.
+    direction : DirectionType
+        Ladder level used.
+    """
+
+    z: FloatArray
+    v: FloatArray
+    slope: float
+    model_curvature: float
+    direction: DirectionType
+
+
+def _quadratic_form(weights: StageWeights, z: FloatArray, v: FloatArray) -> float:
+    zs, zn = z[:-1], z[-1]
+    return float(
+        np.einsum("ki,kij,kj->", zs, weights.Q, zs)
+        + 2.0 * np.einsum("ki,kij,kj->", zs, weights.S, v)
+        + np.einsum("ki,kij,kj->", v, weights.R, v)
+        + zn @ weights.P_N @ zn
+    )
+
+
+def _slope(linearization: Linearization, z: FloatArray, v: FloatArray) -> float:
+    lin = linearization
+    return float(np.sum(lin.a * z[:-1]) + np.sum(lin.b * v) + lin.m_x @ z[-1])
+
+
+def _try_direction(
+    linearization: Linearization, weights: StageWeights, direction: DirectionType
+) -> LqDirection | None:
+    lin = linearization
+    feedback, feedforward, failed = _kernels.lq_backward(
+        lin.A,
+        lin.B,
+        np.ascontiguousarray(weights.Q),
+        np.ascontiguousarray(weights.S),
+        np.ascontiguousarray(weights.R),
+        lin.a,
+        lin.b,
+        np.ascontiguousarray(weights.P_N),
+        np.ascontiguousarray(lin.m_x),
+    )
+    if failed >= 0:
+        logger.debug("%s LQ model not positive definite at stage %d", direction.value, failed)
+        return None
+    z, v = _kernels.lq_forward(lin.A, lin.B, feedback, feedforward)
+    slope = _slope(lin, z, v)
+    if not (np.isfinite(slope) and np.all(np.isfinite(z))):
+        return None
+    curvature = _quadratic_form(weights, z, v)
+    if slope > 0.0:
+        logger.debug("%s direction is not a descent direction (Dh·ζ = %g)", direction.value, slope)
+        return None
+    return LqDirection(z, v, slope, curvature, direction)
+
+
+def solve_lq_direction(
+    linearization: Linearization,
+    weights: StageWeights,
+    *,
+    quasi_weights: Callable[[], StageWeights] | None = None,
+    steepest_weights: StageWeights | None = None,
+    eigenvalue_floor: float = 1e-8,
+) -> LqDirection:
+    """Search direction by the discrete Riccati recursion with cross term (§6.3).
+
+    Fallback ladder: Newton (``weights``) → convexified quasi-Newton (eigenvalue-clipped
+    ``quasi_weights()``, or clipped ``weights`` when none given) → steepest
+    (``steepest_weights``, e.g. the regulator weights). A level is rejected when some
+    ``M_k = R_k + B_kᵀ P_{k+1} B_k`` fails the Cholesky test or ``Dh·ζ > 0``.
+
+    Parameters
+    ----------
+    linearization : Linearization
+        ``A, B, a, b, m_x`` along the current trajectory.
+    weights : StageWeights
+        Exact second-order weights (:func:`second_order_weights`).
+    quasi_weights : callable, optional
+        Lazily computed quasi-Newton weights (cost Hessians only).
+    steepest_weights : StageWeights, optional
+        Last-resort positive-definite model.
+    eigenvalue_floor : float
+        Eigenvalue clip of the convexified model.
+
+    Returns
+    -------
+    LqDirection
+        Direction, slope ``Dh·ζ`` and the ladder level used.
+
+    Raises
+    ------
+    SolverError
+        If no level produced a descent direction.
+    """
+    direction = _try_direction(linearization, weights, DirectionType.NEWTON)
+    if direction is not None:
+        return direction
+    base = quasi_weights() if quasi_weights is not None else weights
+    direction = _try_direction(
+        linearization, convexify(base, eigenvalue_floor), DirectionType.CONVEXIFIED
+    )
+    if direction is not None:
+        return direction
+    if steepest_weights is not None:
+        direction = _try_direction(linearization, steepest_weights, DirectionType.STEEPEST)
+        if direction is not None:
+            return direction
+    raise SolverError("no descent direction: Newton, convexified and steepest models all failed")
