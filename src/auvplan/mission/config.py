@@ -17,7 +17,7 @@ Mission keys (all tables optional except ``[fleet]`` and at least one ``[[vehicl
     [[comm]]       pair = [name, name], max_range_m
     [weights]      terrain, energy, terminal
     [planner]      edge_model = "paper" | "crossed"
-    [deconfliction] method = "astar" | "prioritized", weight, time_step_s
+    [deconfliction] method = "auto" | "astar" | "prioritized", weight, time_step_s, coarsening
     [solver]       dt_s, tol, max_iter, eps_initial, eps_final, eps_factor, delta_initial,
                    propeller_order
 """
@@ -36,7 +36,9 @@ from auvplan.errors import DataFormatError, InputError
 T = TypeVar("T")
 
 EDGE_MODELS: Final = ("paper", "crossed")
-DECONFLICTION_METHODS: Final = ("astar", "prioritized")
+DECONFLICTION_METHODS: Final = ("auto", "astar", "prioritized")
+#: Fleets up to this size use the coordination-space A* under ``method = "auto"``.
+AUTO_ASTAR_MAX_VEHICLES: Final = 4
 #: Default propeller harmonics in the optimiser (see ``auvplan vehicle --orders``): order 3
 #: keeps steady cruise power within 2.5 % and bollard thrust within 4 % of the full series.
 DEFAULT_PROPELLER_ORDER: Final = 3
@@ -148,18 +150,34 @@ class WeightsConfig:
 
 @dataclass(frozen=True)
 class DeconflictionConfig:
-    """Coordination-space method, A* weight (None: the paper's sqrt(N)) and time step [s]."""
+    """Coordination-space deconfliction settings.
 
-    method: str = "astar"
+    ``method``: ``"astar"`` (the paper's weighted A* on the N-D coordination grid),
+    ``"prioritized"`` (scales to 16+ vehicles) or ``"auto"`` (A* up to
+    ``AUTO_ASTAR_MAX_VEHICLES`` vehicles). ``weight``: A* heuristic weight (None: the paper's
+    sqrt(N); 1 gives the grid optimum). ``time_step`` [s] of the grid, and ``coarsening``: the
+    A* searches at ``coarsening * time_step`` and returns the law on the fine grid.
+    """
+
+    method: str = "auto"
     weight: float | None = None
     time_step: float = 0.5
+    coarsening: int = 1
+
+    def method_for(self, n_vehicles: int) -> str:
+        """The method actually used for a fleet of ``n_vehicles``."""
+        if self.method != "auto":
+            return self.method
+        return "astar" if n_vehicles <= AUTO_ASTAR_MAX_VEHICLES else "prioritized"
 
 
 @dataclass(frozen=True)
 class SolverConfig:
     """PRONTO settings: grid step ``dt`` [s], tolerance, iterations and barrier schedule.
 
-    ``propeller_order`` is the number of Fourier harmonics of the four-quadrant propeller
+    ``eigenvalue_floor`` is the smallest curvature kept per stage when PRONTO falls back to
+    its convexified model (cost units; 1e-2 suits costs in joules). ``propeller_order`` is
+    the number of Fourier harmonics of the four-quadrant propeller
     model inside the optimiser (the paper's low-order approximation, its ref. [14]); ``None``
     uses the full series. Plans are simulated, checked and reported with the same model.
     """
@@ -172,6 +190,7 @@ class SolverConfig:
     eps_factor: float = 0.1
     delta_initial: float = 0.5
     propeller_order: int | None = DEFAULT_PROPELLER_ORDER
+    eigenvalue_floor: float = 1e-2
 
 
 @dataclass(frozen=True)
@@ -404,11 +423,12 @@ def _parse_comm(table: _Table, index: int, names: list[str]) -> CommConfig:
 
 
 def _parse_deconfliction(table: _Table) -> DeconflictionConfig:
-    table.only("method", "weight", "time_step_s")
+    table.only("method", "weight", "time_step_s", "coarsening")
     return DeconflictionConfig(
-        method=table.choice("method", DECONFLICTION_METHODS, "astar"),
+        method=table.choice("method", DECONFLICTION_METHODS, "auto"),
         weight=table.number("weight", None, minimum=1.0),
         time_step=table.number("time_step_s", 0.5, minimum=0.0, strict=True),
+        coarsening=table.integer("coarsening", 1, minimum=1),
     )
 
 
@@ -422,7 +442,7 @@ def _propeller_order(table: _Table) -> int | None:
 def _parse_solver(table: _Table) -> SolverConfig:
     table.only(
         "dt_s", "tol", "max_iter", "eps_initial", "eps_final", "eps_factor", "delta_initial",
-        "propeller_order",
+        "propeller_order", "eigenvalue_floor",
     )  # fmt: skip
     config = SolverConfig(
         dt=table.number("dt_s", 0.5, minimum=0.0, strict=True),
@@ -433,6 +453,7 @@ def _parse_solver(table: _Table) -> SolverConfig:
         eps_factor=table.number("eps_factor", 0.1, minimum=0.0, maximum=1.0, strict=True),
         delta_initial=table.number("delta_initial", 0.5, minimum=0.0, strict=True),
         propeller_order=_propeller_order(table),
+        eigenvalue_floor=table.number("eigenvalue_floor", 1e-2, minimum=0.0, strict=True),
     )
     if config.eps_final > config.eps_initial:
         raise InputError(

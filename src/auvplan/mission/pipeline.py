@@ -425,7 +425,10 @@ def run_deconfliction(
             time_step=config.deconfliction.time_step,
         )
         coordination = deconflict(
-            problem, method=config.deconfliction.method, weight=config.deconfliction.weight
+            problem,
+            method=config.deconfliction.method_for(len(lengths)),
+            weight=config.deconfliction.weight,
+            coarsening=config.deconfliction.coarsening,
         )
         makespan = float(np.max(coordination.arrival_times))
         if fleet.horizon is None:
@@ -449,7 +452,7 @@ def run_deconfliction(
     desired = _desired_states(problem, coordination, models, time, preplan)
     logger.info(
         "deconfliction (%s): horizon %.1f s, delays %s s, min separation %.2f m",
-        config.deconfliction.method,
+        coordination.method,
         horizon,
         np.array2string(np.asarray(coordination.delays), precision=1),
         coordination.certificate.min_separation,
@@ -599,6 +602,7 @@ def run_optimization(
         eps_final=solver.eps_final,
         eps_factor=solver.eps_factor,
         delta_initial=solver.delta_initial,
+        eigenvalue_floor=solver.eigenvalue_floor,
     )
     n_vehicles = len(models)
     result = solve_pronto(

@@ -74,7 +74,7 @@ def mission_summary(result: MissionResult) -> dict[str, Any]:
         "fleet": {
             "safety_radius_m": config.fleet.safety_radius,
             "edge_model": config.edge_model,
-            "deconfliction_method": config.deconfliction.method,
+            "deconfliction_method": config.deconfliction.method_for(len(config.vehicles)),
         },
         "solver": dataclasses.asdict(config.solver),
         "vehicles": [],
