@@ -80,10 +80,38 @@ def _row_major(matrix: _Sym) -> _Sym:
     return ca.reshape(matrix.T, -1, 1)
 
 
-def _to_stages(values: ca.DM, n_stages: int, shape: tuple[int, ...]) -> FloatArray:
-    """Turn a mapped CasADi output of shape (prod(shape), N) into a (N, *shape) array."""
-    array = np.asarray(values.full() if isinstance(values, ca.DM) else values, dtype=np.float64)
-    return np.ascontiguousarray(array.T.reshape((n_stages, *shape)))
+def _dense_function(
+    name: str, inputs: list[_Sym], outputs: list[_Sym], in_names: list[str], out_names: list[str]
+) -> ca.Function:
+    """A CasADi Function whose outputs are dense (so raw buffers hold every entry)."""
+    return ca.Function(name, inputs, [ca.densify(out) for out in outputs], in_names, out_names)
+
+
+def _evaluate(function: ca.Function, args: list[FloatArray]) -> list[FloatArray]:
+    """Evaluate a (mapped) Function on numpy buffers, without DM conversion.
+
+    A time-major C-contiguous array ``(N, n)`` is exactly CasADi's column-major ``(n, N)``
+    matrix, so inputs are passed as they are and every output comes back as a flat array
+    that reshapes to ``(N, ...)`` without copying.
+    """
+    buffer, evaluate = function.buffer()
+    arrays = [np.ascontiguousarray(arg, dtype=np.float64) for arg in args]
+    for i, array in enumerate(arrays):
+        if array.size != function.nnz_in(i):
+            raise InputError(
+                f"{function.name()} input {i} needs {function.nnz_in(i)} values, got {array.size}"
+            )
+        buffer.set_arg(i, array.data)  # type: ignore[call-arg]  # SWIG typemap: (ptr, size)
+    outputs = [np.empty(function.nnz_out(i)) for i in range(function.n_out())]
+    for i, output in enumerate(outputs):
+        buffer.set_res(i, output.data)  # type: ignore[call-arg]
+    evaluate()
+    return outputs
+
+
+def _to_stages(values: FloatArray, n_stages: int, shape: tuple[int, ...]) -> FloatArray:
+    """Reshape a flat mapped output (column-major ``(prod(shape), N)``) to ``(N, *shape)``."""
+    return values.reshape((n_stages, *shape))
 
 
 def _check_stages(array: FloatArray, n_cols: int, name: str, n_stages: int | None) -> FloatArray:
@@ -171,7 +199,7 @@ class DiscreteModel:
         n_stages = states.shape[0]
         inputs = _check_stages(inputs, self.n_u, "U", n_stages)
         parameters = _check_stages(parameters, self.n_p, "P", n_stages)
-        return n_stages, states.T, inputs.T, parameters.T
+        return n_stages, states, inputs, parameters
 
     def step(self, states: FloatArray, inputs: FloatArray, parameters: FloatArray) -> FloatArray:
         """Next states ``F(x_k, u_k, p_k)``, shape ``(N, n_x)``.
@@ -188,7 +216,7 @@ class DiscreteModel:
                [0.9048375]])
         """
         n_stages, xs, us, ps = self._inputs(states, inputs, parameters)
-        out = self._map(self.step_function, n_stages)(xs, us, ps)
+        (out,) = _evaluate(self._map(self.step_function, n_stages), [xs, us, ps])
         return _to_stages(out, n_stages, (self.n_x,))
 
     def jacobians(
@@ -196,7 +224,7 @@ class DiscreteModel:
     ) -> tuple[FloatArray, FloatArray]:
         """Exact ``F_x`` of shape ``(N, n_x, n_x)`` and ``F_u`` of shape ``(N, n_x, n_u)``."""
         n_stages, xs, us, ps = self._inputs(states, inputs, parameters)
-        f_x, f_u = self._map(self._jacobians, n_stages)(xs, us, ps)
+        f_x, f_u = _evaluate(self._map(self._jacobians, n_stages), [xs, us, ps])
         return (
             _to_stages(f_x, n_stages, (self.n_x, self.n_x)),
             _to_stages(f_u, n_stages, (self.n_x, self.n_u)),
@@ -224,12 +252,12 @@ class DiscreteModel:
             Blocks of the Hessian of ``λ_{k+1}ᵀ F(x, u, p)`` with respect to ``(x, u)``.
         """
         n_stages, xs, us, ps = self._inputs(states, inputs, parameters)
-        lam = _check_stages(costate_next, self.n_x, "costate_next", n_stages).T
-        h_xx, h_xu, h_uu = self._map(self._dyn_hessian, n_stages)(xs, us, ps, lam)
+        lam = _check_stages(costate_next, self.n_x, "costate_next", n_stages)
+        h_xx, h_xu, h_uu = _evaluate(self._map(self._dyn_hessian, n_stages), [xs, us, ps, lam])
         return self._hessian_blocks(n_stages, h_xx, h_xu, h_uu)
 
     def _hessian_blocks(
-        self, n_stages: int, h_xx: ca.DM, h_xu: ca.DM, h_uu: ca.DM
+        self, n_stages: int, h_xx: FloatArray, h_xu: FloatArray, h_uu: FloatArray
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
         return (
             _to_stages(h_xx, n_stages, (self.n_x, self.n_x)),
@@ -240,7 +268,7 @@ class DiscreteModel:
     def cost(self, states: FloatArray, inputs: FloatArray, parameters: FloatArray) -> FloatArray:
         """Stage costs ``L(x_k, u_k, p_k)``, shape ``(N,)``."""
         n_stages, xs, us, ps = self._inputs(states, inputs, parameters)
-        out = self._map(self.cost_function, n_stages)(xs, us, ps)
+        (out,) = _evaluate(self._map(self.cost_function, n_stages), [xs, us, ps])
         return _to_stages(out, n_stages, ())
 
     def cost_gradients(
@@ -248,7 +276,7 @@ class DiscreteModel:
     ) -> tuple[FloatArray, FloatArray]:
         """Stage-cost gradients ``L_x`` of shape ``(N, n_x)`` and ``L_u`` of shape ``(N, n_u)``."""
         n_stages, xs, us, ps = self._inputs(states, inputs, parameters)
-        l_x, l_u = self._map(self._cost_gradient, n_stages)(xs, us, ps)
+        l_x, l_u = _evaluate(self._map(self._cost_gradient, n_stages), [xs, us, ps])
         return _to_stages(l_x, n_stages, (self.n_x,)), _to_stages(l_u, n_stages, (self.n_u,))
 
     def cost_hessians(
@@ -256,7 +284,7 @@ class DiscreteModel:
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Stage-cost Hessian blocks ``L_xx (N, n_x, n_x)``, ``L_xu (N, n_x, n_u)``, ``L_uu``."""
         n_stages, xs, us, ps = self._inputs(states, inputs, parameters)
-        h_xx, h_xu, h_uu = self._map(self._cost_hessian, n_stages)(xs, us, ps)
+        h_xx, h_xu, h_uu = _evaluate(self._map(self._cost_hessian, n_stages), [xs, us, ps])
         return self._hessian_blocks(n_stages, h_xx, h_xu, h_uu)
 
     def first_order(
@@ -264,7 +292,7 @@ class DiscreteModel:
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
         """All first-order data in one call: ``(F_x, F_u, L, L_x, L_u)`` (shapes as above)."""
         n_stages, xs, us, ps = self._inputs(states, inputs, parameters)
-        f_x, f_u, cost, l_x, l_u = self._map(self._first_order, n_stages)(xs, us, ps)
+        f_x, f_u, cost, l_x, l_u = _evaluate(self._map(self._first_order, n_stages), [xs, us, ps])
         return (
             _to_stages(f_x, n_stages, (self.n_x, self.n_x)),
             _to_stages(f_u, n_stages, (self.n_x, self.n_u)),
@@ -282,8 +310,10 @@ class DiscreteModel:
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Hessian blocks of ``L(x,u,p) + λ_{k+1}ᵀ F(x,u,p)`` in one call (Q, S, R of PRONTO)."""
         n_stages, xs, us, ps = self._inputs(states, inputs, parameters)
-        lam = _check_stages(costate_next, self.n_x, "costate_next", n_stages).T
-        h_xx, h_xu, h_uu = self._map(self._lagrangian_hessian, n_stages)(xs, us, ps, lam)
+        lam = _check_stages(costate_next, self.n_x, "costate_next", n_stages)
+        h_xx, h_xu, h_uu = _evaluate(
+            self._map(self._lagrangian_hessian, n_stages), [xs, us, ps, lam]
+        )
         return self._hessian_blocks(n_stages, h_xx, h_xu, h_uu)
 
     def rollout(
@@ -332,7 +362,7 @@ class DiscreteModel:
         if accumulated is None:
             accumulated = self._closed_loop_step.mapaccum("rollout", n_stages)
             self._cache.functions[key] = accumulated
-        out = accumulated(x0, alpha.T, mu.T, gains.reshape(n_stages, -1).T, params.T)
+        (out,) = _evaluate(accumulated, [x0, alpha, mu, gains.reshape(n_stages, -1), params])
         states = np.empty((n_stages + 1, self.n_x))
         states[0] = x0
         states[1:] = _to_stages(out, n_stages, (self.n_x,))
@@ -385,30 +415,30 @@ def _build_rk4(
     gain = ca.reshape(gains, n_x, n_u).T
     closed_u = mu + gain @ (alpha - x)
     functions = {
-        "step": ca.Function("rk4_step", args, [x_next], names, ["x_next"]),
-        "cost": ca.Function("rk4_cost", args, [stage_cost], names, ["l"]),
-        "jacobians": ca.Function(
+        "step": _dense_function("rk4_step", args, [x_next], names, ["x_next"]),
+        "cost": _dense_function("rk4_cost", args, [stage_cost], names, ["l"]),
+        "jacobians": _dense_function(
             "rk4_jac", args, [_row_major(f_x), _row_major(f_u)], names, ["f_x", "f_u"]
         ),
-        "first_order": ca.Function(
+        "first_order": _dense_function(
             "rk4_first",
             args,
             [_row_major(f_x), _row_major(f_u), stage_cost, l_x, l_u],
             names,
             ["f_x", "f_u", "l", "l_x", "l_u"],
         ),
-        "dyn_hessian": ca.Function(
+        "dyn_hessian": _dense_function(
             "rk4_dyn_hess",
             [*args, lam],
             hessian_blocks(ca.dot(lam, x_next)),
             [*names, "lam"],
             hess_names,
         ),
-        "cost_gradient": ca.Function("rk4_cost_grad", args, [l_x, l_u], names, ["l_x", "l_u"]),
-        "cost_hessian": ca.Function(
+        "cost_gradient": _dense_function("rk4_cost_grad", args, [l_x, l_u], names, ["l_x", "l_u"]),
+        "cost_hessian": _dense_function(
             "rk4_cost_hess", args, hessian_blocks(stage_cost), names, hess_names
         ),
-        "lagrangian_hessian": ca.Function(
+        "lagrangian_hessian": _dense_function(
             "rk4_lag_hess",
             [*args, lam],
             hessian_blocks(stage_cost + ca.dot(lam, x_next)),
@@ -417,7 +447,7 @@ def _build_rk4(
         ),
     }
     step = functions["step"]
-    functions["closed_loop_step"] = ca.Function(
+    functions["closed_loop_step"] = _dense_function(
         "rk4_closed_loop",
         [x, alpha, mu, gains, p],
         [step(x, closed_u, p)],
@@ -532,12 +562,12 @@ class ConstraintModel:
         n_stages = states.shape[0]
         inputs = _check_stages(inputs, self.n_u, "U", n_stages)
         parameters = _check_stages(parameters, self.n_p, "P", n_stages)
-        return n_stages, states.T, inputs.T, parameters.T
+        return n_stages, states, inputs, parameters
 
     def values(self, states: FloatArray, inputs: FloatArray, parameters: FloatArray) -> FloatArray:
         """Constraint values, shape ``(N, n_c)`` (``>= 0`` feasible)."""
         n_stages, xs, us, ps = self._inputs(states, inputs, parameters)
-        out = _mapped(self._cache, self.function, n_stages, "serial", 1)(xs, us, ps)
+        (out,) = _evaluate(_mapped(self._cache, self.function, n_stages, "serial", 1), [xs, us, ps])
         return _to_stages(out, n_stages, (self.n_c,))
 
     def jacobians(
@@ -545,7 +575,9 @@ class ConstraintModel:
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Values ``(N, n_c)`` and Jacobians ``c_x (N, n_c, n_x)``, ``c_u (N, n_c, n_u)``."""
         n_stages, xs, us, ps = self._inputs(states, inputs, parameters)
-        c, c_x, c_u = _mapped(self._cache, self._jacobians, n_stages, "serial", 1)(xs, us, ps)
+        c, c_x, c_u = _evaluate(
+            _mapped(self._cache, self._jacobians, n_stages, "serial", 1), [xs, us, ps]
+        )
         return (
             _to_stages(c, n_stages, (self.n_c,)),
             _to_stages(c_x, n_stages, (self.n_c, self.n_x)),
@@ -561,8 +593,10 @@ class ConstraintModel:
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Blocks of ``Σ_j w_{k,j} ∇²c_j(x_k, u_k, p_k)``; ``weights`` has shape ``(N, n_c)``."""
         n_stages, xs, us, ps = self._inputs(states, inputs, parameters)
-        w = _check_stages(weights, self.n_c, "weights", n_stages).T
-        h_xx, h_xu, h_uu = _mapped(self._cache, self._hessian, n_stages, "serial", 1)(xs, us, ps, w)
+        w = _check_stages(weights, self.n_c, "weights", n_stages)
+        h_xx, h_xu, h_uu = _evaluate(
+            _mapped(self._cache, self._hessian, n_stages, "serial", 1), [xs, us, ps, w]
+        )
         return (
             _to_stages(h_xx, n_stages, (self.n_x, self.n_x)),
             _to_stages(h_xu, n_stages, (self.n_x, self.n_u)),
@@ -608,15 +642,15 @@ def discretize_constraints(
         hess, _ = ca.hessian(ca.dot(weights, c), w)
         args = [x, u, p]
         names = ["x", "u", "p"]
-        value = ca.Function("constraints", args, [c], names, ["c"])
-        jac = ca.Function(
+        value = _dense_function("constraints", args, [c], names, ["c"])
+        jac = _dense_function(
             "constraint_jac",
             args,
             [c, _row_major(ca.jacobian(c, x)), _row_major(ca.jacobian(c, u))],
             names,
             ["c", "c_x", "c_u"],
         )
-        hessian = ca.Function(
+        hessian = _dense_function(
             "constraint_hess",
             [*args, weights],
             [
@@ -677,5 +711,5 @@ def make_terminal_cost(terminal_cost: ca.Function, n_x: int) -> TerminalCost:
         x = ca.MX.sym("x", n_x)
         value = terminal_cost(x)
     hess, grad = ca.hessian(value, x)
-    derivatives = ca.Function("terminal", [x], [value, grad, hess], ["x"], ["m", "m_x", "m_xx"])
+    derivatives = _dense_function("terminal", [x], [value, grad, hess], ["x"], ["m", "m_x", "m_xx"])
     return TerminalCost(n_x, terminal_cost, derivatives)
