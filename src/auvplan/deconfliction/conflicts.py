@@ -136,7 +136,8 @@ def _where(problem: CoordinationProblem, vehicle: int, k: int) -> str:
     n_k = int(problem.n_steps[vehicle])
     point = problem.grid_points(vehicle)[min(max(k, 0), n_k)]
     label = "start" if k <= 0 else "goal" if k >= n_k else "path"
-    return f"vehicle {vehicle}'s {label} at (north, east) = ({point[0]:.1f}, {point[1]:.1f}) m"
+    place = f"({point[0]:.1f}, {point[1]:.1f}) m"
+    return f"vehicle {problem.label(vehicle)}'s {label} at (north, east) = {place}"
 
 
 def check_endpoints(problem: CoordinationProblem) -> None:
@@ -156,7 +157,8 @@ def check_endpoints(problem: CoordinationProblem) -> None:
                 distance = float(np.hypot(*(points[i] - points[j])))
                 if distance < problem.separation:
                     raise InfeasibleError(
-                        f"vehicles {i} and {j} both {'begin' if label == 'start' else 'end'} "
+                        f"vehicles {problem.label(i)} and {problem.label(j)} both "
+                        f"{'begin' if label == 'start' else 'end'} "
                         f"within 2 r_c = {problem.separation:g} m of each other: "
                         f"{label}s at (north, east) = ({points[i][0]:.1f}, {points[i][1]:.1f}) "
                         f"and ({points[j][0]:.1f}, {points[j][1]:.1f}) m, {distance:.2f} m apart"
@@ -186,7 +188,8 @@ def check_pairwise_timing(problem: CoordinationProblem, table: ConflictTable) ->
             reachable, row, col = pair_reachability(row_ptr, table.lo, table.hi, n_i, n_j)
             if not reachable:
                 raise InfeasibleError(
-                    f"vehicles {i} and {j} cannot be separated by timing: "
+                    f"vehicles {problem.label(i)} and {problem.label(j)} cannot be separated "
+                    "by timing: "
                     f"{_where(problem, i, row)} and {_where(problem, j, col)} are within "
                     f"2 r_c = {problem.separation:g} m (plus grid margin "
                     f"{table.radius[i, j] - problem.separation:.3g} m) on every schedule"

@@ -248,7 +248,7 @@ def _solve_prioritized(problem: CoordinationProblem, table: ConflictTable) -> tu
         logger.info("prioritized: vehicle %d found no time law; promoting it", failed)
         order = [failed] + [v for v in order if v != failed]
     raise InfeasibleError(
-        f"prioritised planning found no schedule for vehicle {failed} in any of "
+        f"prioritised planning found no schedule for vehicle {problem.label(failed)} in any of "
         f"{len(tried)} priority orders (the method is incomplete; try method='astar')"
     )
 

@@ -47,6 +47,8 @@ class CoordinationProblem:
         whole path at this speed from ``t = 0``; deconfliction only waits or slows down.
     time_step : float
         Grid step ``dt`` [s], > 0 (the paper uses 0.01 s).
+    names : tuple of str
+        Optional vehicle names used in messages (default: the vehicle indices).
 
     Examples
     --------
@@ -64,15 +66,22 @@ class CoordinationProblem:
     safety_radius: float
     cruise_speeds: FloatArray
     time_step: float
+    names: tuple[str, ...] = ()
     # derived, filled in __post_init__ (not constructor arguments)
     arc_lengths: tuple[FloatArray, ...] = field(init=False, repr=False, compare=False)
     path_lengths: FloatArray = field(init=False, repr=False, compare=False)
     step_lengths: FloatArray = field(init=False, repr=False, compare=False)
     n_steps: IntArray = field(init=False, repr=False, compare=False)
 
+    def label(self, vehicle: int) -> str:
+        """The name of ``vehicle`` for messages (its index when no names were given)."""
+        return self.names[vehicle] if self.names else str(vehicle)
+
     def __post_init__(self) -> None:
         if not isinstance(self.paths, tuple) or len(self.paths) < 1:
             raise InputError(f"paths must be a non-empty tuple of arrays, got {type(self.paths)}")
+        if self.names and len(self.names) != len(self.paths):
+            raise InputError(f"{len(self.names)} names given for {len(self.paths)} paths")
         n_vehicles = len(self.paths)
         cleaned: list[FloatArray] = []
         arcs: list[FloatArray] = []
@@ -112,7 +121,7 @@ class CoordinationProblem:
         if np.any(n_steps > MAX_STEPS_PER_VEHICLE):
             worst = int(np.argmax(n_steps))
             raise InputError(
-                f"vehicle {worst} needs {int(n_steps[worst])} time steps "
+                f"vehicle {self.label(worst)} needs {int(n_steps[worst])} time steps "
                 f"(> {MAX_STEPS_PER_VEHICLE}); increase time_step={self.time_step} s"
             )
         object.__setattr__(self, "paths", tuple(cleaned))

@@ -423,6 +423,7 @@ def run_deconfliction(
             safety_radius=fleet.safety_radius,
             cruise_speeds=speeds,
             time_step=config.deconfliction.time_step,
+            names=preplan.names,
         )
         coordination = deconflict(
             problem,
