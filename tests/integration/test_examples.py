@@ -1,0 +1,39 @@
+"""The shipped example missions plan successfully and keep their constraints (slow)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from auvplan.mission.config import load_mission
+from auvplan.mission.pipeline import run_mission
+
+pytestmark = pytest.mark.slow
+
+MISSIONS = Path(__file__).parents[2] / "examples" / "missions"
+
+
+@pytest.mark.parametrize("name", ["four_vehicles", "monterey"])
+def test_example_mission(name: str) -> None:
+    config = load_mission(MISSIONS / f"{name}.toml")
+    if config.terrain.file is not None and not config.terrain.file.is_file():
+        pytest.skip(f"bathymetry not found: {config.terrain.file}")
+    result = run_mission(config)
+    plan = result.plan
+    assert plan is not None
+    assert plan.result.success, plan.result.message
+    limit = 2 * config.fleet.safety_radius
+    for name_i, others in plan.separations.items():
+        for other, distance in others.items():
+            if other.startswith("obstacle"):
+                assert distance >= config.fleet.safety_radius, (name_i, other, distance)
+            else:
+                assert distance >= limit, (name_i, other, distance)
+    assert np.all(plan.arrival_error < 2.0)
+    assert np.all(plan.tracking_error < 0.5)
+    states = plan.states
+    for comm in config.comms:
+        i, j = config.vehicle_index(comm.pair[0]), config.vehicle_index(comm.pair[1])
+        assert np.hypot(*(states[i, :, :2] - states[j, :, :2]).T).max() <= comm.max_range
