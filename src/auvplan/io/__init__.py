@@ -2,6 +2,18 @@
 
 from __future__ import annotations
 
+from auvplan.io.bathymetry import detect_format, read_bathymetry
+from auvplan.io.maps_file import read_maps_netcdf, write_maps_netcdf
 from auvplan.io.output import staged_output_dir
+from auvplan.io.vehicles import load_propeller_table, load_vehicle, packaged_vehicle_types
 
-__all__ = ["staged_output_dir"]
+__all__ = [
+    "detect_format",
+    "load_propeller_table",
+    "load_vehicle",
+    "packaged_vehicle_types",
+    "read_bathymetry",
+    "read_maps_netcdf",
+    "staged_output_dir",
+    "write_maps_netcdf",
+]
