@@ -86,8 +86,8 @@ def _dense_function(
     """A CasADi Function with dense outputs and common subexpressions merged.
 
     Dense outputs let raw buffers hold every entry; ``casadi.cse`` merges common subexpressions
-    (e.g. between the RK4 stages of the dynamics
-    and of the running cost), which makes the Hessians about 10–15 % cheaper to evaluate.
+    (e.g. between the RK4 stages of the dynamics and of the running cost), which makes the
+    Hessians about 10–15 % cheaper to evaluate.
     """
     dense = [ca.densify(out) for out in outputs]
     if dense and all(isinstance(out, ca.SX) for out in dense):

@@ -500,6 +500,9 @@ def solve_pronto(
     except StopIteration:
         status = ProntoStatus.MAX_ITER
         message = "stopped by the callback"
+    except SolverError as error:  # no descent direction from any model of the ladder
+        status = ProntoStatus.LINE_SEARCH_FAILED
+        message = str(error)
     cost, min_slack = evaluate_cost(model, state.trajectory, epsilon, state.delta)
     if status is None:
         if model.has_constraints and not min_slack > 0.0:
