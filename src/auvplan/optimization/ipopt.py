@@ -88,6 +88,7 @@ def solve_ipopt(
     hard_constraints: bool = True,
     tol: float = 1e-10,
     max_iter: int = 3000,
+    expand: bool = True,
 ) -> IpoptResult:
     """Solve the discretised problem with IPOPT (multiple shooting, MUMPS, exact Hessian).
 
@@ -105,6 +106,9 @@ def solve_ipopt(
         IPOPT ``tol``.
     max_iter : int
         IPOPT ``max_iter``.
+    expand : bool
+        Expand the NLP to SX before solving (slow to build for long horizons, fast to
+        evaluate); ``False`` keeps CasADi's mapped MX graph (fast to build).
 
     Returns
     -------
@@ -148,7 +152,7 @@ def solve_ipopt(
     n_eq = n_x * n_steps
     nlp: dict[str, Any] = {"x": variables, "f": running + terminal + barrier_term, "g": constraints}
     options: dict[str, Any] = {
-        "expand": True,
+        "expand": expand,
         "print_time": False,
         "ipopt.print_level": 0,
         "ipopt.sb": "yes",
