@@ -264,26 +264,25 @@ def test_armijo_rejects_infeasible_candidates_once_feasible() -> None:
     model = build_model(problem)
     result = solve_pronto(problem, zero_guess(problem), options=ProntoOptions(eps_final=1e-2))
     xi = result.trajectory
-    cost, slack = evaluate_cost(model, xi, result.epsilon, result.delta)
+    _, slack = evaluate_cost(model, xi, result.epsilon, result.delta)
     assert slack > 0
-    # a direction that pushes straight into the obstacle centre
+    # reference states pushed straight into the obstacle centre, tracked by the regulator
     z = np.zeros_like(xi.states)
     z[:, 0] = 2.0 - xi.states[:, 0]
     z[:, 1] = 0.15 - xi.states[:, 1]
-    push = LqDirection(z, np.zeros_like(xi.inputs), -1e9, 0.0, DirectionType.STEEPEST)
-    gains = np.zeros((problem.n_steps, problem.n_inputs, problem.n_states))
-    outcome = armijo_step(
-        model,
-        xi,
-        push,
-        gains,
-        cost.total,
-        epsilon=result.epsilon,
-        delta=result.delta,
-        require_feasible=True,
-        max_backtracks=5,
-    )
-    assert not outcome.accepted
+    push = LqDirection(z, np.zeros_like(xi.inputs), 0.0, 0.0, DirectionType.STEEPEST)
+    lin = linearize(model, xi, result.epsilon, result.delta)
+    gains = design_regulator(lin.A, lin.B, 100.0 * problem.state_weight, problem.input_weight)
+    common = {"epsilon": result.epsilon, "delta": result.delta, "max_backtracks": 40}
+    # with a huge reference cost the sufficient-decrease test passes for any finite candidate
+    free = armijo_step(model, xi, push, gains, 1e12, require_feasible=False, **common)
+    assert free.accepted
+    assert free.step == 1.0
+    assert free.min_slack < 0.0  # the full step enters the obstacle
+    strict = armijo_step(model, xi, push, gains, 1e12, require_feasible=True, **common)
+    assert strict.accepted
+    assert strict.step < 1.0
+    assert strict.min_slack > 0.0
 
 
 def test_converged() -> None:
