@@ -140,3 +140,11 @@ def test_preplan_writes_paths(
     for name in ("maps.nc", "maps.png", "paths.png", "paths.geojson"):
         assert (out / name).is_file(), name
     assert not (out / "trajectories.csv").exists()
+
+
+def test_communication_range_violated_at_start(
+    tmp_path: Path, terrain_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    extra = '[[comm]]\npair = ["blue", "green"]\nmax_range_m = 50.0\n'
+    message = _run_bad(tmp_path, _mission(terrain_file, extra=extra), capsys)
+    assert "blue and green start 100 m apart" in message

@@ -8,6 +8,8 @@ from pathlib import Path
 from typing import Any
 
 STAGES = ("preplan", "deconflict", "full")
+#: Exit code when the optimiser did not converge (user errors exit with 2).
+EXIT_NOT_CONVERGED = 3
 
 
 def register(subparsers: Any) -> None:
@@ -83,6 +85,22 @@ def _run(config: Any, args: argparse.Namespace) -> int:
             written += save_mission_figures(result, staging)
     if not args.quiet:
         _print_report(result, [args.output / path.name for path in written])
+    return _exit_code(result)
+
+
+def _exit_code(result: Any) -> int:
+    """0 for a converged plan; 3 (one line on stderr) when an optimisation did not converge.
+
+    The outputs are still written, for inspection, and the summary records the status.
+    """
+    for label, plan in (("plan", result.plan), ("energy-only plan", result.energy_only)):
+        if plan is not None and not plan.result.success:
+            print(
+                f"auvplan: {label} not converged ({plan.result.status.name}): "
+                f"{plan.result.message}; outputs written for inspection",
+                file=sys.stderr,
+            )
+            return EXIT_NOT_CONVERGED
     return 0
 
 

@@ -278,6 +278,7 @@ def run_preplan(config: MissionConfig) -> PreplanStage:
         ]
     )
     _check_pairwise_clearance(names, starts, goals, config.fleet.safety_radius)
+    _check_communication_ranges(config, starts, goals)
     obstacles = _obstacles(config, bathymetry)
     routes = []
     paths = []
@@ -342,6 +343,21 @@ def _check_pairwise_clearance(
                         f"vehicles {names[i]} and {names[j]} {what} {distance:.1f} m apart, "
                         f"closer than 2 r_c = {limit:g} m"
                     )
+
+
+def _check_communication_ranges(
+    config: MissionConfig, starts: FloatArray, goals: FloatArray
+) -> None:
+    """A pair that starts or ends out of its communication range can never satisfy it."""
+    for comm in config.comms:
+        i, j = config.vehicle_index(comm.pair[0]), config.vehicle_index(comm.pair[1])
+        for what, points in (("start", starts), ("goal", goals)):
+            distance = float(np.hypot(*(points[i, :2] - points[j, :2])))
+            if distance > comm.max_range:
+                raise InfeasibleError(
+                    f"vehicles {comm.pair[0]} and {comm.pair[1]} {what} {distance:.0f} m apart, "
+                    f"beyond their communication range max_range_m = {comm.max_range:g} m"
+                )
 
 
 def _obstacles(
