@@ -76,12 +76,12 @@ def plot_coordination_space(
     ax.plot(result.progress[i], result.progress[j], color="tab:blue", lw=2, label="deconflicted")
     ax.plot([0.0, length_i], [0.0, length_j], "o", color="k", ms=4)
     ax.set(
-        xlabel=f"progress $s_{i}$ of vehicle {i} [m]",
-        ylabel=f"progress $s_{j}$ of vehicle {j} [m]",
+        xlabel=f"progress $s_{i}$ of vehicle {problem.label(i)} [m]",
+        ylabel=f"progress $s_{j}$ of vehicle {problem.label(j)} [m]",
         xlim=(0.0, length_i),
         ylim=(0.0, length_j),
         aspect="equal",
-        title=f"coordination space of vehicles {i} and {j} "
+        title=f"coordination space of vehicles {problem.label(i)} and {problem.label(j)} "
         f"(red: closer than 2 $r_c$ = {problem.separation:g} m)",
     )
     ax.title.set_fontsize("small")
@@ -124,7 +124,9 @@ def plot_timed_paths(
     marks = timed_positions(result, problem, snapshots)
     critical = timed_positions(result, problem, np.array([result.min_separation_time]))[:, 0]
     for i, path in enumerate(problem.paths):
-        ax_map.plot(path[:, 1], path[:, 0], color=colors[i], lw=1.5, label=f"vehicle {i}")
+        ax_map.plot(
+            path[:, 1], path[:, 0], color=colors[i], lw=1.5, label=f"vehicle {problem.label(i)}"
+        )
         ax_map.scatter(
             marks[i, :, 1],
             marks[i, :, 0],
@@ -158,7 +160,7 @@ def plot_timed_paths(
                 fine,
                 np.hypot(*(positions[i] - positions[j]).T),
                 lw=1,
-                label=f"{i}–{j}" if problem.n_vehicles <= 6 else None,
+                label=f"{problem.label(i)}–{problem.label(j)}" if problem.n_vehicles <= 6 else None,
             )
     ax_sep.axhline(problem.separation, color="tab:red", lw=1.5, label="2 $r_c$")
     ax_sep.plot(
