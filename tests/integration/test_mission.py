@@ -124,7 +124,7 @@ def test_separation_arrival_and_energy(demo_output: Path) -> None:
         arrival = np.hypot(final[1] - goal["north"], final[2] - goal["east"])
         assert arrival < 2.0
         assert optimization["vehicles"][name]["arrival_error_m"] == pytest.approx(arrival)
-        energy = np.trapezoid(tracks[name][:, 12], tracks[name][:, 0])
+        energy = np.trapezoid(tracks[name][:, 11], tracks[name][:, 0])
         assert optimization["vehicles"][name]["energy_J"] == pytest.approx(energy, rel=1e-9)
 
 
