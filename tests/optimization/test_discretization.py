@@ -246,3 +246,36 @@ def test_rejects_bad_inputs() -> None:
     model = discretize_rk4(f, cost, 0.1)
     with pytest.raises(InputError, match="U"):
         model.step(np.zeros((3, 3)), np.zeros((2, 2)), np.zeros((3, 2)))
+
+
+def test_compiled_functions_match_the_virtual_machine(
+    points: tuple[np.ndarray, ...], tmp_path, rng: np.random.Generator
+) -> None:
+    f, cost, _ = _model_functions()
+    vm = discretize_rk4(f, cost, 0.2)
+    compiled = discretize_rk4(f, cost, 0.2, compile_c=True, cache_dir=tmp_path)
+    libraries = sorted(tmp_path.glob("*.so"))
+    if not libraries:
+        pytest.skip("no working C compiler")
+    assert "external" in compiled.step_function.class_name().lower() or compiled.step_function.is_a(
+        "External"
+    )
+    X, U, P, lam = points
+    np.testing.assert_allclose(compiled.step(X, U, P), vm.step(X, U, P), rtol=1e-13)
+    for got, expected in zip(compiled.first_order(X, U, P), vm.first_order(X, U, P), strict=True):
+        np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-13)
+    for got, expected in zip(
+        compiled.lagrangian_hessians(X, U, P, lam),
+        vm.lagrangian_hessians(X, U, P, lam),
+        strict=True,
+    ):
+        np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12)
+    gains = 0.1 * rng.normal(size=(N_STAGES, 2, 3))
+    for got, expected in zip(
+        compiled.rollout(X[0], X, U, gains, P), vm.rollout(X[0], X, U, gains, P), strict=True
+    ):
+        np.testing.assert_allclose(got, expected, rtol=1e-12)
+    # a second model with the same expressions reuses the cached library
+    again = discretize_rk4(f, cost, 0.2, compile_c=True, cache_dir=tmp_path)
+    assert sorted(tmp_path.glob("*.so")) == libraries
+    np.testing.assert_allclose(again.step(X, U, P), vm.step(X, U, P), rtol=1e-13)

@@ -78,10 +78,12 @@ class ProntoModel:
         return self.constraints is not None and self.constraints.n_c > 0
 
 
-_MODEL_CACHE: dict[tuple[int, int], tuple[TrajectoryProblem, ProntoModel]] = {}
+_MODEL_CACHE: dict[tuple[int, int, bool], tuple[TrajectoryProblem, ProntoModel]] = {}
 
 
-def build_model(problem: TrajectoryProblem, *, n_threads: int = 1) -> ProntoModel:
+def build_model(
+    problem: TrajectoryProblem, *, n_threads: int = 1, compile_c: bool = False
+) -> ProntoModel:
     """Discretise a problem (RK4 map, stage cost, constraints, terminal cost); cached per problem.
 
     Parameters
@@ -90,13 +92,15 @@ def build_model(problem: TrajectoryProblem, *, n_threads: int = 1) -> ProntoMode
         The problem.
     n_threads : int, optional
         Threads for the batched stage evaluations (1 = serial).
+    compile_c : bool, optional
+        Compile the stage functions to C (cached on disk; see :func:`discretize_rk4`).
 
     Returns
     -------
     ProntoModel
         Batched evaluators.
     """
-    key = (id(problem), n_threads)
+    key = (id(problem), n_threads, compile_c)
     cached = _MODEL_CACHE.get(key)
     if cached is not None and cached[0] is problem:
         return cached[1]
@@ -106,6 +110,7 @@ def build_model(problem: TrajectoryProblem, *, n_threads: int = 1) -> ProntoMode
         problem.dt,
         parallelization="thread" if n_threads > 1 else "serial",
         n_threads=n_threads,
+        compile_c=compile_c,
     )
     terminal = make_terminal_cost(problem.terminal_cost, problem.n_states)
     constraints = None
