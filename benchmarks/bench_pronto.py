@@ -21,8 +21,10 @@ import argparse
 import cProfile
 import dataclasses
 import io
+import os
 import pstats
 import sys
+import tempfile
 import time
 from dataclasses import dataclass
 
@@ -225,6 +227,9 @@ class Comparison:
     pronto_time: float
     pronto_cold_time: float
     pronto_threads_time: float
+    pronto_c_time: float
+    pronto_c_cold_time: float
+    pronto_c_cost: float
     ipopt: IpoptResult
     ipopt_mx: IpoptResult
     ipopt_barrier: IpoptResult | None
@@ -266,6 +271,13 @@ def compare(
     start = time.perf_counter()
     solve_pronto(problem, initial, options=threaded)
     pronto_threads_time = time.perf_counter() - start
+    compiled = dataclasses.replace(options, compile_c=True)
+    start = time.perf_counter()
+    solve_pronto(problem, initial, options=compiled)  # includes the one-off C compilation
+    pronto_c_cold_time = time.perf_counter() - start
+    start = time.perf_counter()
+    pronto_c = solve_pronto(problem, initial, options=compiled)
+    pronto_c_time = time.perf_counter() - start
     ipopt = solve_ipopt(problem, initial)
     ipopt_mx = solve_ipopt(problem, initial, expand=False)
     ipopt_barrier = None
@@ -282,6 +294,9 @@ def compare(
         pronto_time=pronto_time,
         pronto_cold_time=pronto_cold_time,
         pronto_threads_time=pronto_threads_time,
+        pronto_c_time=pronto_c_time,
+        pronto_c_cold_time=pronto_c_cold_time,
+        pronto_c_cost=pronto_c.cost,
         ipopt=ipopt,
         ipopt_mx=ipopt_mx,
         ipopt_barrier=ipopt_barrier,
@@ -293,10 +308,11 @@ def format_tables(rows: list[Comparison]) -> str:
     timing = [
         (
             "| problem | n_x | n_u | N | PRONTO it | PRONTO s warm / cold / 2 threads | "
+            "PRONTO compiled s warm (first, incl. C compile) | "
             "IPOPT it | IPOPT SX s total (build + solve) | IPOPT MX s total (solve) | "
-            "speed-up vs best IPOPT total | vs IPOPT solve only |"
+            "speed-up vs best IPOPT total: VM (compiled) | vs IPOPT solve only: VM (compiled) |"
         ),
-        "|" + "---|" * 11,
+        "|" + "---|" * 12,
     ]
     costs = [
         (
@@ -312,10 +328,11 @@ def format_tables(rows: list[Comparison]) -> str:
         timing.append(
             f"| {row.name} | {row.n_x} | {row.n_u} | {row.n_steps} | {len(pr.history)} | "
             f"{row.pronto_time:.2f} / {row.pronto_cold_time:.2f} / {row.pronto_threads_time:.2f} | "
+            f"{row.pronto_c_time:.2f} ({row.pronto_c_cold_time:.1f}) | "
             f"{ip.n_iter} | {ip.wall_time:.2f} ({ip.wall_time - ip.solve_time:.2f} + "
             f"{ip.solve_time:.2f}) | {mx.wall_time:.2f} ({mx.solve_time:.2f}) | "
-            f"{best_total / row.pronto_time:.1f}x (cold {best_total / row.pronto_cold_time:.1f}x)"
-            f" | {best_solve / row.pronto_time:.1f}x |"
+            f"{best_total / row.pronto_time:.1f}x ({best_total / row.pronto_c_time:.1f}x) | "
+            f"{best_solve / row.pronto_time:.1f}x ({best_solve / row.pronto_c_time:.1f}x) |"
         )
         rel = (pr.cost - ip.cost) / abs(ip.cost)
         barrier = "-"
@@ -390,6 +407,8 @@ def _profile(problem: TrajectoryProblem, guess: Trajectory, options: ProntoOptio
 
 
 def main(argv: list[str]) -> int:
+    # a fresh cache folder, so that the "first" compiled time includes the C compilation
+    os.environ["AUVPLAN_CACHE_DIR"] = tempfile.mkdtemp(prefix="auvplan_bench_")
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="toy problems only")
     parser.add_argument("--profile", action="store_true", help="profile the MEDUSA solve")
