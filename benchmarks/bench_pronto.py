@@ -316,7 +316,7 @@ def format_tables(rows: list[Comparison]) -> str:
     ]
     costs = [
         (
-            "| problem | PRONTO status | cost PRONTO | cost IPOPT (hard) | rel. diff | "
+            "| problem | PRONTO status | cost PRONTO (compiled) | cost IPOPT (hard) | rel. diff | "
             "barrier objective rel. diff (PRONTO vs IPOPT at same ε, δ) | final ε | min slack |"
         ),
         "|" + "---|" * 8,
@@ -340,7 +340,8 @@ def format_tables(rows: list[Comparison]) -> str:
             rel_b = (pr.objective - row.ipopt_barrier.objective) / abs(row.ipopt_barrier.objective)
             barrier = f"{rel_b:+.1e}"
         costs.append(
-            f"| {row.name} | {pr.status.value} | {pr.cost:.8g} | {ip.cost:.8g} | {rel:+.1e} | "
+            f"| {row.name} | {pr.status.value} | {pr.cost:.8g} ({row.pronto_c_cost:.8g}) | "
+            f"{ip.cost:.8g} | {rel:+.1e} | "
             f"{barrier} | {pr.epsilon:.0e} | {pr.min_slack:.2e} |"
         )
     return "\n".join(timing) + "\n\n" + "\n".join(costs)
@@ -397,12 +398,13 @@ class MedusaCrossing:
 
 
 def _profile(problem: TrajectoryProblem, guess: Trajectory, options: ProntoOptions) -> str:
+    solve_pronto(problem, guess, options=options)  # warm
     profiler = cProfile.Profile()
     profiler.enable()
     solve_pronto(problem, guess, options=options)
     profiler.disable()
     stream = io.StringIO()
-    pstats.Stats(profiler, stream=stream).sort_stats("tottime").print_stats(15)
+    pstats.Stats(profiler, stream=stream).sort_stats("tottime").print_stats(12)
     return stream.getvalue()
 
 
@@ -427,7 +429,10 @@ def main(argv: list[str]) -> int:
         rows.append(compare("MEDUSA 2-vehicle crossing", problem, options, guess))
         if args.profile:
             initial, _ = project_guess(build_model(problem), guess, options)
+            print("profile, CasADi virtual machine:")
             print(_profile(problem, initial, options))
+            print("profile, compiled stage functions:")
+            print(_profile(problem, initial, dataclasses.replace(options, compile_c=True)))
     print()
     print(format_tables(rows))
     for row in rows:
