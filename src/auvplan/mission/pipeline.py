@@ -57,6 +57,7 @@ from auvplan.planning import (
     Route,
     blocked_cells,
     blocked_lookup,
+    distance_to_obstacle,
     path_length,
     plan_route,
     smooth_path,
@@ -126,7 +127,8 @@ class OptimizedPlan:
     ``(n_vehicles, n_t)`` [W], ``energy`` ``(n_vehicles,)`` [J] = trapezoidal ∫ power dt,
     ``arrival_error`` ``(n_vehicles,)`` [m], ``terrain_information`` ``(n_vehicles,)`` mean
     information-map value along the trajectory; ``separations[name][other]`` the minimum
-    distance [m] to each other vehicle (centre to centre) and circular obstacle (to its edge),
+    distance [m] to each other vehicle (centre to centre) and obstacle (to its edge; polygons
+    are enforced by the pre-planner and only checked here),
     when the plan is flown with its tracking regulator on a grid ``CHECK_REFINEMENT`` times
     finer than the solver's (:func:`auvplan.mission.verify.replay_closed_loop`), whose time
     series are ``fine_distances`` (labels ``"a / b"``) on ``fine_time``; ``tracking_error``
@@ -688,11 +690,9 @@ def _evaluate_plan(
                 np.min(distance)
             )
         for k, obstacle in enumerate(preplan.obstacles):
-            if isinstance(obstacle, CircleObstacle):
-                centre = np.array([obstacle.north, obstacle.east])
-                distance = np.hypot(*(fine_positions[i] - centre).T) - obstacle.radius
-                fine_distances[f"{names[i]} / obstacle {k}"] = distance
-                separations[names[i]][f"obstacle {k}"] = float(np.min(distance))
+            distance = distance_to_obstacle(obstacle, *fine_positions[i].T)
+            fine_distances[f"{names[i]} / obstacle {k}"] = distance
+            separations[names[i]][f"obstacle {k}"] = float(np.min(distance))
     return OptimizedPlan(
         result=result,
         terrain_weight=terrain_weight,
