@@ -622,6 +622,7 @@ def run_optimization(
         eps_factor=solver.eps_factor,
         delta_initial=solver.delta_initial,
         eigenvalue_floor=solver.eigenvalue_floor,
+        compile_c=solver.compile,
     )
     n_vehicles = len(models)
     result = solve_pronto(
