@@ -56,6 +56,7 @@ def test_every_output_file_is_present(demo_output: Path) -> None:
     for name in (
         "summary.json", "trajectories.csv", "desired.csv", "maps.nc", "paths.geojson",
         "maps.png", "paths.png", "time_series.png", "separation.png", "coordination.png",
+        "paths_energy_only.png",
     ):  # fmt: skip
         assert (demo_output / name).is_file(), name
 

@@ -18,8 +18,8 @@ def mission_figures(result: MissionResult) -> dict[str, Figure]:
     """The figures of a run, by file stem.
 
     ``maps`` (paper Fig. 5), ``paths`` (Fig. 6 over the bathymetry), ``paths_cost`` (over the
-    cost map), and by stage ``coordination``, ``time_series`` (speeds, propellers, power) and
-    ``separation``.
+    cost map), and by stage ``coordination``, ``time_series`` (speeds, propellers, power),
+    ``separation`` and, with the comparison, ``paths_energy_only``.
     """
     preplan = result.preplan
     config = result.config
@@ -42,6 +42,13 @@ def mission_figures(result: MissionResult) -> dict[str, Figure]:
         background_label="shifted cost ω + w·M_C", cmap="magma",
         title="Pre-planned paths over the cost map",
     )  # fmt: skip
+    if result.energy_only is not None:
+        figures["paths_energy_only"] = plot_mission_paths(
+            preplan.bathymetry, preplan.names, planned,
+            [track[:, :2] for track in result.energy_only.states], safety_radius=radius,
+            circles=circles, polygons=polygons,
+            title="Energy-only optimum (terrain weight 0) against the pre-planned paths",
+        )  # fmt: skip
     stage2 = result.deconfliction
     if stage2 is not None and len(preplan.names) >= 2:
         figures["coordination"] = plot_coordination_space(
