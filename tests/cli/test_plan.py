@@ -148,3 +148,28 @@ def test_communication_range_violated_at_start(
     extra = '[[comm]]\npair = ["blue", "green"]\nmax_range_m = 50.0\n'
     message = _run_bad(tmp_path, _mission(terrain_file, extra=extra), capsys)
     assert "blue and green start 100 m apart" in message
+
+
+def test_cruise_speed_mode_deconflicts_and_arrives_together(
+    tmp_path: Path, terrain_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import json
+
+    text = _mission(terrain_file).replace("horizon_s = 600.0", "cruise_speed = 0.6")
+    text += "[solver]\ndt_s = 0.5\n"
+    mission = tmp_path / "mission.toml"
+    mission.write_text(text)
+    out = tmp_path / "out"
+    assert main(["-q", "plan", str(mission), "-o", str(out), "--stage", "deconflict"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    horizon = summary["deconfliction"]["horizon_s"]
+    assert horizon == pytest.approx(0.5 * round(horizon / 0.5))
+    for vehicle in summary["vehicles"]:
+        assert vehicle["timing"]["arrival_time_s"] == pytest.approx(horizon)
+        assert vehicle["timing"]["nominal_speed_m_s"] == pytest.approx(0.6)
+    assert summary["deconfliction"]["certified_min_separation_m"] >= 10.0
+    rows = np.genfromtxt(out / "desired.csv", delimiter=",", skip_header=1, usecols=(1, 2, 3))
+    blue, green = rows[: len(rows) // 2], rows[len(rows) // 2 :]
+    np.testing.assert_allclose(blue[:, 0], green[:, 0])
+    assert np.hypot(*(blue[:, 1:] - green[:, 1:]).T).min() >= 10.0
+    assert not (out / "trajectories.csv").exists()
