@@ -133,6 +133,17 @@ def _check_stages(array: FloatArray, n_cols: int, name: str, n_stages: int | Non
     return array
 
 
+def _stage_arrays(
+    states: FloatArray, inputs: FloatArray, parameters: FloatArray, n_x: int, n_u: int, n_p: int
+) -> tuple[int, FloatArray, FloatArray, FloatArray]:
+    """Validate per-stage ``X``, ``U``, ``P`` against one horizon; return ``(N, X, U, P)``."""
+    states = _check_stages(states, n_x, "X", None)
+    n_stages = states.shape[0]
+    inputs = _check_stages(inputs, n_u, "U", n_stages)
+    parameters = _check_stages(parameters, n_p, "P", n_stages)
+    return n_stages, states, inputs, parameters
+
+
 @dataclass(frozen=True, eq=False)
 class _MappedCache:
     """Mapped CasADi Functions per horizon length (filled lazily)."""
@@ -205,11 +216,7 @@ class DiscreteModel:
     def _inputs(
         self, states: FloatArray, inputs: FloatArray, parameters: FloatArray
     ) -> tuple[int, FloatArray, FloatArray, FloatArray]:
-        states = _check_stages(states, self.n_x, "X", None)
-        n_stages = states.shape[0]
-        inputs = _check_stages(inputs, self.n_u, "U", n_stages)
-        parameters = _check_stages(parameters, self.n_p, "P", n_stages)
-        return n_stages, states, inputs, parameters
+        return _stage_arrays(states, inputs, parameters, self.n_x, self.n_u, self.n_p)
 
     def step(self, states: FloatArray, inputs: FloatArray, parameters: FloatArray) -> FloatArray:
         """Next states ``F(x_k, u_k, p_k)``, shape ``(N, n_x)``.
@@ -578,11 +585,7 @@ class ConstraintModel:
     def _inputs(
         self, states: FloatArray, inputs: FloatArray, parameters: FloatArray
     ) -> tuple[int, FloatArray, FloatArray, FloatArray]:
-        states = _check_stages(states, self.n_x, "X", None)
-        n_stages = states.shape[0]
-        inputs = _check_stages(inputs, self.n_u, "U", n_stages)
-        parameters = _check_stages(parameters, self.n_p, "P", n_stages)
-        return n_stages, states, inputs, parameters
+        return _stage_arrays(states, inputs, parameters, self.n_x, self.n_u, self.n_p)
 
     def values(self, states: FloatArray, inputs: FloatArray, parameters: FloatArray) -> FloatArray:
         """Constraint values, shape ``(N, n_c)`` (``>= 0`` feasible)."""
