@@ -82,7 +82,7 @@ def test_missing_mission_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]
         ({"extra": "[planner]\nedge_model = 'quick'\n"}, "planner.edge_model"),
         ({"blue_start": "{ north = 280.0, east = 20.0 }"}, "blue"),  # on land
         ({"blue_start": "{ north = -50.0, east = 20.0 }"}, "blue"),  # outside the map
-        ({"green_start": "{ north = 12.0, east = 203.0 }"}, "closer than"),
+        ({"green_start": "{ north = 12.0, east = 203.0 }"}, "within 2 r_c"),
         (
             {"extra": "[[obstacle]]\ncenter = { north = 250.0, east = 220.0 }\nradius_m = 30.0\n"},
             "blue",

@@ -60,13 +60,12 @@ def run_plan(args: argparse.Namespace) -> int:
 
 def run_demo(args: argparse.Namespace) -> int:
     """Run the packaged demo mission."""
-    import tomllib
     from importlib import resources
 
-    from auvplan.mission.config import parse_mission
+    from auvplan.mission.config import load_mission
 
-    text = resources.files("auvplan").joinpath("data/missions/demo.toml").read_text("utf-8")
-    return _run(parse_mission(tomllib.loads(text)), args)
+    with resources.as_file(resources.files("auvplan") / "data/missions/demo.toml") as path:
+        return _run(load_mission(path), args)
 
 
 def _run(config: Any, args: argparse.Namespace) -> int:

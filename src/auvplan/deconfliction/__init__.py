@@ -6,7 +6,11 @@ two vehicles come closer than ``2 r_c``, certified in continuous time.
 
 from __future__ import annotations
 
-from auvplan.deconfliction.conflicts import ConflictTable, build_conflict_table
+from auvplan.deconfliction.conflicts import (
+    ConflictTable,
+    build_conflict_table,
+    check_endpoint_clearance,
+)
 from auvplan.deconfliction.coordination import deconflict
 from auvplan.deconfliction.problem import CoordinationProblem, headings_along, positions_along
 from auvplan.deconfliction.result import (
@@ -31,6 +35,7 @@ __all__ = [
     "arrival_times_of",
     "build_conflict_table",
     "certify_separation",
+    "check_endpoint_clearance",
     "deconflict",
     "headings_along",
     "positions_along",

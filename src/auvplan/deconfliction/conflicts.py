@@ -148,18 +148,35 @@ def check_endpoints(problem: CoordinationProblem) -> None:
     InfeasibleError
         Naming the pair and the places.
     """
-    n = problem.n_vehicles
-    starts = np.array([path[0] for path in problem.paths])
-    goals = np.array([path[-1] for path in problem.paths])
+    check_endpoint_clearance(
+        tuple(problem.label(i) for i in range(problem.n_vehicles)),
+        np.array([path[0] for path in problem.paths]),
+        np.array([path[-1] for path in problem.paths]),
+        problem.separation,
+    )
+
+
+def check_endpoint_clearance(
+    names: tuple[str, ...], starts: FloatArray, goals: FloatArray, separation: float
+) -> None:
+    """Raise if two starts (or two goals) are closer than ``separation`` [m].
+
+    ``starts`` and ``goals`` have shape ``(n, 2)``: north/east [m].
+
+    Raises
+    ------
+    InfeasibleError
+        Naming the pair and the places.
+    """
     for label, points in (("start", starts), ("goal", goals)):
-        for i in range(n):
-            for j in range(i + 1, n):
+        for i in range(len(names)):
+            for j in range(i + 1, len(names)):
                 distance = float(np.hypot(*(points[i] - points[j])))
-                if distance < problem.separation:
+                if distance < separation:
                     raise InfeasibleError(
-                        f"vehicles {problem.label(i)} and {problem.label(j)} both "
+                        f"vehicles {names[i]} and {names[j]} both "
                         f"{'begin' if label == 'start' else 'end'} "
-                        f"within 2 r_c = {problem.separation:g} m of each other: "
+                        f"within 2 r_c = {separation:g} m of each other: "
                         f"{label}s at (north, east) = ({points[i][0]:.1f}, {points[i][1]:.1f}) "
                         f"and ({points[j][0]:.1f}, {points[j][1]:.1f}) m, {distance:.2f} m apart"
                     )

@@ -1,8 +1,12 @@
-r"""The fleet optimal-control problem of stage 3 (SPEC §5), as CasADi functions.
+r"""The fleet: stacked states of several vehicles, and the stage-3 problem as CasADi functions.
 
-All vehicles are stacked into one system, ``x = (x_1, …, x_N)`` with 8 states each and
-``c = (c_1, …, c_N)`` with 2 inputs each; the dynamics are block-diagonal. The per-stage
-parameter vector ``p`` holds every vehicle's desired state (8 per vehicle), so the running cost
+:class:`FleetLayout` is the one owner of how vehicles are stacked: vehicle ``i`` occupies
+``state_slice(i)`` of the stacked state ``x = (x_1, …, x_N)`` and ``input_slice(i)`` of
+``c = (c_1, …, c_N)``, each of the size its own model declares (vehicle types may differ).
+Named states come from the vehicle models (:meth:`auvplan.vehicle.VehicleModel.index`).
+
+The dynamics are block-diagonal. The per-stage parameter ``p`` holds every vehicle's desired
+state (stacked like ``x``), so the running cost
 
 .. math::
 
@@ -12,13 +16,14 @@ parameter vector ``p`` holds every vehicle's desired state (8 per vehicle), so t
 is a rate in watts (energy weight ``w_E``, terrain weight ``w_T``), and the terminal cost
 ``m(x) = ½ Σ_i (k_p ‖pos_i − goal_i‖² + k_ψ (ψ_i − ψ_goal,i)²)`` is in joules. Constraints
 follow SPEC §5 (feasible when ``c >= 0``): inter-vehicle collision
-``‖p_i − p_j‖²/(2 r_c)² − 1`` and circular obstacles ``‖p_i − o‖²/(r_c + r_o)² − 1`` with the
-hockey stick; communication range ``1 − ‖p_i − p_j‖²/d_max²`` and propeller-speed limits
-``1 − (n/n_max)²`` plain (both define convex sets).
+``‖p_i − p_j‖²/(2 r_c + margin)² − 1`` and circular obstacles
+``‖p_i − o‖²/(r_c + r_o + margin)² − 1`` with the hockey stick; communication range
+``1 − ‖p_i − p_j‖²/d_max²`` and state limits ``1 − (x/x_max)²`` plain (convex sets).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Final, Literal
 
@@ -26,14 +31,19 @@ import casadi as ca
 import numpy as np
 
 from auvplan._typing import FloatArray
+from auvplan.vehicle import VehicleModel
 
-N_STATES: Final = 8
-N_INPUTS: Final = 2
-
-#: Desired-state weights Q (diagonal) of the tracking term, per unit of ``terrain`` weight:
-#: position [W/m²], heading [W/rad²], surge/sway [W/(m/s)²], yaw rate [W/(rad/s)²],
-#: propeller speeds [W/(rev/s)²].
-TRACKING_WEIGHTS: Final = (1.0, 1.0, 20.0, 20.0, 0.0, 0.0, 1e-3, 1e-3)
+#: Desired-state weights Q of the tracking term per unit of ``terrain`` weight, by state name:
+#: position [W/m²], heading [W/rad²], surge [W/(m/s)²], propeller speeds [W/(rev/s)²];
+#: states not named here get 0.
+TRACKING_WEIGHTS: Final = {
+    "north": 1.0, "east": 1.0, "psi": 20.0, "u": 20.0, "n_ps": 1e-3, "n_sb": 1e-3,
+}  # fmt: skip
+#: Weights of the projection regulator (PRONTO's tracking LQR), by state name; others get 1.
+REGULATOR_WEIGHTS: Final = {
+    "north": 1.0, "east": 1.0, "psi": 10.0, "u": 10.0, "v": 1.0, "r": 10.0,
+    "n_ps": 1e-3, "n_sb": 1e-3,
+}  # fmt: skip
 #: Input regularisation R [W per unit c²] (keeps the LQ subproblem strongly convex in c).
 INPUT_WEIGHT: Final = 1e-2
 #: Terminal stiffness per unit of ``terminal`` weight: position [J/m²], heading [J/rad²].
@@ -41,12 +51,67 @@ TERMINAL_POSITION_WEIGHT: Final = 2e3
 TERMINAL_HEADING_WEIGHT: Final = 2e3
 
 
+@dataclass(frozen=True, eq=False)
+class FleetLayout:
+    """How the vehicles' states and inputs are stacked into one system."""
+
+    names: tuple[str, ...]
+    models: tuple[VehicleModel, ...]
+
+    @property
+    def n_vehicles(self) -> int:
+        """Number of vehicles."""
+        return len(self.models)
+
+    @property
+    def n_x(self) -> int:
+        """Stacked state dimension."""
+        return sum(model.n_x for model in self.models)
+
+    @property
+    def n_u(self) -> int:
+        """Stacked input dimension."""
+        return sum(model.n_u for model in self.models)
+
+    def state_slice(self, i: int) -> slice:
+        """Rows of vehicle ``i`` in the stacked state."""
+        start = sum(model.n_x for model in self.models[:i])
+        return slice(start, start + self.models[i].n_x)
+
+    def input_slice(self, i: int) -> slice:
+        """Rows of vehicle ``i`` in the stacked input."""
+        start = sum(model.n_u for model in self.models[:i])
+        return slice(start, start + self.models[i].n_u)
+
+    def stack(self, per_vehicle: Sequence[FloatArray]) -> FloatArray:
+        """Per-vehicle arrays ``(n_t, n_x_i)`` (or ``(n_t, n_u_i)``) side by side."""
+        return np.ascontiguousarray(np.concatenate(per_vehicle, axis=-1))
+
+    def unstack_states(self, stacked: FloatArray) -> tuple[FloatArray, ...]:
+        """Per-vehicle views ``(n_t, n_x_i)`` of stacked states ``(n_t, n_x)``."""
+        return tuple(stacked[..., self.state_slice(i)] for i in range(self.n_vehicles))
+
+    def unstack_inputs(self, stacked: FloatArray) -> tuple[FloatArray, ...]:
+        """Per-vehicle views ``(n_t, n_u_i)`` of stacked inputs ``(n_t, n_u)``."""
+        return tuple(stacked[..., self.input_slice(i)] for i in range(self.n_vehicles))
+
+    def gains_of(self, gains: FloatArray, i: int) -> FloatArray:
+        """Vehicle ``i``'s own block ``(N, n_u_i, n_x_i)`` of stacked gains ``(N, n_u, n_x)``."""
+        return gains[:, self.input_slice(i), self.state_slice(i)]
+
+    def state_weights(self, weights: dict[str, float], default: float) -> FloatArray:
+        """A stacked weight vector from per-name weights (``default`` for unnamed states)."""
+        return np.concatenate(
+            [[weights.get(name, default) for name in model.state_names] for model in self.models]
+        )
+
+
 @dataclass(frozen=True)
 class FleetConstraint:
     """One block of path constraints ``c(x, u, p) >= 0`` of the stacked fleet system.
 
     ``kind`` is ``"hockey"`` (non-convex, barrier composed with the hockey stick) or
-    ``"plain"``; ``labels`` name each row (``"blue-green"``, ``"blue-obstacle0"``, …).
+    ``"plain"``; ``labels`` name each row (``"blue-green"``, ``"blue-obstacle 0"``, …).
     """
 
     name: str
@@ -59,163 +124,158 @@ class FleetConstraint:
 class FleetProblemFunctions:
     """CasADi functions of the fleet problem; see the module docstring for the equations."""
 
-    n_vehicles: int
+    layout: FleetLayout
     dynamics: ca.Function
     running_cost: ca.Function
     power: ca.Function
     terminal_cost: ca.Function
     constraints: tuple[FleetConstraint, ...]
 
-    @property
-    def n_x(self) -> int:
-        """Stacked state dimension (8 per vehicle)."""
-        return N_STATES * self.n_vehicles
 
-    @property
-    def n_u(self) -> int:
-        """Stacked input dimension (2 per vehicle)."""
-        return N_INPUTS * self.n_vehicles
+@dataclass(frozen=True)
+class FleetWeights:
+    """Trade-off multipliers (see :class:`auvplan.mission.config.WeightsConfig`)."""
+
+    terrain: float
+    energy: float
+    terminal: float
+
+
+@dataclass(frozen=True)
+class FleetLimits:
+    """Separation and range limits of the fleet problem.
+
+    ``obstacles`` ``(n_obstacles, 3)``: circles ``north, east, radius`` [m] labelled by
+    ``obstacle_names``; ``comm_pairs``: vehicle index pairs and their range [m].
+    ``separation_margin`` [m] is added to ``2 r_c`` and ``r_c + r_o``: the constraints are imposed
+    at the grid nodes only, and it covers the largest dip of a distance between two nodes.
+    """
+
+    safety_radius: float
+    separation_margin: float
+    obstacles: FloatArray
+    obstacle_names: tuple[str, ...]
+    comm_pairs: tuple[tuple[int, int, float], ...]
 
 
 def build_fleet_functions(
-    dynamics: list[ca.Function],
-    power: list[ca.Function],
-    names: list[str],
-    goals: FloatArray,
-    *,
-    safety_radius: float,
-    separation_margin: float,
-    max_propeller_speeds: FloatArray,
-    obstacles: FloatArray,
-    comm_pairs: list[tuple[int, int, float]],
-    terrain_weight: float,
-    energy_weight: float,
-    terminal_weight: float,
+    layout: FleetLayout, goals: FloatArray, weights: FleetWeights, limits: FleetLimits
 ) -> FleetProblemFunctions:
-    """Stack per-vehicle models into the fleet problem.
+    """Stack the vehicle models into the fleet problem.
 
     Parameters
     ----------
-    dynamics, power : list of casadi.Function
-        Per vehicle ``f(x[8], c[2]) -> xdot[8]`` and ``P(x[8], c[2]) -> W``.
-    names : list of str
-        Vehicle names (for constraint labels).
+    layout : FleetLayout
+        The vehicles and their models.
     goals : ndarray of shape (n_vehicles, 3)
-        Goal ``north, east`` [m] and heading [rad] (already unwrapped next to the arrival heading).
-    safety_radius : float
-        ``r_c`` [m]; pairs keep ``>= 2 r_c``.
-    separation_margin : float
-        Added to ``2 r_c`` and to ``r_c + r_o`` [m] in the constraints, which are imposed at
-        the grid nodes only: it covers the largest dip of a distance between two nodes.
-    max_propeller_speeds : ndarray of shape (n_vehicles,)
-        ``n_max`` [rev/s] per vehicle.
-    obstacles : ndarray of shape (n_obstacles, 3)
-        Circular obstacles ``north, east, radius`` [m].
-    comm_pairs : list of (int, int, float)
-        Vehicle index pairs that must stay within the given range [m].
-    terrain_weight, energy_weight, terminal_weight : float
-        Trade-off multipliers (see :class:`auvplan.mission.config.WeightsConfig`).
+        Goal ``north, east`` [m] and heading [rad] (unwrapped next to the arrival heading).
+    weights : FleetWeights
+        Cost multipliers.
+    limits : FleetLimits
+        Safety radius, obstacles, communication pairs.
     """
-    n_vehicles = len(dynamics)
-    x = ca.SX.sym("x", N_STATES * n_vehicles)
-    c = ca.SX.sym("c", N_INPUTS * n_vehicles)
-    p = ca.SX.sym("p", N_STATES * n_vehicles)
-    xs = [x[N_STATES * i : N_STATES * (i + 1)] for i in range(n_vehicles)]
-    cs = [c[N_INPUTS * i : N_INPUTS * (i + 1)] for i in range(n_vehicles)]
-    ps = [p[N_STATES * i : N_STATES * (i + 1)] for i in range(n_vehicles)]
+    x = ca.SX.sym("x", layout.n_x)
+    c = ca.SX.sym("c", layout.n_u)
+    p = ca.SX.sym("p", layout.n_x)
+    xs = [x[layout.state_slice(i)] for i in range(layout.n_vehicles)]
+    cs = [c[layout.input_slice(i)] for i in range(layout.n_vehicles)]
+    models = layout.models
 
-    xdot = ca.vertcat(*[dynamics[i](xs[i], cs[i]) for i in range(n_vehicles)])
-    powers = ca.vertcat(*[power[i](xs[i], cs[i]) for i in range(n_vehicles)])
-    q = ca.DM(TRACKING_WEIGHTS)
-    rate = energy_weight * ca.sum1(powers)
-    for i in range(n_vehicles):
-        error = xs[i] - ps[i]
-        rate += 0.5 * terrain_weight * ca.dot(q * error, error)
-        rate += 0.5 * INPUT_WEIGHT * ca.dot(cs[i], cs[i])
+    xdot = ca.vertcat(*[model.dynamics(xs[i], cs[i]) for i, model in enumerate(models)])
+    powers = ca.vertcat(*[model.power(xs[i], cs[i]) for i, model in enumerate(models)])
+    q = ca.DM(layout.state_weights(TRACKING_WEIGHTS, 0.0))
+    error = x - p
+    rate = weights.energy * ca.sum1(powers)
+    rate += 0.5 * weights.terrain * ca.dot(q * error, error)
+    rate += 0.5 * INPUT_WEIGHT * ca.dot(c, c)
 
     terminal = 0.0
-    for i in range(n_vehicles):
-        d_north = xs[i][0] - goals[i, 0]
-        d_east = xs[i][1] - goals[i, 1]
-        d_psi = xs[i][2] - goals[i, 2]
+    for i, model in enumerate(models):
+        pose = [xs[i][model.index(name)] for name in ("north", "east", "psi")]
         terminal += (
             0.5
-            * terminal_weight
+            * weights.terminal
             * (
-                TERMINAL_POSITION_WEIGHT * (d_north**2 + d_east**2)
-                + TERMINAL_HEADING_WEIGHT * d_psi**2
+                TERMINAL_POSITION_WEIGHT
+                * ((pose[0] - goals[i, 0]) ** 2 + (pose[1] - goals[i, 1]) ** 2)
+                + TERMINAL_HEADING_WEIGHT * (pose[2] - goals[i, 2]) ** 2
             )
         )
-
-    constraints = _constraints(
-        x, c, p, xs, names, safety_radius, separation_margin, max_propeller_speeds, obstacles,
-        comm_pairs,
-    )  # fmt: skip
     return FleetProblemFunctions(
-        n_vehicles=n_vehicles,
+        layout=layout,
         dynamics=ca.Function("fleet_f", [x, c, p], [xdot]),
         running_cost=ca.Function("fleet_l", [x, c, p], [rate]),
         power=ca.Function("fleet_power", [x, c], [powers]),
         terminal_cost=ca.Function("fleet_m", [x], [terminal]),
-        constraints=constraints,
+        constraints=_constraints(layout, (x, c, p), xs, limits),
     )
 
 
 def _constraints(
-    x: ca.SX,
-    c: ca.SX,
-    p: ca.SX,
+    layout: FleetLayout,
+    arguments: tuple[ca.SX, ca.SX, ca.SX],
     xs: list[ca.SX],
-    names: list[str],
-    safety_radius: float,
-    margin: float,
-    max_propeller_speeds: FloatArray,
-    obstacles: FloatArray,
-    comm_pairs: list[tuple[int, int, float]],
+    limits: FleetLimits,
 ) -> tuple[FleetConstraint, ...]:
-    n_vehicles = len(xs)
+    names, models = layout.names, layout.models
     blocks: list[FleetConstraint] = []
 
     def add(
         name: str, rows: list[ca.SX], labels: list[str], kind: Literal["plain", "hockey"]
     ) -> None:
         if rows:
-            function = ca.Function(name, [x, c, p], [ca.vertcat(*rows)])
+            function = ca.Function(name, list(arguments), [ca.vertcat(*rows)])
             blocks.append(FleetConstraint(name, function, kind, tuple(labels)))
 
-    def squared_distance(i: int, north: ca.SX, east: ca.SX) -> ca.SX:
-        return (xs[i][0] - north) ** 2 + (xs[i][1] - east) ** 2
+    def position(i: int) -> tuple[ca.SX, ca.SX]:
+        return xs[i][models[i].index("north")], xs[i][models[i].index("east")]
 
-    pairs = [(i, j) for i in range(n_vehicles) for j in range(i + 1, n_vehicles)]
+    def squared_distance(i: int, north: ca.SX, east: ca.SX) -> ca.SX:
+        own_north, own_east = position(i)
+        return (own_north - north) ** 2 + (own_east - east) ** 2
+
+    pairs = [(i, j) for i in range(layout.n_vehicles) for j in range(i + 1, layout.n_vehicles)]
+    separation = 2 * limits.safety_radius + limits.separation_margin
     add(
         "collision",
-        [
-            squared_distance(i, xs[j][0], xs[j][1]) / (2 * safety_radius + margin) ** 2 - 1
-            for i, j in pairs
-        ],
+        [squared_distance(i, *position(j)) / separation**2 - 1 for i, j in pairs],
         [f"{names[i]}-{names[j]}" for i, j in pairs],
         "hockey",
     )
+    circles = np.asarray(limits.obstacles).reshape(-1, 3)
+    reach = limits.safety_radius + limits.separation_margin
     add(
         "obstacle",
         [
-            squared_distance(i, north, east) / (safety_radius + radius + margin) ** 2 - 1
-            for i in range(n_vehicles)
-            for north, east, radius in np.asarray(obstacles).reshape(-1, 3)
+            squared_distance(i, north, east) / (reach + radius) ** 2 - 1
+            for i in range(layout.n_vehicles)
+            for north, east, radius in circles
         ],
-        [f"{names[i]}-obstacle{k}" for i in range(n_vehicles) for k in range(len(obstacles))],
+        [
+            f"{names[i]}-{label}"
+            for i in range(layout.n_vehicles)
+            for label in limits.obstacle_names
+        ],
         "hockey",
     )
     add(
         "communication",
-        [1 - squared_distance(i, xs[j][0], xs[j][1]) / d_max**2 for i, j, d_max in comm_pairs],
-        [f"{names[i]}-{names[j]}" for i, j, _ in comm_pairs],
+        [1 - squared_distance(i, *position(j)) / d_max**2 for i, j, d_max in limits.comm_pairs],
+        [f"{names[i]}-{names[j]}" for i, j, _ in limits.comm_pairs],
         "plain",
     )
     add(
-        "propeller",
-        [1 - (xs[i][k] / max_propeller_speeds[i]) ** 2 for i in range(n_vehicles) for k in (6, 7)],
-        [f"{names[i]}-{side}" for i in range(n_vehicles) for side in ("n_ps", "n_sb")],
+        "state_limits",
+        [
+            1 - (xs[i][model.index(state)] / limit) ** 2
+            for i, model in enumerate(models)
+            for state, limit in model.state_limits
+        ],
+        [
+            f"{names[i]}-{state}"
+            for i, model in enumerate(models)
+            for state, _ in model.state_limits
+        ],
         "plain",
     )
     return tuple(blocks)

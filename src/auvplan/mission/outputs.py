@@ -15,6 +15,7 @@ from auvplan.io.results import (
 )
 from auvplan.mission.pipeline import MissionResult
 from auvplan.mission.summary import mission_summary
+from auvplan.vehicle import headings, positions
 
 
 def write_mission_files(result: MissionResult, directory: Path) -> list[Path]:
@@ -39,7 +40,11 @@ def write_mission_files(result: MissionResult, directory: Path) -> list[Path]:
     stage2 = result.deconfliction
     if stage2 is not None:
         path = directory / "desired.csv"
-        write_desired_csv(path, names, stage2.time, stage2.desired_states[:, :, :3])
+        poses = [
+            np.column_stack([positions(model, desired), headings(model, desired)])
+            for model, desired in zip(stage2.layout.models, stage2.desired_states, strict=True)
+        ]
+        write_desired_csv(path, names, stage2.time, np.stack(poses))
         written.append(path)
     for plan, file_name in (
         (result.plan, "trajectories.csv"),

@@ -9,7 +9,8 @@ from typing import Any
 import numpy as np
 
 from auvplan import __version__
-from auvplan.mission.pipeline import MissionResult, OptimizedPlan
+from auvplan.mission.evaluation import OptimizedPlan
+from auvplan.mission.pipeline import MissionResult
 from auvplan.planning import path_length
 
 
@@ -73,10 +74,9 @@ def mission_summary(result: MissionResult) -> dict[str, Any]:
         },
         "fleet": {
             "safety_radius_m": config.fleet.safety_radius,
-            "edge_model": config.edge_model,
-            "deconfliction_method": config.deconfliction.method_for(len(config.vehicles)),
+            "edge_model": config.planner.edge_model,
         },
-        "solver": dataclasses.asdict(config.solver),
+        "solver": config.solver.model_dump(by_alias=True),
         "vehicles": [],
         "wall_time_s": dict(result.timings),
     }
@@ -105,6 +105,7 @@ def mission_summary(result: MissionResult) -> dict[str, Any]:
             "message": coordination.message,
             "objective": coordination.objective,
             "n_expanded": coordination.n_expanded,
+            "method": coordination.method,
             "certified_min_separation_m": coordination.certificate.min_separation,
             "certificate": dataclasses.asdict(coordination.certificate),
         }

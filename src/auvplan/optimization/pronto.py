@@ -140,7 +140,7 @@ class ProntoOptions:
     delta_feasible_factor: float = 0.1
     delta_feasible_max: float = 1e-3
     max_infeasible_restarts: int = 10
-    eigenvalue_floor: float = 1e-8
+    eigenvalue_floor: float = 1e-2
     terminal_regulator: Literal["dare", "weight"] = "dare"
     n_threads: int = 1
     compile_c: bool = False

@@ -37,6 +37,12 @@ from auvplan.vehicle.propulsion import (
     thrust_coefficient,
     torque_coefficient,
 )
+from auvplan.vehicle.reference import (
+    headings,
+    positions,
+    reference_states,
+    surge_trim_table,
+)
 from auvplan.vehicle.simulate import (
     AdaptiveSimulation,
     SimulationStatus,
@@ -89,14 +95,18 @@ __all__ = [
     "electrical_power",
     "energy",
     "energy_per_metre",
+    "headings",
     "max_yaw_rate",
     "open_water_thrust_torque",
     "optimal_cruise_speed",
+    "positions",
+    "reference_states",
     "rk4_simulate",
     "rk4_step_function",
     "simulate_adaptive",
     "smoothing_effect",
     "steady_motion",
+    "surge_trim_table",
     "thrust_coefficient",
     "top_speed",
     "torque_coefficient",

@@ -72,10 +72,36 @@ class VehicleModel:
     """``(x[8]) -> (T_ps, T_sb, Q_ps, Q_sb)`` [N, N, N m, N m]."""
     current: ca.Function
     """``(x[8]) -> (I_ps, I_sb)`` motor currents [A]."""
-    n_x: int = N_STATES
-    """Number of states [-]."""
-    n_u: int = N_INPUTS
-    """Number of inputs [-]."""
+    state_names: tuple[str, ...] = STATE_NAMES
+    """Names of the states, in order (the first three are the pose ``north, east, psi``)."""
+    input_names: tuple[str, ...] = INPUT_NAMES
+    """Names of the inputs, in order."""
+
+    @property
+    def n_x(self) -> int:
+        """Number of states [-]."""
+        return len(self.state_names)
+
+    @property
+    def n_u(self) -> int:
+        """Number of inputs [-]."""
+        return len(self.input_names)
+
+    def index(self, name: str) -> int:
+        """Position of the state called ``name`` in the state vector.
+
+        Examples
+        --------
+        >>> from auvplan.io.vehicles import load_vehicle
+        >>> build_vehicle_model(load_vehicle("medusa")).index("u")
+        3
+        """
+        return self.state_names.index(name)
+
+    @property
+    def state_limits(self) -> tuple[tuple[str, float], ...]:
+        """States with a symmetric bound ``|x| <= limit``: the propeller speeds [rev/s]."""
+        return (("n_ps", self.params.n_max), ("n_sb", self.params.n_max))
 
 
 def _smooth_abs(value: ca.SX, eps: float) -> ca.SX:

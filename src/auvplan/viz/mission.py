@@ -15,6 +15,7 @@ from matplotlib.patches import Circle, Polygon
 
 from auvplan._typing import FloatArray
 from auvplan.terrain.grid import BathymetryGrid
+from auvplan.vehicle import STATE_NAMES
 
 VEHICLE_COLORS = ("tab:blue", "tab:green", "tab:orange", "tab:purple", "tab:red", "tab:brown")
 
@@ -107,11 +108,21 @@ def plot_time_series(
     axes = figure.subplots(4, 1, sharex=True)
     for k, name in enumerate(names):
         color = _color(k)
-        axes[0].plot(time, states[k, :, 3], color=color, label=f"{name} u")
-        axes[0].plot(time, states[k, :, 4], ":", color=color, label=f"{name} v")
-        axes[1].plot(time, states[k, :, 5], color=color, label=name)
-        axes[2].plot(time, states[k, :, 6], color=color, label=f"{name} port")
-        axes[2].plot(time, states[k, :, 7], "--", color=color, label=f"{name} starboard")
+        axes[0].plot(time, states[k, :, STATE_NAMES.index("u")], color=color, label=f"{name} u")
+        axes[0].plot(
+            time, states[k, :, STATE_NAMES.index("v")], ":", color=color, label=f"{name} v"
+        )
+        axes[1].plot(time, states[k, :, STATE_NAMES.index("r")], color=color, label=name)
+        axes[2].plot(
+            time, states[k, :, STATE_NAMES.index("n_ps")], color=color, label=f"{name} port"
+        )
+        axes[2].plot(
+            time,
+            states[k, :, STATE_NAMES.index("n_sb")],
+            "--",
+            color=color,
+            label=f"{name} starboard",
+        )
         axes[3].plot(time, power[k], color=color, label=name)
     labels = ("speed [m/s]", "yaw rate [rad/s]", "propeller [rev/s]", "electrical power [W]")
     for ax, label in zip(axes, labels, strict=True):

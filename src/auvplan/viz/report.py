@@ -9,6 +9,7 @@ from matplotlib.figure import Figure
 
 from auvplan.mission.pipeline import MissionResult
 from auvplan.planning import CircleObstacle, PolygonObstacle
+from auvplan.vehicle import positions
 from auvplan.viz.coordination import plot_coordination_space
 from auvplan.viz.maps import plot_terrain_maps
 from auvplan.viz.mission import plot_mission_paths, plot_separation, plot_time_series
@@ -28,7 +29,8 @@ def mission_figures(result: MissionResult) -> dict[str, Figure]:
     ).reshape(-1, 3)
     polygons = [o.vertices for o in preplan.obstacles if isinstance(o, PolygonObstacle)]
     planned = [route.points for route in preplan.routes]
-    optimized = None if result.plan is None else [track[:, :2] for track in result.plan.states]
+    stage2 = result.deconfliction
+    optimized = None if result.plan is None else _tracks(result, result.plan.states)
     radius = config.fleet.safety_radius
     figures: dict[str, Figure] = {"maps": plot_terrain_maps(preplan.maps)}
     figures["paths"] = plot_mission_paths(
@@ -45,11 +47,10 @@ def mission_figures(result: MissionResult) -> dict[str, Figure]:
     if result.energy_only is not None:
         figures["paths_energy_only"] = plot_mission_paths(
             preplan.bathymetry, preplan.names, planned,
-            [track[:, :2] for track in result.energy_only.states], safety_radius=radius,
+            _tracks(result, result.energy_only.states), safety_radius=radius,
             circles=circles, polygons=polygons,
             title="Energy-only optimum (terrain weight 0) against the pre-planned paths",
         )  # fmt: skip
-    stage2 = result.deconfliction
     if stage2 is not None and len(preplan.names) >= 2:
         figures["coordination"] = plot_coordination_space(
             stage2.problem, stage2.coordination, pair=(0, 1)
@@ -63,6 +64,13 @@ def mission_figures(result: MissionResult) -> dict[str, Figure]:
                 result.plan.fine_time, result.plan.fine_distances, 2 * radius
             )
     return figures
+
+
+def _tracks(result: MissionResult, states: np.ndarray) -> list[np.ndarray]:
+    """North/east ``(n_t, 2)`` of each vehicle's states."""
+    assert result.deconfliction is not None  # a plan exists only after stage 2
+    models = result.deconfliction.layout.models
+    return [positions(model, track) for model, track in zip(models, states, strict=True)]
 
 
 def _cost_on_bathymetry_grid(result: MissionResult) -> np.ndarray:

@@ -1,0 +1,142 @@
+"""Evaluation of an optimised plan: energy, information, arrival, replay, separation.
+
+Separation is measured on the plan flown with its tracking regulator on a grid
+``CHECK_REFINEMENT`` times finer than the solver's (:func:`auvplan.mission.verify.
+replay_closed_loop`), so that it holds between the solver's samples as well.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Final
+
+import numpy as np
+from scipy.interpolate import RegularGridInterpolator
+
+from auvplan._typing import FloatArray
+from auvplan.mission.fleet import FleetProblemFunctions
+from auvplan.mission.preplan import PreplanStage
+from auvplan.mission.verify import replay_closed_loop
+from auvplan.optimization import ProntoResult
+from auvplan.planning import distance_to_obstacle
+from auvplan.terrain import TerrainMaps
+from auvplan.vehicle import positions
+
+#: Refinement of the solver grid for the certified-separation resimulation.
+CHECK_REFINEMENT: Final = 10
+
+
+@dataclass(frozen=True)
+class OptimizedPlan:
+    """Stage 3 for one weighting: the PRONTO result and the fleet's trajectories.
+
+    ``states`` ``(n_vehicles, n_t, n_x)``, ``inputs`` ``(n_vehicles, n_t - 1, n_u)``, ``power``
+    ``(n_vehicles, n_t)`` [W], ``energy`` ``(n_vehicles,)`` [J] = trapezoidal ∫ power dt,
+    ``arrival_error`` ``(n_vehicles,)`` [m], ``terrain_information`` ``(n_vehicles,)`` mean
+    information-map value along the trajectory; ``separations[name][other]`` the minimum
+    distance [m] to each other vehicle (centre to centre) and obstacle (to its edge; polygons
+    are enforced by the pre-planner and only checked here) when the plan is flown with its
+    tracking regulator on a grid ``CHECK_REFINEMENT`` times finer than the solver's, whose
+    time series are ``fine_distances`` (labels ``"a / b"``) on ``fine_time``;
+    ``tracking_error`` ``(n_vehicles,)`` is that replay's largest distance [m] from the plan at
+    the solver nodes.
+    """
+
+    result: ProntoResult
+    terrain_weight: float
+    states: FloatArray
+    inputs: FloatArray
+    power: FloatArray
+    energy: FloatArray
+    arrival_error: FloatArray
+    terrain_information: FloatArray
+    separations: dict[str, dict[str, float]]
+    fine_time: FloatArray
+    fine_distances: dict[str, FloatArray]
+    tracking_error: FloatArray
+
+
+def evaluate_plan(
+    preplan: PreplanStage,
+    time: FloatArray,
+    functions: FleetProblemFunctions,
+    result: ProntoResult,
+    terrain_weight: float,
+) -> OptimizedPlan:
+    """Energy, information, arrival error and sampled-and-between separations of a result."""
+    layout = functions.layout
+    models = layout.models
+    flat_states, flat_inputs = result.trajectory.states, result.trajectory.inputs
+    states = np.stack(layout.unstack_states(flat_states))
+    inputs = np.stack(layout.unstack_inputs(flat_inputs))
+    held = np.vstack([flat_inputs, flat_inputs[-1:]])
+    power_map = functions.power.map(time.size)
+    power = np.asarray(power_map(flat_states.T, held.T)).reshape(layout.n_vehicles, time.size)
+    energy = np.asarray(np.trapezoid(power, time, axis=1), dtype=np.float64)
+    planned = np.stack([positions(model, states[i]) for i, model in enumerate(models)])
+    arrival = np.hypot(*(planned[:, -1] - preplan.goals[:, :2]).T)
+    information = information_along(preplan.maps, planned)
+
+    dt = float(time[1] - time[0])
+    flown = [
+        replay_closed_loop(
+            model,
+            states[i],
+            inputs[i],
+            layout.gains_of(result.regulator_gains, i),
+            dt,
+            refinement=CHECK_REFINEMENT,
+        )
+        for i, model in enumerate(models)
+    ]
+    fine = np.stack([positions(model, flown[i]) for i, model in enumerate(models)])
+    fine_time = dt / CHECK_REFINEMENT * np.arange(fine.shape[1], dtype=np.float64)
+    tracking_error = np.max(np.linalg.norm(fine[:, ::CHECK_REFINEMENT] - planned, axis=-1), axis=1)
+    fine_distances, separations = pairwise_distances(preplan, fine)
+    return OptimizedPlan(
+        result=result,
+        terrain_weight=terrain_weight,
+        states=states,
+        inputs=inputs,
+        power=power,
+        energy=energy,
+        arrival_error=arrival,
+        terrain_information=information,
+        separations=separations,
+        fine_time=fine_time,
+        fine_distances=fine_distances,
+        tracking_error=tracking_error,
+    )
+
+
+def pairwise_distances(
+    preplan: PreplanStage, tracks: FloatArray
+) -> tuple[dict[str, FloatArray], dict[str, dict[str, float]]]:
+    """Distance series between every pair and to every obstacle, and their minima.
+
+    ``tracks`` ``(n_vehicles, n_t, 2)`` north/east [m]. Returns the series labelled
+    ``"a / b"`` and ``minima[a][b]`` (symmetric between vehicles) [m].
+    """
+    names = preplan.names
+    series: dict[str, FloatArray] = {}
+    minima: dict[str, dict[str, float]] = {name: {} for name in names}
+    for i, name in enumerate(names):
+        for j in range(i + 1, len(names)):
+            distance = np.hypot(*(tracks[i] - tracks[j]).T)
+            series[f"{name} / {names[j]}"] = distance
+            minima[name][names[j]] = minima[names[j]][name] = float(np.min(distance))
+        for obstacle, label in zip(preplan.obstacles, preplan.obstacle_names, strict=True):
+            distance = distance_to_obstacle(obstacle, *tracks[i].T)
+            series[f"{name} / {label}"] = distance
+            minima[name][label] = float(np.min(distance))
+    return series, minima
+
+
+def information_along(maps: TerrainMaps, tracks: FloatArray) -> FloatArray:
+    """Mean information-map value (eq. 13, fine grid) along each track ``(n_t, 2)``."""
+    geometry = maps.bathymetry.geometry
+    field = np.nan_to_num(maps.information, nan=0.0)
+    interpolator = RegularGridInterpolator(
+        (geometry.north, geometry.east), field, bounds_error=False, fill_value=0.0
+    )
+    return np.array([float(np.mean(interpolator(track))) for track in tracks])

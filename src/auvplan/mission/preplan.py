@@ -1,0 +1,207 @@
+"""Stage 1 (SPEC §1): terrain, maps (eq. 13-15), resolved poses, one smoothed A* route each."""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from auvplan._typing import FloatArray
+from auvplan.deconfliction import check_endpoint_clearance
+from auvplan.errors import InfeasibleError, InputError
+from auvplan.io.bathymetry import read_bathymetry
+from auvplan.mission.config import (
+    CommConfig,
+    MapsConfig,
+    MissionConfig,
+    PlannerConfig,
+    Position,
+    TerrainConfig,
+)
+from auvplan.planning import (
+    CircleObstacle,
+    EdgeModel,
+    PolygonObstacle,
+    Route,
+    blocked_cells,
+    blocked_lookup,
+    plan_route,
+    smooth_path,
+)
+from auvplan.terrain import BathymetryGrid, MapParameters, TerrainMaps, compute_terrain_maps
+from auvplan.terrain.synthetic import synthetic_bank
+
+logger = logging.getLogger(__name__)
+
+Obstacle = CircleObstacle | PolygonObstacle
+
+
+@dataclass(frozen=True)
+class PreplanStage:
+    """Stage 1: terrain, maps, resolved poses and one A* route per vehicle.
+
+    ``starts`` and ``goals`` have shape ``(n_vehicles, 3)``: north, east [m], psi [rad];
+    ``start_speeds`` [m/s]. ``paths`` are the smoothed routes (``(n_i, 2)`` north/east [m]);
+    ``obstacle_names`` label ``obstacles``.
+    """
+
+    bathymetry: BathymetryGrid
+    maps: TerrainMaps
+    names: tuple[str, ...]
+    starts: FloatArray
+    start_speeds: FloatArray
+    goals: FloatArray
+    obstacles: tuple[Obstacle, ...]
+    obstacle_names: tuple[str, ...]
+    routes: tuple[Route, ...]
+    paths: tuple[FloatArray, ...]
+
+
+def load_terrain(terrain: TerrainConfig) -> BathymetryGrid:
+    """The mission's bathymetry: a file (any supported format) or the synthetic bank."""
+    window = terrain.window
+    if terrain.synthetic:
+        if window.is_geographic:
+            raise InputError("terrain.window: the synthetic bank has no lat/lon; use north/east")
+        grid = synthetic_bank(seed=terrain.seed)
+        return grid.window(window.north, window.east) if window.north or window.east else grid
+    assert terrain.file is not None  # guaranteed by TerrainConfig
+    return read_bathymetry(
+        terrain.file,
+        window_north=window.north,
+        window_east=window.east,
+        window_lat=window.lat,
+        window_lon=window.lon,
+    )
+
+
+def compute_maps(bathymetry: BathymetryGrid, maps: MapsConfig) -> TerrainMaps:
+    """The information, excitation and cost maps of eq. 13-15."""
+    parameters = MapParameters(
+        exponent=maps.exponent, block=maps.block, omega=maps.omega, weight=maps.weight
+    )
+    return compute_terrain_maps(bathymetry, parameters)
+
+
+def resolve_position(position: Position, grid: BathymetryGrid, what: str) -> tuple[float, float]:
+    """``north, east`` [m] of a local or geographic position on ``grid``."""
+    first, second = position.coordinates
+    if not position.is_geographic:
+        return first, second
+    if grid.projection is None:
+        raise InputError(f"{what} is given in lat/lon but the terrain has no geographic reference")
+    north, east = grid.projection.to_local(np.array([first]), np.array([second]))
+    return float(north[0]), float(east[0])
+
+
+def resolve_obstacles(
+    config: MissionConfig, grid: BathymetryGrid
+) -> tuple[tuple[Obstacle, ...], tuple[str, ...]]:
+    """The mission's obstacles in the map frame, and their labels."""
+    obstacles: list[Obstacle] = []
+    for obstacle, name in zip(config.obstacles, config.obstacle_names, strict=True):
+        if obstacle.polygon is not None:
+            obstacles.append(PolygonObstacle(np.array(obstacle.polygon, dtype=np.float64)))
+        else:
+            north, east = resolve_position(obstacle.circle[0], grid, f"{name} center")
+            obstacles.append(CircleObstacle(north, east, obstacle.circle[1]))
+    return tuple(obstacles), config.obstacle_names
+
+
+def check_communication_ranges(
+    comms: tuple[CommConfig, ...], names: tuple[str, ...], starts: FloatArray, goals: FloatArray
+) -> None:
+    """A pair that starts or ends out of its communication range can never satisfy it."""
+    for comm in comms:
+        i, j = names.index(comm.pair[0]), names.index(comm.pair[1])
+        for what, points in (("start", starts), ("goal", goals)):
+            distance = float(np.hypot(*(points[i, :2] - points[j, :2])))
+            if distance > comm.max_range:
+                raise InfeasibleError(
+                    f"vehicles {comm.pair[0]} and {comm.pair[1]} {what} {distance:.0f} m apart, "
+                    f"beyond their communication range max_range_m = {comm.max_range:g} m"
+                )
+
+
+def plan_routes(
+    maps: TerrainMaps,
+    names: tuple[str, ...],
+    starts: FloatArray,
+    goals: FloatArray,
+    obstacles: tuple[Obstacle, ...],
+    *,
+    clearance: float,
+    planner: PlannerConfig,
+) -> tuple[tuple[Route, ...], tuple[FloatArray, ...]]:
+    """One A* route per vehicle on the shifted cost map, and its smoothed curve."""
+    geometry = maps.cost_geometry
+    cell = min(geometry.spacing_north, geometry.spacing_east)
+    blocked = blocked_cells(maps.shifted_cost, geometry, obstacles=obstacles, clearance=clearance)
+    is_blocked = blocked_lookup(geometry, blocked)
+    routes, paths = [], []
+    for index, name in enumerate(names):
+        route = plan_route(
+            maps.shifted_cost,
+            geometry,
+            (float(starts[index, 0]), float(starts[index, 1])),
+            (float(goals[index, 0]), float(goals[index, 1])),
+            obstacles=obstacles,
+            clearance=clearance,
+            edge_model=EdgeModel(planner.edge_model),
+            name=name,
+        )
+        routes.append(route)
+        # within half a cell of the route, never through a no-go cell
+        paths.append(
+            smooth_path(
+                route.points, spacing=0.25 * cell, max_deviation=0.5 * cell, is_blocked=is_blocked
+            )
+        )
+        logger.info(
+            "A* %s: %d cells, cost %.1f, %d expanded", name, len(route.cells), route.cost,
+            route.n_expanded,
+        )  # fmt: skip
+    return tuple(routes), tuple(paths)
+
+
+def run_preplan(config: MissionConfig) -> PreplanStage:
+    """Stage 1: load terrain, compute the maps, resolve poses, plan and smooth A* routes."""
+    bathymetry = load_terrain(config.terrain)
+    maps = compute_maps(bathymetry, config.maps)
+    logger.info(
+        "terrain: %s, %d x %d cells of %.1f x %.1f m; cost grid %d x %d",
+        bathymetry.name,
+        *bathymetry.geometry.shape,
+        bathymetry.geometry.spacing_north,
+        bathymetry.geometry.spacing_east,
+        *maps.cost_geometry.shape,
+    )
+    names = tuple(vehicle.name for vehicle in config.vehicles)
+    starts = np.array(
+        [(*resolve_position(v.start, bathymetry, f"vehicle {v.name} start"), v.start.psi)
+         for v in config.vehicles]
+    )  # fmt: skip
+    goals = np.array(
+        [(*resolve_position(v.goal, bathymetry, f"vehicle {v.name} goal"), v.goal.psi)
+         for v in config.vehicles]
+    )  # fmt: skip
+    check_endpoint_clearance(names, starts[:, :2], goals[:, :2], 2.0 * config.fleet.safety_radius)
+    check_communication_ranges(config.comms, names, starts, goals)
+    obstacles, obstacle_names = resolve_obstacles(config, bathymetry)
+    routes, paths = plan_routes(
+        maps, names, starts, goals, obstacles,
+        clearance=config.fleet.safety_radius, planner=config.planner,
+    )  # fmt: skip
+    return PreplanStage(
+        bathymetry=bathymetry,
+        maps=maps,
+        names=names,
+        starts=starts,
+        start_speeds=np.array([v.start.speed for v in config.vehicles]),
+        goals=goals,
+        obstacles=obstacles,
+        obstacle_names=obstacle_names,
+        routes=routes,
+        paths=paths,
+    )

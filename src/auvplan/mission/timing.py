@@ -1,0 +1,210 @@
+"""Stage 2 (SPEC §2): the common horizon, coordination-space time laws, desired states.
+
+The horizon policy: with ``fleet.horizon_s`` the nominal speeds are ``L_i / T``; when waiting
+makes the makespan exceed ``T`` the speeds are raised by the ratio (at most three times) as
+long as they stay within ``SPEED_MARGIN`` of each vehicle's top speed. With
+``fleet.cruise_speed`` ``T`` is the makespan at that speed, rounded up to the solver interval.
+Every vehicle arrives at ``T`` (:func:`auvplan.deconfliction.retime_for_arrival`). The desired
+states on the solver grid come from :func:`auvplan.vehicle.reference_states`.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+from typing import Final
+
+import numpy as np
+
+from auvplan._typing import FloatArray
+from auvplan.deconfliction import (
+    CoordinationProblem,
+    CoordinationResult,
+    deconflict,
+    retime_for_arrival,
+    timed_headings,
+    timed_positions,
+)
+from auvplan.errors import InfeasibleError, InputError
+from auvplan.mission.config import DeconflictionConfig, FleetConfig
+from auvplan.mission.fleet import FleetLayout
+from auvplan.planning import path_length
+from auvplan.vehicle import reference_states, top_speed
+
+logger = logging.getLogger(__name__)
+
+#: Fraction of a vehicle's top speed that the mean speed along its path may use.
+SPEED_MARGIN: Final = 0.85
+#: Speed-raising rounds when deconfliction overruns a fixed horizon.
+HORIZON_ATTEMPTS: Final = 4
+#: Fleets up to this size use the coordination-space A* under ``method = "auto"``.
+AUTO_ASTAR_MAX_VEHICLES: Final = 4
+#: Largest working memory [bytes] the optimiser may need before the mission is refused.
+MEMORY_BUDGET: Final = 16 * 2**30
+#: Dense arrays of size ``(n_x + n_u)²`` the optimiser keeps per solver step (Jacobians,
+#: Hessian blocks, gains, Riccati matrices), with a safety factor.
+ARRAYS_PER_STEP: Final = 16
+
+
+@dataclass(frozen=True)
+class DeconflictStage:
+    """Stage 2: horizon, coordination-space time laws and the desired trajectories.
+
+    ``desired_states`` holds one ``(n_t, n_x_i)`` array per vehicle of ``layout`` on ``time``
+    (the solver grid of interval ``dt`` [s]).
+    """
+
+    layout: FleetLayout
+    horizon: float
+    dt: float
+    cruise_speeds: FloatArray
+    problem: CoordinationProblem
+    coordination: CoordinationResult
+    time: FloatArray
+    desired_states: tuple[FloatArray, ...]
+
+
+def check_problem_size(layout: FleetLayout, horizon: float, dt: float) -> int:
+    """The number of solver steps, refused before anything large is allocated.
+
+    Raises
+    ------
+    InputError
+        When ``horizon / dt`` is not an integer or the optimiser's arrays would need more than
+        ``MEMORY_BUDGET``; names the keys to change.
+    """
+    n_steps = round(horizon / dt)
+    if n_steps < 1 or not math.isclose(n_steps * dt, horizon, rel_tol=1e-9):
+        raise InputError(f"solver.dt_s = {dt:g} s does not divide the horizon {horizon:g} s")
+    size = layout.n_x + layout.n_u
+    needed = float(n_steps) * ARRAYS_PER_STEP * size * size * 8
+    if needed > MEMORY_BUDGET:
+        raise InputError(
+            f"{n_steps} solver steps x {layout.n_vehicles} vehicles need ~{needed / 2**30:.0f} GiB "
+            f"(budget {MEMORY_BUDGET / 2**30:.0f} GiB); use a larger solver.dt_s or a shorter "
+            "horizon"
+        )
+    return n_steps
+
+
+def _nominal_speeds(
+    fleet: FleetConfig, lengths: FloatArray, limits: FloatArray, names: tuple[str, ...]
+) -> tuple[FloatArray, float]:
+    """Speeds [m/s] and horizon [s] (NaN when derived later) before deconfliction."""
+    if fleet.horizon is not None:
+        horizon, speeds = fleet.horizon, lengths / fleet.horizon
+    else:
+        assert fleet.cruise_speed is not None
+        horizon, speeds = float("nan"), np.full(len(lengths), fleet.cruise_speed)
+    too_fast = np.flatnonzero(speeds > limits)
+    if too_fast.size:
+        i = int(too_fast[0])
+        what = (
+            f"horizon_s = {horizon:g} s is too short"
+            if fleet.horizon is not None
+            else f"cruise_speed = {fleet.cruise_speed:g} m/s is too fast"
+        )
+        raise InfeasibleError(
+            f"{what} for vehicle {names[i]}: its {lengths[i]:.0f} m path needs "
+            f">= {lengths[i] / limits[i]:.0f} s at {limits[i]:.2f} m/s ({SPEED_MARGIN:.0%} of top "
+            "speed)"
+        )
+    return speeds, horizon
+
+
+def _method(settings: DeconflictionConfig, n_vehicles: int) -> str:
+    if settings.method != "auto":
+        return settings.method
+    return "astar" if n_vehicles <= AUTO_ASTAR_MAX_VEHICLES else "prioritized"
+
+
+def run_deconfliction(
+    layout: FleetLayout,
+    paths: tuple[FloatArray, ...],
+    start_headings: FloatArray,
+    *,
+    fleet: FleetConfig,
+    settings: DeconflictionConfig,
+    dt: float,
+) -> DeconflictStage:
+    """Stage 2: choose the horizon, deconflict in the coordination space, sample the timing.
+
+    Parameters
+    ----------
+    layout : FleetLayout
+        The vehicles.
+    paths : tuple of ndarray of shape (n_i, 2)
+        Smoothed pre-planned paths, north/east [m].
+    start_headings : ndarray of shape (n_vehicles,)
+        Start headings [rad] (the desired headings are unwrapped next to them).
+    fleet, settings : FleetConfig, DeconflictionConfig
+        Timing, safety radius and coordination-space settings.
+    dt : float
+        Solver (control) interval [s].
+    """
+    names = layout.names
+    lengths = np.array([path_length(path) for path in paths])
+    limits = np.array([SPEED_MARGIN * top_speed(model) for model in layout.models])
+    speeds, horizon = _nominal_speeds(fleet, lengths, limits, names)
+    for _attempt in range(HORIZON_ATTEMPTS):
+        problem = CoordinationProblem(
+            paths=paths,
+            safety_radius=fleet.safety_radius,
+            cruise_speeds=speeds,
+            time_step=settings.time_step,
+            names=names,
+        )
+        coordination = deconflict(
+            problem,
+            method=_method(settings, len(paths)),
+            weight=settings.weight,
+            coarsening=settings.coarsening,
+        )
+        makespan = float(np.max(coordination.arrival_times))
+        if fleet.horizon is None:
+            horizon = dt * math.ceil(makespan / dt - 1e-9)
+            break
+        if makespan <= horizon + 1e-9:
+            break
+        speeds = speeds * (makespan / horizon) * 1.02
+        if np.any(speeds > limits):
+            raise InfeasibleError(
+                f"horizon_s = {horizon:g} s is too short: deconfliction needs {makespan:.0f} s "
+                "within the vehicles' speed limits"
+            )
+    else:
+        raise InfeasibleError(f"horizon_s = {horizon:g} s is too short after deconfliction")
+    n_steps = check_problem_size(layout, horizon, dt)
+    coordination = retime_for_arrival(coordination, problem, horizon)
+    time = dt * np.arange(n_steps + 1, dtype=np.float64)
+    desired = desired_states(layout, problem, coordination, time, start_headings)
+    logger.info(
+        "deconfliction (%s): horizon %.1f s, delays %s s, min separation %.2f m",
+        coordination.method,
+        horizon,
+        ", ".join(f"{delay:.1f}" for delay in coordination.delays),
+        coordination.certificate.min_separation,
+    )
+    return DeconflictStage(layout, horizon, dt, speeds, problem, coordination, time, desired)
+
+
+def desired_states(
+    layout: FleetLayout,
+    problem: CoordinationProblem,
+    coordination: CoordinationResult,
+    time: FloatArray,
+    start_headings: FloatArray,
+) -> tuple[FloatArray, ...]:
+    """Each vehicle's reference state along its timed path, on ``time``."""
+    positions = timed_positions(coordination, problem, time)
+    headings = timed_headings(coordination, problem, time)
+    desired = []
+    for i, model in enumerate(layout.models):
+        psi = np.unwrap(headings[i])
+        # keep the first desired heading within pi of the start heading
+        psi += 2 * np.pi * np.round((start_headings[i] - psi[0]) / (2 * np.pi))
+        speed = np.hypot(*np.gradient(positions[i], time, axis=0).T)
+        pose = np.column_stack([positions[i], psi])
+        desired.append(reference_states(model, pose, speed, np.gradient(psi, time)))
+    return tuple(desired)
