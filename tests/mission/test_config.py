@@ -142,7 +142,7 @@ def test_missing_and_malformed_files(tmp_path: Path) -> None:
 
 def test_small_horizon_over_dt_refused_before_allocation() -> None:
     text = MINIMAL.replace("horizon_s = 600.0", "horizon_s = 172800.0") + "[solver]\ndt_s = 0.01\n"
-    with pytest.raises(InputError, match="use a larger solver.dt_s"):
+    with pytest.raises(InputError, match=r"use a larger solver\.dt_s"):
         parse_mission(tomllib.loads(text))
 
 

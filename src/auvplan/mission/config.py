@@ -134,10 +134,18 @@ class FleetConfig(_Table):
 class Position(_Table):
     """A horizontal position: ``north, east`` [m] in the map frame, or ``lat, lon`` [deg]."""
 
-    north: Number | None = Field(None, ge=-1e7, le=1e7, json_schema_extra=_unit("m"))
-    east: Number | None = Field(None, ge=-1e7, le=1e7, json_schema_extra=_unit("m"))
-    lat: Number | None = Field(None, ge=-90.0, le=90.0, json_schema_extra=_unit("deg"))
-    lon: Number | None = Field(None, ge=-180.0, le=360.0, json_schema_extra=_unit("deg"))
+    north: Number | None = Field(
+        None, ge=-1e7, le=1e7, description="north of the map origin", json_schema_extra=_unit("m")
+    )
+    east: Number | None = Field(
+        None, ge=-1e7, le=1e7, description="east of the map origin", json_schema_extra=_unit("m")
+    )
+    lat: Number | None = Field(
+        None, ge=-90.0, le=90.0, description="latitude (WGS 84)", json_schema_extra=_unit("deg")
+    )
+    lon: Number | None = Field(
+        None, ge=-180.0, le=360.0, description="longitude (WGS 84)", json_schema_extra=_unit("deg")
+    )
 
     @model_validator(mode="after")
     def _one_pair(self) -> Position:
@@ -193,7 +201,9 @@ def _check_name(name: str) -> None:
 class VehicleConfig(_Table):
     """One vehicle: name, type (packaged type or vehicle-file path), start and goal."""
 
-    name: Text = Field(min_length=1, max_length=40, description="unique name of the vehicle")
+    name: Text = Field(
+        min_length=1, max_length=40, description="unique name (default vehicle1, vehicle2, ...)"
+    )
     type: Text = Field("medusa", min_length=1, description="packaged type or vehicle TOML path")
     start: StartPose
     goal: GoalPose
@@ -210,7 +220,12 @@ class ObstacleConfig(_Table):
     name: Text | None = Field(None, min_length=1, max_length=40, description="label (unique)")
     center: Position | None = None
     radius: Number | None = Field(
-        None, alias="radius_m", gt=0.0, le=1e5, json_schema_extra=_unit("m")
+        None,
+        alias="radius_m",
+        gt=0.0,
+        le=1e5,
+        description="radius of a circle",
+        json_schema_extra=_unit("m"),
     )
     polygon: tuple[tuple[Number, Number], ...] | None = Field(
         None, description="vertices [north, east]", json_schema_extra=_unit("m")
@@ -252,7 +267,10 @@ class CommConfig(_Table):
     """Two vehicles that must stay within ``max_range_m`` of each other."""
 
     pair: tuple[Text, Text] = Field(description="the two vehicle names")
-    max_range: Number = Field(alias="max_range_m", gt=0.0, le=1e6, json_schema_extra=_unit("m"))
+    max_range: Number = Field(
+        alias="max_range_m", gt=0.0, le=1e6, description="largest allowed distance",
+        json_schema_extra=_unit("m"),
+    )  # fmt: skip
 
 
 class WeightsConfig(_Table):
@@ -306,15 +324,28 @@ class SolverConfig(_Table):
         json_schema_extra=_unit("s"),
     )  # fmt: skip
     tol: Number = Field(_SOLVER_DEFAULTS.tol, gt=0.0, le=1e3, description="stop when -Dh·ζ < tol")
-    max_iter: Integer = Field(_SOLVER_DEFAULTS.max_iter, ge=1, le=10_000)
-    eps_initial: Number = Field(_SOLVER_DEFAULTS.eps_initial, gt=0.0, le=1e6)
-    eps_final: Number = Field(_SOLVER_DEFAULTS.eps_final, gt=0.0, le=1e6)
-    eps_factor: Number = Field(_SOLVER_DEFAULTS.eps_factor, gt=0.0, lt=1.0)
-    delta_initial: Number = Field(_SOLVER_DEFAULTS.delta_initial, gt=0.0, le=10.0)
+    max_iter: Integer = Field(
+        _SOLVER_DEFAULTS.max_iter, ge=1, le=10_000, description="PRONTO iterations, all levels"
+    )
+    eps_initial: Number = Field(
+        _SOLVER_DEFAULTS.eps_initial, gt=0.0, le=1e6, description="first barrier weight ε"
+    )
+    eps_final: Number = Field(
+        _SOLVER_DEFAULTS.eps_final, gt=0.0, le=1e6, description="last barrier weight ε"
+    )
+    eps_factor: Number = Field(
+        _SOLVER_DEFAULTS.eps_factor, gt=0.0, lt=1.0, description="ε reduction per level"
+    )
+    delta_initial: Number = Field(
+        _SOLVER_DEFAULTS.delta_initial, gt=0.0, le=10.0, description="first barrier switch δ"
+    )
     propeller_order: Integer | Literal["full"] = Field(
         3, description="propeller harmonics in the optimiser, or 'full'"
     )
-    eigenvalue_floor: Number = Field(_SOLVER_DEFAULTS.eigenvalue_floor, gt=0.0, le=1e6)
+    eigenvalue_floor: Number = Field(
+        _SOLVER_DEFAULTS.eigenvalue_floor, gt=0.0, le=1e6,
+        description="smallest curvature kept by the convexified fallback",
+    )  # fmt: skip
     compile: Flag = Field(_SOLVER_DEFAULTS.compile_c, description="C-compile stage functions")
 
     @model_validator(mode="after")
@@ -358,6 +389,20 @@ class MissionConfig(_Table):
     deconfliction: DeconflictionConfig = Field(default_factory=DeconflictionConfig)
     solver: SolverConfig = Field(default_factory=SolverConfig)
     source: Path | None = Field(None, exclude=True, description="the mission file (not a key)")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _default_vehicle_names(cls, data: Any) -> Any:
+        vehicles = data.get("vehicle") if isinstance(data, dict) else None
+        if isinstance(vehicles, list):
+            data = {
+                **data,
+                "vehicle": [
+                    {"name": f"vehicle{index + 1}", **table} if isinstance(table, dict) else table
+                    for index, table in enumerate(vehicles)
+                ],
+            }
+        return data
 
     @model_validator(mode="after")
     def _cross_checks(self) -> MissionConfig:

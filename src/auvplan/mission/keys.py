@@ -1,0 +1,132 @@
+"""The reference of every mission-file key, generated from the models of :mod:`.config`.
+
+Nothing here is written by hand: key names, types, defaults, ranges, units and descriptions
+come from the pydantic fields, so the reference cannot drift from what the parser accepts.
+"""
+
+from __future__ import annotations
+
+import types
+from dataclasses import dataclass
+from typing import Any, Literal, Union, get_args, get_origin
+
+import annotated_types
+from pydantic import BaseModel
+from pydantic.fields import FieldInfo
+from pydantic_core import PydanticUndefined
+
+from auvplan.mission.config import MissionConfig
+
+_BOUNDS = (
+    (annotated_types.Gt, "gt", ">"),
+    (annotated_types.Ge, "ge", ">="),
+    (annotated_types.Lt, "lt", "<"),
+    (annotated_types.Le, "le", "<="),
+)
+
+
+@dataclass(frozen=True)
+class KeyReference:
+    """One key: dotted TOML path, type, default, range, unit and description."""
+
+    key: str
+    type: str
+    default: str
+    range: str
+    unit: str
+    description: str
+
+
+def _nested_model(annotation: Any) -> tuple[type[BaseModel] | None, bool]:
+    """The model inside ``X``, ``X | None`` or ``tuple[X, ...]``, and whether it is an array."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation, False
+    is_array = get_origin(annotation) is tuple
+    for argument in get_args(annotation):
+        model, _ = _nested_model(argument)
+        if model is not None:
+            return model, is_array
+    return None, False
+
+
+def _type_name(annotation: Any) -> str:
+    origin = get_origin(annotation)
+    if origin is Literal:
+        return " | ".join(repr(value) for value in get_args(annotation))
+    if origin in (Union, types.UnionType):
+        names = [_type_name(a) for a in get_args(annotation) if a is not type(None)]
+        return " | ".join(names)
+    if origin is tuple:
+        arguments = get_args(annotation)
+        if len(arguments) == 2 and arguments[1] is Ellipsis:
+            return f"[{_type_name(arguments[0])}, ...]"
+        return "[" + ", ".join(_type_name(a) for a in arguments) + "]"
+    base = get_args(annotation)[0] if hasattr(annotation, "__metadata__") else annotation
+    return {float: "number", int: "integer", bool: "boolean", str: "string"}.get(
+        base, getattr(base, "__name__", str(base))
+    )
+
+
+def _range(field: FieldInfo) -> str:
+    parts = []
+    for kind, attribute, symbol in _BOUNDS:
+        for item in field.metadata:
+            if isinstance(item, kind):
+                parts.append(f"{symbol} {getattr(item, attribute):g}")
+    return ", ".join(parts)
+
+
+def _default(field: FieldInfo) -> str:
+    if field.default_factory is not None:
+        return ""
+    if field.default is PydanticUndefined:
+        return "required"
+    return "" if field.default is None else repr(field.default)
+
+
+def key_reference(model: type[BaseModel] = MissionConfig, prefix: str = "") -> list[KeyReference]:
+    """Every key below ``model``, depth first, tables before their keys.
+
+    Examples
+    --------
+    >>> keys = {row.key: row for row in key_reference()}
+    >>> keys["solver.dt_s"].unit, keys["fleet.safety_radius_m"].default
+    ('s', 'required')
+    """
+    rows: list[KeyReference] = []
+    for name, field in model.model_fields.items():
+        if field.exclude:
+            continue
+        key = f"{prefix}{field.alias or name}"
+        nested, is_array = _nested_model(field.annotation)
+        if nested is not None:
+            table = f"[[{key}]]" if is_array else f"[{key}]"
+            rows.append(
+                KeyReference(table, "table", "", "", "", (nested.__doc__ or "").split("\n")[0])
+            )
+            rows.extend(key_reference(nested, f"{key}."))
+            continue
+        extra = field.json_schema_extra if isinstance(field.json_schema_extra, dict) else {}
+        rows.append(
+            KeyReference(
+                key=key,
+                type=_type_name(field.annotation),
+                default=_default(field),
+                range=_range(field),
+                unit=str(extra.get("unit", "")),
+                description=field.description or "",
+            )
+        )
+    return rows
+
+
+def key_reference_markdown() -> str:
+    """The key reference as a Markdown table."""
+    lines = ["| key | type | default | range | unit | meaning |", "|---|---|---|---|---|---|"]
+    for row in key_reference():
+        cells = [f"`{row.key}`", row.type, row.default, row.range, row.unit, row.description]
+        lines.append("| " + " | ".join(cell.replace("|", "\\|") for cell in cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+__all__ = ["KeyReference", "key_reference", "key_reference_markdown"]
