@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 STAGES = ("preplan", "deconflict", "full")
-#: Exit code when the optimiser did not converge (user errors exit with 2).
+#: Exit code when the plan did not converge or breaks a constraint (user errors exit with 2).
 EXIT_NOT_CONVERGED = 3
 
 
@@ -88,15 +88,15 @@ def _run(config: Any, args: argparse.Namespace) -> int:
 
 
 def _exit_code(result: Any) -> int:
-    """0 for a converged plan; 3 (one line on stderr) when an optimisation did not converge.
+    """0 for a plan that converged with every constraint met between samples; otherwise 3.
 
-    The outputs are still written, for inspection, and the summary records the status.
+    The outputs are still written (the best plan found), the summary records the status and
+    the violations, and one line on stderr names the first problem and what to change.
     """
     for label, plan in (("plan", result.plan), ("energy-only plan", result.energy_only)):
-        if plan is not None and not plan.result.success:
+        if plan is not None and not plan.verdict.success:
             print(
-                f"auvplan: {label} not converged ({plan.result.status.name}): "
-                f"{plan.result.message}; outputs written for inspection",
+                f"auvplan: {label} {plan.verdict.status.name}: {plan.verdict.message}",
                 file=sys.stderr,
             )
             return EXIT_NOT_CONVERGED
@@ -110,7 +110,11 @@ def _print_report(result: Any, written: list[Path]) -> None:
         print(f"  {name:<22s} {seconds:8.2f} s", file=out)
     plan = result.plan
     if plan is not None:
-        print(f"optimiser: {plan.result.status.name}, {plan.result.n_iter} iterations", file=out)
+        print(
+            f"optimiser: {plan.result.status.name}, {plan.result.n_iter} iterations; "
+            f"plan {plan.verdict.status.name}",
+            file=out,
+        )
         for i, name in enumerate(result.preplan.names):
             closest = min(plan.separations[name].values(), default=float("nan"))
             print(

@@ -14,6 +14,8 @@ import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 
 from auvplan._typing import FloatArray
+from auvplan.mission.checks import PlanVerdict, judge_plan
+from auvplan.mission.config import MissionConfig
 from auvplan.mission.fleet import FleetProblemFunctions
 from auvplan.mission.preplan import PreplanStage
 from auvplan.mission.verify import replay_closed_loop
@@ -39,7 +41,8 @@ class OptimizedPlan:
     tracking regulator on a grid ``CHECK_REFINEMENT`` times finer than the solver's, whose
     time series are ``fine_distances`` (labels ``"a / b"``) on ``fine_time``;
     ``tracking_error`` ``(n_vehicles,)`` is that replay's largest distance [m] from the plan at
-    the solver nodes.
+    the solver nodes. ``verdict`` says whether every constraint holds between samples
+    (:func:`auvplan.mission.checks.judge_plan`).
     """
 
     result: ProntoResult
@@ -54,9 +57,11 @@ class OptimizedPlan:
     fine_time: FloatArray
     fine_distances: dict[str, FloatArray]
     tracking_error: FloatArray
+    verdict: PlanVerdict
 
 
 def evaluate_plan(
+    config: MissionConfig,
     preplan: PreplanStage,
     time: FloatArray,
     functions: FleetProblemFunctions,
@@ -106,6 +111,7 @@ def evaluate_plan(
         fine_time=fine_time,
         fine_distances=fine_distances,
         tracking_error=tracking_error,
+        verdict=judge_plan(config, preplan.names, result, fine_time, fine_distances, arrival),
     )
 
 

@@ -164,4 +164,6 @@ def run_optimization(
         result.n_iter,
         result.cost,
     )
-    return evaluate_plan(preplan, deconfliction.time, assembled.functions, result, terrain_weight)
+    return evaluate_plan(
+        config, preplan, deconfliction.time, assembled.functions, result, terrain_weight
+    )

@@ -28,6 +28,9 @@ def _plan_summary(plan: OptimizedPlan, names: tuple[str, ...]) -> dict[str, Any]
     result = plan.result
     return {
         "terrain_weight": plan.terrain_weight,
+        "plan_status": plan.verdict.status.name,
+        "verdict": plan.verdict.message,
+        "violations": [dataclasses.asdict(violation) for violation in plan.verdict.violations],
         "status": result.status.name,
         "message": result.message,
         "n_iter": result.n_iter,

@@ -1,0 +1,140 @@
+"""The verdict on an optimised plan: CONVERGED only when every constraint holds between samples.
+
+The optimiser imposes its constraints at the solver nodes; here they are checked on the plan
+flown with its tracking regulator on a grid ``CHECK_REFINEMENT`` times finer
+(:mod:`auvplan.mission.evaluation`): separation ``>= 2 r_c`` between vehicles, clearance
+``>= r_c`` from every obstacle's edge, communication ranges, and arrival within
+``ARRIVAL_TOLERANCE`` of the goal. Each violation names the vehicles or obstacle, the worst
+value and when, and a change to the mission that would help.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+from typing import Final
+
+import numpy as np
+
+from auvplan._typing import FloatArray
+from auvplan.mission.config import MissionConfig
+from auvplan.optimization import ProntoResult
+
+#: Slack [m] allowed on distance limits for round-off between the plan and its replay.
+DISTANCE_TOLERANCE: Final = 1e-3
+#: Largest distance [m] from the goal at the horizon that still counts as arrived.
+ARRIVAL_TOLERANCE: Final = 2.0
+
+
+class PlanStatus(enum.Enum):
+    """Verdict on a plan (the optimiser's own status is kept beside it)."""
+
+    CONVERGED = "converged"
+    """The optimiser converged and every constraint holds between samples."""
+    CONSTRAINT_VIOLATED = "constraint_violated"
+    """The optimiser converged but a constraint fails somewhere (see the violations)."""
+    NOT_CONVERGED = "not_converged"
+    """The optimiser stopped early; the best plan found is reported."""
+
+
+@dataclass(frozen=True)
+class Violation:
+    """One constraint that does not hold: ``kind`` of constraint, who, worst value, when."""
+
+    kind: str
+    who: str
+    value: float
+    limit: float
+    time: float
+    advice: str
+
+    def describe(self) -> str:
+        """One line for the user."""
+        relation = ">" if self.kind == "communication" else "<"
+        return (
+            f"{self.kind}: {self.who} at {self.value:.2f} m {relation} {self.limit:g} m "
+            f"(t = {self.time:.0f} s); {self.advice}"
+        )
+
+
+@dataclass(frozen=True)
+class PlanVerdict:
+    """Status, the violations found, and the one-line message for the user."""
+
+    status: PlanStatus
+    violations: tuple[Violation, ...]
+    message: str
+
+    @property
+    def success(self) -> bool:
+        """True for :attr:`PlanStatus.CONVERGED`."""
+        return self.status is PlanStatus.CONVERGED
+
+
+_TIMING_ADVICE: Final = "try a longer fleet.horizon_s or a smaller solver.dt_s"
+
+
+def _worst(distance: FloatArray, time: FloatArray, *, largest: bool) -> tuple[float, float]:
+    k = int(np.argmax(distance) if largest else np.argmin(distance))
+    return float(distance[k]), float(time[k])
+
+
+def judge_plan(
+    config: MissionConfig,
+    names: tuple[str, ...],
+    result: ProntoResult,
+    fine_time: FloatArray,
+    fine_distances: dict[str, FloatArray],
+    arrival_error: FloatArray,
+) -> PlanVerdict:
+    """Check a plan's constraints on the fine replay and give its verdict.
+
+    ``fine_distances`` are labelled ``"a / b"`` (vehicles or a vehicle and an obstacle label);
+    ``arrival_error`` ``(n_vehicles,)`` [m].
+    """
+    radius = config.fleet.safety_radius
+    obstacles = set(config.obstacle_names)
+    violations: list[Violation] = []
+    for label, distance in fine_distances.items():
+        first, second = label.split(" / ")
+        limit = radius if second in obstacles else 2.0 * radius
+        value, when = _worst(distance, fine_time, largest=False)
+        if value < limit - DISTANCE_TOLERANCE:
+            kind = "obstacle clearance" if second in obstacles else "separation"
+            violations.append(
+                Violation(kind, f"{first} / {second}", value, limit, when, _TIMING_ADVICE)
+            )
+    for comm in config.comms:
+        label = " / ".join(sorted(comm.pair, key=names.index))
+        value, when = _worst(fine_distances[label], fine_time, largest=True)
+        if value > comm.max_range + DISTANCE_TOLERANCE:
+            advice = "move the goals closer together or raise max_range_m"
+            violations.append(
+                Violation("communication", label, value, comm.max_range, when, advice)
+            )
+    for i, error in enumerate(arrival_error):
+        if error > ARRIVAL_TOLERANCE:
+            advice = "try a longer fleet.horizon_s or a larger weights.terminal"
+            violations.append(
+                Violation(
+                    "arrival",
+                    names[i],
+                    float(error),
+                    ARRIVAL_TOLERANCE,
+                    float(fine_time[-1]),
+                    advice,
+                )
+            )
+    if not result.success:
+        status = PlanStatus.NOT_CONVERGED
+        message = (
+            f"optimiser stopped with {result.status.name} after {result.n_iter} iterations "
+            f"({result.message}); try a larger solver.max_iter or solver.dt_s"
+        )
+        if violations:
+            message += f"; {violations[0].describe()}"
+    elif violations:
+        status, message = PlanStatus.CONSTRAINT_VIOLATED, violations[0].describe()
+    else:
+        status, message = PlanStatus.CONVERGED, "every constraint holds between samples"
+    return PlanVerdict(status, tuple(violations), message)

@@ -1,0 +1,103 @@
+"""The plan verdict: CONVERGED only when every constraint holds between samples."""
+
+from __future__ import annotations
+
+import tomllib
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+
+from auvplan.mission.checks import ARRIVAL_TOLERANCE, PlanStatus, judge_plan
+from auvplan.mission.config import parse_mission
+
+MISSION = """
+[terrain]
+synthetic = true
+[fleet]
+horizon_s = 100.0
+safety_radius_m = 5.0
+[[vehicle]]
+name = "a"
+start = { north = 0.0, east = 0.0 }
+goal = { north = 50.0, east = 0.0 }
+[[vehicle]]
+name = "b"
+start = { north = 0.0, east = 30.0 }
+goal = { north = 50.0, east = 30.0 }
+[[obstacle]]
+name = "rock"
+center = { north = 25.0, east = 15.0 }
+radius_m = 2.0
+[[comm]]
+pair = ["b", "a"]
+max_range_m = 40.0
+"""
+TIME = np.linspace(0.0, 100.0, 1001)
+
+
+def _result(success: bool = True) -> Any:
+    return SimpleNamespace(
+        success=success, status=SimpleNamespace(name="CONVERGED" if success else "MAX_ITER"),
+        n_iter=7, message="",
+    )  # fmt: skip
+
+
+def _distances(**overrides: np.ndarray) -> dict[str, np.ndarray]:
+    distances = {
+        "a / b": np.full(TIME.size, 30.0),
+        "a / rock": np.full(TIME.size, 12.0),
+        "b / rock": np.full(TIME.size, 12.0),
+    }
+    distances.update({key.replace("_", " / "): value for key, value in overrides.items()})
+    return distances
+
+
+def _judge(distances: dict[str, np.ndarray], arrival: float = 0.1, success: bool = True) -> Any:
+    config = parse_mission(tomllib.loads(MISSION))
+    return judge_plan(
+        config, ("a", "b"), _result(success), TIME, distances, np.array([arrival, 0.0])
+    )
+
+
+def test_clean_plan_converges() -> None:
+    verdict = _judge(_distances())
+    assert verdict.status is PlanStatus.CONVERGED
+    assert verdict.success
+    assert verdict.violations == ()
+
+
+def test_dip_between_samples_is_a_named_separation_violation() -> None:
+    dip = np.full(TIME.size, 30.0)
+    dip[400] = 9.4  # one fine sample below 2 r_c = 10 m
+    verdict = _judge(_distances(a_b=dip))
+    assert verdict.status is PlanStatus.CONSTRAINT_VIOLATED
+    (violation,) = verdict.violations
+    assert (violation.kind, violation.who, violation.value) == ("separation", "a / b", 9.4)
+    assert violation.time == TIME[400]
+    assert "a / b" in verdict.message
+    assert "fleet.horizon_s" in verdict.message
+    assert "\n" not in verdict.message
+
+
+def test_obstacle_clearance_and_comm_range_and_arrival() -> None:
+    close = np.full(TIME.size, 12.0)
+    close[10] = 4.0  # r_c = 5 m from the edge needed
+    far = np.full(TIME.size, 30.0)
+    far[-1] = 41.0  # max_range_m = 40
+    verdict = _judge(_distances(b_rock=close, a_b=far), arrival=ARRIVAL_TOLERANCE + 1.0)
+    kinds = {(v.kind, v.who) for v in verdict.violations}
+    assert kinds == {
+        ("obstacle clearance", "b / rock"),
+        ("communication", "a / b"),
+        ("arrival", "a"),
+    }
+
+
+def test_not_converged_wins_over_violations_and_names_them() -> None:
+    dip = np.full(TIME.size, 30.0)
+    dip[3] = 1.0
+    verdict = _judge(_distances(a_b=dip), success=False)
+    assert verdict.status is PlanStatus.NOT_CONVERGED
+    assert "MAX_ITER" in verdict.message
+    assert "separation" in verdict.message
