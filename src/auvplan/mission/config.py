@@ -13,369 +13,39 @@ from these models (:mod:`auvplan.mission.keys`).
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Annotated, Any, Final, Literal
+from typing import Any, Final
 
-from pydantic import BaseModel, ConfigDict, Field, Strict, ValidationError, model_validator
+from pydantic import BaseModel, Field, ValidationError, model_validator
 
 from auvplan.errors import InputError
 from auvplan.io.text import read_toml
-from auvplan.optimization import ProntoOptions
-
-#: Strict scalar types: TOML's own types, no strings parsed as numbers, no NaN/inf.
-Number = Annotated[float, Strict()]
-Integer = Annotated[int, Strict()]
-Flag = Annotated[bool, Strict()]
-Text = Annotated[str, Strict()]
-Interval = tuple[Number, Number]
-BlockSize = Annotated[int, Strict(), Field(ge=1, le=256)]
+from auvplan.mission.tables import (
+    CommConfig,
+    DeconflictionConfig,
+    FleetConfig,
+    GoalPose,
+    MapsConfig,
+    ObstacleConfig,
+    PlannerConfig,
+    Position,
+    SolverConfig,
+    StartPose,
+    TableModel,
+    TerrainConfig,
+    VehicleConfig,
+    WeightsConfig,
+    WindowConfig,
+    nested_model,
+)
 
 #: Most solver steps a mission may ask for (``horizon_s / dt_s``) before anything is allocated.
 MAX_SOLVER_STEPS: Final = 200_000
-#: Characters that would break CSV rows or labels in a vehicle or obstacle name.
-FORBIDDEN_NAME_CHARACTERS: Final = ",\n\"'"
 
-_SOLVER_DEFAULTS: Final = ProntoOptions()
 
-
-def _unit(unit: str) -> dict[str, Any]:
-    return {"unit": unit}
-
-
-class _Table(BaseModel):
-    """A TOML table: unknown keys and NaN/inf are refused; instances are immutable."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
-
-
-def _check_interval(value: Interval | None, key: str) -> None:
-    if value is not None and not value[0] < value[1]:
-        raise ValueError(f"{key}: low must be < high, got {list(value)}")
-
-
-class WindowConfig(_Table):
-    """Crop of the terrain: ``(low, high)`` in metres (north/east) or degrees (lat/lon)."""
-
-    north: Interval | None = Field(None, description="north range", json_schema_extra=_unit("m"))
-    east: Interval | None = Field(None, description="east range", json_schema_extra=_unit("m"))
-    lat: Interval | None = Field(None, description="latitude range", json_schema_extra=_unit("deg"))
-    lon: Interval | None = Field(
-        None, description="longitude range", json_schema_extra=_unit("deg")
-    )
-
-    @model_validator(mode="after")
-    def _consistent(self) -> WindowConfig:
-        for key in ("north", "east", "lat", "lon"):
-            _check_interval(getattr(self, key), key)
-        if (self.north or self.east) and (self.lat or self.lon):
-            raise ValueError("use north/east or lat/lon, not both")
-        return self
-
-    @property
-    def is_geographic(self) -> bool:
-        """True when the window is given in lat/lon."""
-        return self.lat is not None or self.lon is not None
-
-
-class TerrainConfig(_Table):
-    """Where the bathymetry comes from: a file (resolved next to the mission) or the bank."""
-
-    file: Path | None = Field(
-        None, description="bathymetry file: NetCDF, GeoTIFF, ESRI ASCII or XYZ"
-    )
-    synthetic: Flag = Field(False, description="use the built-in synthetic volcanic bank")
-    seed: Integer = Field(7, ge=0, le=2**32 - 1, description="seed of the synthetic bank")
-    window: WindowConfig = Field(default_factory=WindowConfig, description="crop of the grid")
-
-    @model_validator(mode="after")
-    def _one_source(self) -> TerrainConfig:
-        if (self.file is None) == (not self.synthetic):
-            raise ValueError("give a bathymetry file = '...' or synthetic = true (one of them)")
-        return self
-
-
-class MapsConfig(_Table):
-    """Map parameters (paper eq. 13-15)."""
-
-    exponent: Number = Field(1.0, alias="s", gt=0.0, le=10.0, description="exponent s (eq. 13)")
-    block: tuple[BlockSize, BlockSize] = Field(
-        (2, 2), description="excitation block (r_n, r_e) (eq. 14)", json_schema_extra=_unit("cells")
-    )
-    omega: Number = Field(10.0, gt=0.0, le=1e4, description="admissibility shift ω (eq. 15)")
-    weight: Number = Field(10.0, alias="w", ge=0.0, le=1e4, description="cost weight w (eq. 15)")
-
-
-class FleetConfig(_Table):
-    """Fleet-wide timing and safety."""
-
-    horizon: Number | None = Field(
-        None, alias="horizon_s", gt=0.0, le=172_800.0, description="common arrival time T",
-        json_schema_extra=_unit("s"),
-    )  # fmt: skip
-    cruise_speed: Number | None = Field(
-        None, ge=0.05, le=10.0, description="nominal speed; the horizon is derived from it",
-        json_schema_extra=_unit("m/s"),
-    )  # fmt: skip
-    safety_radius: Number = Field(
-        alias="safety_radius_m", gt=0.0, le=1000.0,
-        description="r_c; every pair keeps >= 2 r_c", json_schema_extra=_unit("m"),
-    )  # fmt: skip
-
-    @model_validator(mode="after")
-    def _one_timing(self) -> FleetConfig:
-        if (self.horizon is None) == (self.cruise_speed is None):
-            raise ValueError("give exactly one of horizon_s and cruise_speed")
-        return self
-
-
-class Position(_Table):
-    """A horizontal position: ``north, east`` [m] in the map frame, or ``lat, lon`` [deg]."""
-
-    north: Number | None = Field(
-        None, ge=-1e7, le=1e7, description="north of the map origin", json_schema_extra=_unit("m")
-    )
-    east: Number | None = Field(
-        None, ge=-1e7, le=1e7, description="east of the map origin", json_schema_extra=_unit("m")
-    )
-    lat: Number | None = Field(
-        None, ge=-90.0, le=90.0, description="latitude (WGS 84)", json_schema_extra=_unit("deg")
-    )
-    lon: Number | None = Field(
-        None, ge=-180.0, le=360.0, description="longitude (WGS 84)", json_schema_extra=_unit("deg")
-    )
-
-    @model_validator(mode="after")
-    def _one_pair(self) -> Position:
-        local = (self.north is not None, self.east is not None)
-        geographic = (self.lat is not None, self.lon is not None)
-        if any(local) == any(geographic):
-            raise ValueError("give north and east (m) or lat and lon (deg)")
-        if not (all(local) or all(geographic)):
-            raise ValueError("both coordinates are required")
-        return self
-
-    @property
-    def is_geographic(self) -> bool:
-        """True when given as latitude/longitude."""
-        return self.lat is not None
-
-    @property
-    def coordinates(self) -> tuple[float, float]:
-        """``(north, east)`` [m], or ``(lat, lon)`` [deg] when :attr:`is_geographic`."""
-        pair = (self.lat, self.lon) if self.is_geographic else (self.north, self.east)
-        if pair[0] is None or pair[1] is None:  # excluded by the validator
-            raise InputError("position: both coordinates are required")
-        return pair[0], pair[1]
-
-
-class GoalPose(Position):
-    """A position with a heading (degrees clockwise from north in the file)."""
-
-    heading_deg: Number = Field(
-        0.0, ge=-360.0, le=360.0, description="heading, clockwise from north",
-        json_schema_extra=_unit("deg"),
-    )  # fmt: skip
-
-    @property
-    def psi(self) -> float:
-        """Heading [rad] reduced to ``(-π, π]``."""
-        return math.remainder(math.radians(self.heading_deg), 2.0 * math.pi)
-
-
-class StartPose(GoalPose):
-    """The start pose and surge speed (checked against the vehicle's top speed later)."""
-
-    speed: Number = Field(
-        0.0, ge=0.0, le=10.0, description="surge speed", json_schema_extra=_unit("m/s")
-    )
-
-
-def _check_name(name: str) -> None:
-    if not name.strip() or any(ch in name for ch in FORBIDDEN_NAME_CHARACTERS):
-        raise ValueError(f"{name!r} is not a usable name (no commas, quotes or line breaks)")
-
-
-class VehicleConfig(_Table):
-    """One vehicle: name, type (packaged type or vehicle-file path), start and goal."""
-
-    name: Text = Field(
-        min_length=1, max_length=40, description="unique name (default vehicle1, vehicle2, ...)"
-    )
-    type: Text = Field("medusa", min_length=1, description="packaged type or vehicle TOML path")
-    start: StartPose
-    goal: GoalPose
-
-    @model_validator(mode="after")
-    def _usable(self) -> VehicleConfig:
-        _check_name(self.name)
-        return self
-
-
-class ObstacleConfig(_Table):
-    """A circular (``center``, ``radius_m``) or polygonal (``polygon`` [[n, e], ...]) obstacle."""
-
-    name: Text | None = Field(None, min_length=1, max_length=40, description="label (unique)")
-    center: Position | None = None
-    radius: Number | None = Field(
-        None,
-        alias="radius_m",
-        gt=0.0,
-        le=1e5,
-        description="radius of a circle",
-        json_schema_extra=_unit("m"),
-    )
-    polygon: tuple[tuple[Number, Number], ...] | None = Field(
-        None, description="vertices [north, east]", json_schema_extra=_unit("m")
-    )
-
-    @property
-    def circle(self) -> tuple[Position, float]:
-        """``(center, radius [m])`` of a circular obstacle."""
-        if self.center is None or self.radius is None:
-            raise InputError("obstacle: not a circle")
-        return self.center, self.radius
-
-    @model_validator(mode="after")
-    def _shape(self) -> ObstacleConfig:
-        if self.name is not None:
-            _check_name(self.name)
-        if self.polygon is not None:
-            if self.center is not None or self.radius is not None:
-                raise ValueError("give center and radius_m, or polygon, not both")
-            _check_polygon(self.polygon)
-        elif self.center is None or self.radius is None:
-            raise ValueError("a circle needs center and radius_m (or give a polygon)")
-        return self
-
-
-def _check_polygon(vertices: tuple[tuple[float, float], ...]) -> None:
-    from shapely import Polygon
-    from shapely.validation import explain_validity
-
-    if len(vertices) < 3:
-        raise ValueError(f"polygon needs at least 3 [north, east] vertices, got {len(vertices)}")
-    shape = Polygon([(east, north) for north, east in vertices])
-    if not shape.is_valid or shape.area <= 0.0:
-        reason = explain_validity(shape) if not shape.is_valid else "zero area"
-        raise ValueError(f"polygon is not a simple polygon ({reason})")
-
-
-class CommConfig(_Table):
-    """Two vehicles that must stay within ``max_range_m`` of each other."""
-
-    pair: tuple[Text, Text] = Field(description="the two vehicle names")
-    max_range: Number = Field(
-        alias="max_range_m", gt=0.0, le=1e6, description="largest allowed distance",
-        json_schema_extra=_unit("m"),
-    )  # fmt: skip
-
-
-class WeightsConfig(_Table):
-    """Trade-off multipliers of the optimiser's cost (dimensionless).
-
-    ``terrain`` scales the pull towards the terrain-informed desired trajectory (0 gives the
-    energy-only plan), ``energy`` the electrical power, ``terminal`` the arrival stiffness.
-    """
-
-    terrain: Number = Field(1.0, ge=0.0, le=1e6, description="terrain (desired-path) weight")
-    energy: Number = Field(1.0, ge=0.0, le=1e6, description="electrical-energy weight")
-    terminal: Number = Field(1.0, gt=0.0, le=1e6, description="arrival-pose weight")
-
-
-class PlannerConfig(_Table):
-    """The A* pre-planner."""
-
-    edge_model: Literal["paper", "crossed"] = Field(
-        "paper", description="paper: cost of the cell entered; crossed: length x terrain crossed"
-    )
-
-
-class DeconflictionConfig(_Table):
-    """Coordination-space deconfliction (see :func:`auvplan.deconfliction.deconflict`)."""
-
-    method: Literal["auto", "astar", "prioritized"] = Field(
-        "auto", description="auto: exact A* for small fleets, else prioritized"
-    )
-    weight: Number | None = Field(
-        None, ge=1.0, le=100.0, description="A* heuristic weight (default sqrt(N))"
-    )
-    time_step: Number = Field(
-        0.5, alias="time_step_s", ge=0.01, le=60.0, description="coordination grid step",
-        json_schema_extra=_unit("s"),
-    )  # fmt: skip
-    coarsening: Integer = Field(
-        1, ge=1, le=1000, description="A* searches on a k-times coarser grid"
-    )
-
-
-class SolverConfig(_Table):
-    """Stage-3 settings; defaults are :class:`auvplan.optimization.ProntoOptions`'s own.
-
-    ``dt`` is the control and output interval. ``propeller_order`` is the number of Fourier
-    harmonics of the four-quadrant propeller model inside the optimiser (the paper's low-order
-    approximation) or ``"full"``. ``compile`` C-compiles the stage functions (cached on disk).
-    """
-
-    dt: Number = Field(
-        0.5, alias="dt_s", ge=0.01, le=10.0, description="control and output interval",
-        json_schema_extra=_unit("s"),
-    )  # fmt: skip
-    tol: Number = Field(_SOLVER_DEFAULTS.tol, gt=0.0, le=1e3, description="stop when -Dh·ζ < tol")
-    max_iter: Integer = Field(
-        _SOLVER_DEFAULTS.max_iter, ge=1, le=10_000, description="PRONTO iterations, all levels"
-    )
-    eps_initial: Number = Field(
-        _SOLVER_DEFAULTS.eps_initial, gt=0.0, le=1e6, description="first barrier weight ε"
-    )
-    eps_final: Number = Field(
-        _SOLVER_DEFAULTS.eps_final, gt=0.0, le=1e6, description="last barrier weight ε"
-    )
-    eps_factor: Number = Field(
-        _SOLVER_DEFAULTS.eps_factor, gt=0.0, lt=1.0, description="ε reduction per level"
-    )
-    delta_initial: Number = Field(
-        _SOLVER_DEFAULTS.delta_initial, gt=0.0, le=10.0, description="first barrier switch δ"
-    )
-    propeller_order: Integer | Literal["full"] = Field(
-        3, description="propeller harmonics in the optimiser, or 'full'"
-    )
-    eigenvalue_floor: Number = Field(
-        _SOLVER_DEFAULTS.eigenvalue_floor, gt=0.0, le=1e6,
-        description="smallest curvature kept by the convexified fallback",
-    )  # fmt: skip
-    compile: Flag = Field(_SOLVER_DEFAULTS.compile_c, description="C-compile stage functions")
-
-    @model_validator(mode="after")
-    def _schedule(self) -> SolverConfig:
-        if self.eps_final > self.eps_initial:
-            raise ValueError(f"eps_final = {self.eps_final:g} exceeds eps_initial")
-        if isinstance(self.propeller_order, int) and not 1 <= self.propeller_order <= 64:
-            raise ValueError(f"propeller_order: 1 to 64 or 'full', got {self.propeller_order}")
-        return self
-
-    def pronto_options(self) -> ProntoOptions:
-        """The optimiser's options built from these settings."""
-        return ProntoOptions(
-            tol=self.tol,
-            max_iter=self.max_iter,
-            eps_initial=self.eps_initial,
-            eps_final=self.eps_final,
-            eps_factor=self.eps_factor,
-            delta_initial=self.delta_initial,
-            eigenvalue_floor=self.eigenvalue_floor,
-            compile_c=self.compile,
-        )
-
-    @property
-    def harmonics(self) -> int | None:
-        """``propeller_order`` with ``"full"`` as ``None``."""
-        return None if self.propeller_order == "full" else self.propeller_order
-
-
-class MissionConfig(_Table):
+class MissionConfig(TableModel):
     """A validated mission (SI units, radians). Built by :func:`load_mission`."""
 
     terrain: TerrainConfig
@@ -498,22 +168,11 @@ def _keys_of(location: tuple[int | str, ...]) -> list[str]:
         field = next(
             (f for name, f in model.model_fields.items() if (f.alias or name) == part), None
         )
-        nested = _model_in(field.annotation) if field is not None else None
+        nested = nested_model(field.annotation)[0] if field is not None else None
         if nested is None:
             return []
         model = nested
     return [f.alias or name for name, f in model.model_fields.items() if not f.exclude]
-
-
-def _model_in(annotation: Any) -> type[BaseModel] | None:
-    """The pydantic model inside ``X``, ``X | None`` or ``tuple[X, ...]``."""
-    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return annotation
-    for argument in getattr(annotation, "__args__", ()):
-        found = _model_in(argument)
-        if found is not None:
-            return found
-    return None
 
 
 def _one_line(error: ValidationError) -> str:

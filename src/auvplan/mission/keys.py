@@ -16,6 +16,7 @@ from pydantic.fields import FieldInfo
 from pydantic_core import PydanticUndefined
 
 from auvplan.mission.config import MissionConfig
+from auvplan.mission.tables import nested_model
 
 _BOUNDS = (
     (annotated_types.Gt, "gt", ">"),
@@ -35,18 +36,6 @@ class KeyReference:
     range: str
     unit: str
     description: str
-
-
-def _nested_model(annotation: Any) -> tuple[type[BaseModel] | None, bool]:
-    """The model inside ``X``, ``X | None`` or ``tuple[X, ...]``, and whether it is an array."""
-    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return annotation, False
-    is_array = get_origin(annotation) is tuple
-    for argument in get_args(annotation):
-        model, _ = _nested_model(argument)
-        if model is not None:
-            return model, is_array
-    return None, False
 
 
 def _type_name(annotation: Any) -> str:
@@ -98,7 +87,7 @@ def key_reference(model: type[BaseModel] = MissionConfig, prefix: str = "") -> l
         if field.exclude:
             continue
         key = f"{prefix}{field.alias or name}"
-        nested, is_array = _nested_model(field.annotation)
+        nested, is_array = nested_model(field.annotation)
         if nested is not None:
             table = f"[[{key}]]" if is_array else f"[{key}]"
             rows.append(
