@@ -93,6 +93,9 @@ def _exit_code(result: Any) -> int:
     The outputs are still written (the best plan found), the summary records the status and
     the violations, and one line on stderr names the first problem and what to change.
     """
+    if result.failure is not None:
+        print(f"auvplan: plan FAILED: {result.failure}", file=sys.stderr)
+        return EXIT_NOT_CONVERGED
     for label, plan in (("plan", result.plan), ("energy-only plan", result.energy_only)):
         if plan is not None and not plan.verdict.success:
             print(

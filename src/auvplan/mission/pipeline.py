@@ -25,6 +25,7 @@ from enum import Enum
 from functools import cache
 from typing import Any
 
+from auvplan.errors import InputError, SolverError
 from auvplan.io.vehicles import load_vehicle
 from auvplan.mission.assembly import assemble_problem
 from auvplan.mission.config import MissionConfig
@@ -33,7 +34,7 @@ from auvplan.mission.fleet import FleetLayout
 from auvplan.mission.preplan import PreplanStage, run_preplan
 from auvplan.mission.timing import DeconflictStage, run_deconfliction
 from auvplan.optimization import solve_pronto
-from auvplan.vehicle import VehicleModel, build_vehicle_model
+from auvplan.vehicle import VehicleModel, build_vehicle_model, top_speed
 
 logger = logging.getLogger(__name__)
 
@@ -48,7 +49,11 @@ class Stage(Enum):
 
 @dataclass(frozen=True)
 class MissionResult:
-    """Everything a mission run produced; ``timings`` holds wall seconds per stage."""
+    """Everything a mission run produced; ``timings`` holds wall seconds per stage.
+
+    ``failure`` names why stage 3 produced no plan at all (the optimiser failed before its
+    first iterate); the earlier stages' results are kept so that they can be written.
+    """
 
     config: MissionConfig
     stage: Stage
@@ -57,6 +62,7 @@ class MissionResult:
     plan: OptimizedPlan | None = None
     energy_only: OptimizedPlan | None = None
     timings: dict[str, float] = field(default_factory=dict)
+    failure: str | None = None
 
 
 def run_mission(
@@ -111,20 +117,37 @@ def run_mission(
             config, layout, preplan, deconfliction, terrain_weight, callback=callback
         )
 
-    plan = timed("optimize", lambda: optimize(config.weights.terrain))
-    energy_only = None
-    if compare_energy_only:
-        energy_only = timed("optimize_energy_only", lambda: optimize(0.0))
+    try:
+        plan = timed("optimize", lambda: optimize(config.weights.terrain))
+        energy_only = None
+        if compare_energy_only:
+            energy_only = timed("optimize_energy_only", lambda: optimize(0.0))
+    except SolverError as error:
+        failure = f"the optimiser failed: {error}; try a smaller solver.dt_s or a longer horizon"
+        return MissionResult(
+            config, stage, preplan, deconfliction, timings=timings, failure=failure
+        )
     return MissionResult(config, stage, preplan, deconfliction, plan, energy_only, timings=timings)
 
 
 def fleet_layout(config: MissionConfig) -> FleetLayout:
-    """The vehicles' models with the optimiser's propeller order, stacked in mission order."""
+    """The vehicles' models with the optimiser's propeller order, stacked in mission order.
+
+    Raises
+    ------
+    InputError
+        If a start speed exceeds its vehicle's top speed.
+    """
     order = config.solver.harmonics
-    return FleetLayout(
-        names=tuple(vehicle.name for vehicle in config.vehicles),
-        models=tuple(vehicle_model(vehicle.type, order) for vehicle in config.vehicles),
-    )
+    models = tuple(vehicle_model(vehicle.type, order) for vehicle in config.vehicles)
+    for index, (vehicle, model) in enumerate(zip(config.vehicles, models, strict=True)):
+        fastest = top_speed(model)
+        if vehicle.start.speed > fastest:
+            raise InputError(
+                f"vehicle[{index}].start.speed = {vehicle.start.speed:g} m/s exceeds the "
+                f"top speed of {vehicle.name} ({vehicle.type}), {fastest:.2f} m/s"
+            )
+    return FleetLayout(names=tuple(vehicle.name for vehicle in config.vehicles), models=models)
 
 
 @cache

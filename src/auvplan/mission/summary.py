@@ -119,6 +119,8 @@ def mission_summary(result: MissionResult) -> dict[str, Any]:
                 "delay_s": coordination.delays[i],
                 "time_law": {"t_s": coordination.time, "progress_m": coordination.progress[i]},
             }
+    if result.failure is not None:
+        summary["optimization"] = {"plan_status": "FAILED", "verdict": result.failure}
     if result.plan is not None:
         summary["optimization"] = _plan_summary(result.plan, preplan.names)
     if result.energy_only is not None:

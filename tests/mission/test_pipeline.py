@@ -1,0 +1,54 @@
+"""Pipeline behaviour that needs no optimisation run: limits, failures, exit codes."""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from auvplan.cli.main import main
+from auvplan.errors import InputError, SolverError
+from auvplan.mission import pipeline
+from auvplan.mission.config import parse_mission
+
+MISSION = """
+[terrain]
+synthetic = true
+[fleet]
+horizon_s = 100.0
+safety_radius_m = 5.0
+[[vehicle]]
+name = "a"
+start = { north = 10.0, east = 400.0, speed = 0.5 }
+goal = { north = 60.0, east = 400.0 }
+[solver]
+dt_s = 1.0
+"""
+
+
+def test_start_speed_above_top_speed_names_the_key() -> None:
+    config = parse_mission(tomllib.loads(MISSION.replace("speed = 0.5", "speed = 1.6")))
+    with pytest.raises(InputError, match=r"vehicle\[0\]\.start\.speed = 1\.6 m/s exceeds"):
+        pipeline.fleet_layout(config)
+
+
+def test_optimiser_failure_writes_earlier_stages_and_exits_3(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    def fail(*_args: object, **_kwargs: object) -> None:
+        raise SolverError("the projection of the initial guess diverged")
+
+    monkeypatch.setattr(pipeline, "solve_pronto", fail)
+    mission = tmp_path / "mission.toml"
+    mission.write_text(MISSION)
+    out = tmp_path / "out"
+    assert main(["plan", str(mission), "-o", str(out), "--no-figures"]) == 3
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line.startswith("auvplan: plan FAILED: the optimiser failed")
+    assert "solver.dt_s" in line
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["optimization"]["plan_status"] == "FAILED"
+    assert (out / "desired.csv").is_file()
+    assert not (out / "trajectories.csv").exists()
