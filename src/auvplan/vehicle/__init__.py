@@ -50,6 +50,7 @@ from auvplan.vehicle.simulate import (
     rk4_step_function,
     simulate_adaptive,
 )
+from auvplan.vehicle.stiffness import fastest_mode, stable_rk4_step
 from auvplan.vehicle.trim import (
     BollardPull,
     CruiseOptimum,
@@ -95,6 +96,7 @@ __all__ = [
     "electrical_power",
     "energy",
     "energy_per_metre",
+    "fastest_mode",
     "headings",
     "max_yaw_rate",
     "open_water_thrust_torque",
@@ -105,6 +107,7 @@ __all__ = [
     "rk4_step_function",
     "simulate_adaptive",
     "smoothing_effect",
+    "stable_rk4_step",
     "steady_motion",
     "surge_trim_table",
     "thrust_coefficient",
