@@ -9,6 +9,7 @@ from matplotlib.figure import Figure
 
 from auvplan.vehicle.dynamics import VehicleModel
 from auvplan.vehicle.propulsion import thrust_coefficient, torque_coefficient
+from auvplan.vehicle.reference import positions
 from auvplan.vehicle.simulate import rk4_simulate
 from auvplan.vehicle.trim import top_speed, trim_surge, trim_turn
 
@@ -109,10 +110,16 @@ def plot_vehicle_validation(
     turn = trim_turn(model, turn_speed, turn_rate)
     period = 2.0 * np.pi / abs(turn_rate)
     n_steps = 400
-    start = np.array([0.0, 0.0, 0.0, turn_speed, turn.v, turn_rate, turn.n_ps, turn.n_sb])
-    states = rk4_simulate(model, start, np.zeros((n_steps, 2)), period / n_steps)
+    start = np.zeros(model.n_x)
+    for name, value in (
+        ("u", turn_speed), ("v", turn.v), ("r", turn_rate), ("n_ps", turn.n_ps),
+        ("n_sb", turn.n_sb),
+    ):  # fmt: skip
+        start[model.index(name)] = value
+    states = rk4_simulate(model, start, np.zeros((n_steps, model.n_u)), period / n_steps)
     radius = float(np.hypot(turn_speed, turn.v) / abs(turn_rate))
-    turn_axes.plot(states[:, 1], states[:, 0], color="tab:purple")
+    track = positions(model, states)
+    turn_axes.plot(track[:, 1], track[:, 0], color="tab:purple")
     turn_axes.plot([0.0], [0.0], "o", color="k", label="start (heading north)")
     turn_axes.set_aspect("equal")
     turn_axes.set_xlabel("east [m]")
