@@ -7,11 +7,12 @@ two vehicles come closer than ``2 r_c``, certified in continuous time.
 from __future__ import annotations
 
 from auvplan.deconfliction.conflicts import ConflictTable, build_conflict_table
-from auvplan.deconfliction.coordination import deconflict
+from auvplan.deconfliction.coordination import AstarHeuristic, deconflict
 from auvplan.deconfliction.problem import CoordinationProblem, headings_along, positions_along
 from auvplan.deconfliction.result import (
     CoordinationResult,
     CoordinationStatus,
+    DeconflictionMethod,
     SeparationCertificate,
 )
 from auvplan.deconfliction.schedule import (
@@ -23,10 +24,12 @@ from auvplan.deconfliction.schedule import (
 )
 
 __all__ = [
+    "AstarHeuristic",
     "ConflictTable",
     "CoordinationProblem",
     "CoordinationResult",
     "CoordinationStatus",
+    "DeconflictionMethod",
     "SeparationCertificate",
     "arrival_times_of",
     "build_conflict_table",

@@ -115,15 +115,19 @@ class CoordinationProblem:
         speeds.flags.writeable = False
         lengths = np.array([arc[-1] for arc in arcs])
         steps = speeds * self.time_step
-        # the small tolerance keeps L = 60.0, h = 0.01 at 6000 steps, not 6001 by rounding
-        n_steps = np.ceil(lengths / steps * (1.0 - 1e-12)).astype(np.int64)
-        n_steps = np.maximum(n_steps, 1)
-        if np.any(n_steps > MAX_STEPS_PER_VEHICLE):
-            worst = int(np.argmax(n_steps))
+        # in floating point first: a tiny speed must not overflow the integer step count.
+        # The small tolerance keeps L = 60.0, h = 0.01 at 6000 steps, not 6001 by rounding
+        n_float = np.ceil(lengths / steps * (1.0 - 1e-12))
+        if not np.all(n_float <= MAX_STEPS_PER_VEHICLE):  # also catches inf and nan
+            worst = int(np.argmax(np.where(np.isfinite(n_float), n_float, np.inf)))
             raise InputError(
-                f"vehicle {self.label(worst)} needs {int(n_steps[worst])} time steps "
-                f"(> {MAX_STEPS_PER_VEHICLE}); increase time_step={self.time_step} s"
+                f"vehicle {self.label(worst)} needs {n_float[worst]:.3g} grid steps "
+                f"(> {MAX_STEPS_PER_VEHICLE}) for its {lengths[worst]:.0f} m path at "
+                f"{speeds[worst]:.3g} m/s with time_step = {self.time_step:g} s; raise the "
+                "cruise speed (fleet.cruise_speed, or a shorter fleet.horizon_s) or "
+                "deconfliction.time_step_s"
             )
+        n_steps = np.maximum(n_float.astype(np.int64), 1)
         object.__setattr__(self, "paths", tuple(cleaned))
         object.__setattr__(self, "cruise_speeds", speeds)
         object.__setattr__(self, "arc_lengths", tuple(arcs))

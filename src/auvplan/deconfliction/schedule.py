@@ -24,12 +24,8 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.deconfliction.problem import CoordinationProblem, headings_along, positions_along
-from auvplan.deconfliction.result import (
-    CoordinationResult,
-    CoordinationStatus,
-    SeparationCertificate,
-)
-from auvplan.errors import InputError
+from auvplan.deconfliction.result import CoordinationResult, SeparationCertificate
+from auvplan.errors import InfeasibleError, InputError
 
 logger = logging.getLogger(__name__)
 
@@ -312,18 +308,20 @@ def retime_for_arrival(
             early.append(i)
     certificate = certify_separation(problem, time, progress)
     arrivals = arrival_times_of(problem, time, progress)
-    status = result.status
     message = f"{result.message}; retimed to arrive at {final_time:.6g} s"
     if early:
         message += f" (vehicles {early} arrive early and wait at their goals)"
         logger.warning("retime_for_arrival: vehicles %s could not be slowed down safely", early)
     if not certificate.holds:
-        status = CoordinationStatus.UNCERTIFIED
-        message += f"; separation NOT certified ({certificate.min_separation:.4g} m)"
+        i, j = certificate.pair
+        raise InfeasibleError(
+            f"retiming vehicles {problem.label(i)} and {problem.label(j)} to arrive at "
+            f"{final_time:.6g} s is not certified ({certificate.min_separation:.4g} m < "
+            f"2 r_c = {problem.separation:g} m at t = {certificate.time:.6g} s)"
+        )
     delays = arrivals - problem.nominal_arrival_times
     return dataclasses.replace(
         result,
-        status=status,
         message=message,
         time=time,
         progress=progress,
