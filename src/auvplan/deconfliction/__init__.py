@@ -15,10 +15,10 @@ from auvplan.deconfliction.result import (
     DeconflictionMethod,
     SeparationCertificate,
 )
+from auvplan.deconfliction.retime import retime_for_arrival
 from auvplan.deconfliction.schedule import (
     arrival_times_of,
     certify_separation,
-    retime_for_arrival,
     timed_headings,
     timed_positions,
 )

@@ -167,7 +167,7 @@ def deconflict(
     ...     (np.array([[-10.0, 0.0], [10.0, 0.0]]), np.array([[0.0, -10.0], [0.0, 10.0]])),
     ...     safety_radius=1.0, cruise_speeds=np.ones(2), time_step=0.5)
     >>> result = deconflict(problem, weight=1.0)
-    >>> result.status.name, result.method, result.min_separation >= 2.0
+    >>> result.status.name, str(result.method), result.min_separation >= 2.0
     ('OPTIMAL', 'astar', True)
     >>> float(result.delays.max()) > 0, result.fallback
     (True, '')

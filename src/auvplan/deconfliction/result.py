@@ -110,6 +110,7 @@ class CoordinationResult:
     objective: tuple[float, float]
     fallback: str = ""
     speeds: FloatArray | None = None
+    within_limits: tuple[bool, ...] = ()
 
     @property
     def success(self) -> bool:
