@@ -60,9 +60,11 @@ CASES = (
     ("paper 4v 60s one point", 4, 60.0, 1.0, "astar", 25),
     ("paper 4v 60s one point", 4, 60.0, 1.0, "astar", 50),
     ("paper 4v 60s one point", 4, 60.0, 1.0, "prioritized", 1),
+    ("paper 4v 60s one point", 4, 60.0, 1.0, "auto", 1),
     ("paper 4v 60s spread", 4, 60.0, 10.0, "astar", 1),
     ("paper 4v 60s spread", 4, 60.0, 10.0, "astar", 50),
     ("paper 4v 60s spread", 4, 60.0, 10.0, "prioritized", 1),
+    ("paper 4v 60s spread", 4, 60.0, 10.0, "auto", 1),
     ("8v 60s", 8, 60.0, 1.0, "prioritized", 1),
     ("8v 600s", 8, 600.0, 1.0, "prioritized", 1),
     ("16v 600s", 16, 600.0, 1.0, "prioritized", 1),
@@ -132,6 +134,8 @@ def main() -> None:
             f"{result.delays.sum():>15.2f} {result.delays.max():>13.2f} "
             f"{result.min_separation:>8.3f} >= {problem.separation:g}"
         )
+        if result.fallback:
+            print(f"{'':<24} -> ran {result.method}: {result.fallback}")
 
 
 if __name__ == "__main__":

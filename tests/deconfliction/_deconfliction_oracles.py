@@ -38,12 +38,24 @@ def dense_min_separation(
     fine = np.linspace(0.0, result.time[-1], (result.time.size - 1) * n_per_step + 1)
     positions = []
     for i, path in enumerate(problem.paths):
-        s = np.interp(fine, result.time, result.progress[i])
-        positions.append(np.array([polyline_point(path, float(v)) for v in s]))
+        s = [law_at(result, i, float(t)) for t in fine]
+        positions.append(np.array([polyline_point(path, v) for v in s]))
     best = np.inf
     for i, j in itertools.combinations(range(problem.n_vehicles), 2):
         best = min(best, float(np.hypot(*(positions[i] - positions[j]).T).min()))
     return best
+
+
+def law_at(result: CoordinationResult, vehicle: int, t: float) -> float:
+    """Arc length at ``t``: linear between samples, or integrated from the linear speed."""
+    m = min(int(np.searchsorted(result.time, t, side="right")) - 1, result.time.size - 2)
+    t0, t1 = result.time[m], result.time[m + 1]
+    s0, s1 = result.progress[vehicle, m], result.progress[vehicle, m + 1]
+    if result.speeds is None or np.isnan(result.speeds[vehicle, m]):
+        return float(s0 + (s1 - s0) * (t - t0) / (t1 - t0))
+    v0, v1 = result.speeds[vehicle, m], result.speeds[vehicle, m + 1]
+    acceleration = (v1 - v0) / (t1 - t0)
+    return float(s0 + v0 * (t - t0) + 0.5 * acceleration * (t - t0) ** 2)
 
 
 def grid_collides(problem: CoordinationProblem, k: tuple[int, ...]) -> bool:

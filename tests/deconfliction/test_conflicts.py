@@ -10,6 +10,7 @@ from auvplan.deconfliction._conflict_kernels import (
     DEAD_END,
     pair_cost_to_go,
     pair_reachability,
+    shadow_cells,
 )
 from auvplan.deconfliction.conflicts import build_pair_heuristic, inflated_radius
 
@@ -80,10 +81,17 @@ def test_pair_cost_to_go_and_reachability_match_brute_force(seed: int) -> None:
     expected = brute_cost_to_go(forbidden)
     n_i, n_j = (int(n) for n in problem.n_steps)
     rows = table.row_ptr[: n_i + 2]
-    first, start, length, values, count = pair_cost_to_go(
-        rows, table.lo, table.hi, n_i, n_j, np.empty(8, dtype=np.uint16), 0
+    first, start, length, values, count, n_cells = pair_cost_to_go(
+        rows, table.lo, table.hi, n_i, n_j, np.empty(8, dtype=np.uint16), 0, 10**9
     )
-    assert count == int(length.sum())
+    assert count == int(length.sum()) <= n_cells
+    # the estimate made before allocating counts at least every forbidden cell
+    assert shadow_cells(rows, table.lo, table.hi, n_i, n_j) >= int(forbidden.sum())
+    # a budget below the windows stops the programme and says so
+    *_, n_stopped = pair_cost_to_go(
+        rows, table.lo, table.hi, n_i, n_j, np.empty(8, dtype=np.uint16), 0, n_cells - 1
+    )
+    assert n_cells == 0 or n_stopped > n_cells - 1
     for a in range(n_i + 1):
         for b in range(n_j + 1):
             if forbidden[a, b]:
@@ -107,4 +115,21 @@ def test_pair_heuristic_skips_pairs_that_never_meet() -> None:
     )
     table = build_conflict_table(far, ordered_pairs=((0, 1),))
     assert table.lo.size == 0
-    assert build_pair_heuristic(far, table).pair_base.tolist() == [-1, -1, -1, -1]
+    heuristic = build_pair_heuristic(far, table)
+    assert heuristic is not None
+    assert heuristic.pair_base.tolist() == [-1, -1, -1, -1]
+
+
+def test_shadow_estimate_is_exact_for_a_crossing() -> None:
+    # two straight 40 m paths crossing at 60 degrees: the raised cost-to-go fills exactly the
+    # diagonal shadow of the forbidden blob (what the budget check relies on)
+    direction = np.array([[np.cos(a), np.sin(a)] for a in (0.3, 0.3 + np.pi / 3)])
+    s = np.linspace(-20.0, 20.0, 3)[:, None]
+    problem = CoordinationProblem((s * direction[0], s * direction[1] + 0.5), 2.0, np.ones(2), 0.05)
+    table = build_conflict_table(problem, ordered_pairs=((0, 1),))
+    n_i, n_j = (int(n) for n in problem.n_steps)
+    rows = table.row_ptr[: n_i + 2]
+    heuristic = build_pair_heuristic(problem, table)
+    assert heuristic is not None
+    assert shadow_cells(rows, table.lo, table.hi, n_i, n_j) == heuristic.excess.size > 10_000
+    assert build_pair_heuristic(problem, table, max_cells=heuristic.excess.size - 1) is None

@@ -17,11 +17,12 @@ from auvplan.deconfliction import (
     CoordinationProblem,
     CoordinationResult,
     CoordinationStatus,
+    DeconflictionMethod,
     deconflict,
     timed_headings,
     timed_positions,
 )
-from auvplan.errors import InfeasibleError, InputError
+from auvplan.errors import InfeasibleError, InputError, SolverError
 
 METHODS = [("astar", 1.0), ("astar", None), ("prioritized", None)]
 
@@ -170,6 +171,8 @@ def test_bad_options() -> None:
         deconflict(problem, method="prioritized", weight=2.0)
     with pytest.raises(InputError, match="heuristic"):
         deconflict(problem, heuristic="euclid")
+    by_enum = deconflict(problem, method=DeconflictionMethod.PRIORITIZED)
+    assert by_enum.method == "prioritized"
 
 
 def test_single_vehicle_is_its_nominal_schedule() -> None:
@@ -310,3 +313,41 @@ def test_sixteen_vehicles_ten_minutes_at_the_papers_grid() -> None:
     result = deconflict(problem, method="prioritized")
     assert result.certificate.holds
     assert vectorised_dense_min_separation(problem, result, 3) >= problem.separation - 1e-9
+
+
+@pytest.mark.parametrize(
+    ("max_expanded", "method"), [(60_000, DeconflictionMethod.ASTAR), (2_000, "prioritized")]
+)
+def test_auto_falls_back_when_astar_exhausts_its_budget(max_expanded: int, method: str) -> None:
+    # four vehicles through one point at the paper's 0.01 s grid: exact A* exceeds its
+    # budget; auto then searches a 25x coarser grid (5.5e4 expansions), else plans by priority
+    problem = star_of_vehicles(4, 60.0, 0.01)
+    with pytest.raises(SolverError, match="max_expanded"):
+        deconflict(problem, method="astar", max_expanded=max_expanded)
+    result = deconflict(problem, max_expanded=max_expanded)
+    check_schedule(problem, result)
+    assert result.method == method
+    assert f"max_expanded = {max_expanded}" in result.fallback
+    assert result.fallback in result.message
+    assert result.time[1] == pytest.approx(0.01)
+
+
+@pytest.mark.slow
+def test_auto_falls_back_at_the_default_budget() -> None:
+    # the failure of issue 11: "A* expanded max_expanded=1000000 ... use method='prioritized'"
+    problem = star_of_vehicles(4, 60.0, 0.01)
+    result = deconflict(problem)
+    check_schedule(problem, result)
+    assert result.method is DeconflictionMethod.ASTAR
+    assert "max_expanded = 1000000" in result.fallback
+    assert "25x coarser" in result.fallback
+
+
+def test_auto_uses_prioritized_planning_beyond_four_vehicles() -> None:
+    problem = crossing([0.0, 30.0, 60.0, 90.0, 120.0, 150.0], half_length=12.0, time_step=0.5)
+    result = deconflict(problem)
+    check_schedule(problem, result)
+    assert result.method is DeconflictionMethod.PRIORITIZED
+    assert "6 vehicles > 4" in result.fallback
+    small = deconflict(crossing([0.0, 90.0], half_length=12.0, time_step=0.5))
+    assert (small.method, small.fallback) == (DeconflictionMethod.ASTAR, "")

@@ -61,7 +61,8 @@ def test_repeated_points_are_dropped() -> None:
         ({"cruise_speeds": np.array([1.0])}, "cruise_speeds"),
         ({"cruise_speeds": np.array([1.0, -1.0])}, "cruise_speeds"),
         ({"time_step": 0.0}, "time_step"),
-        ({"time_step": 1e-9}, "time steps"),
+        ({"time_step": 1e-9}, "grid steps"),
+        ({"cruise_speeds": np.array([1.0, 1e-17])}, "cruise speed"),
     ],
 )
 def test_invalid_input_is_named(overrides: dict[str, object], fragment: str) -> None:

@@ -8,14 +8,13 @@ from _deconfliction_oracles import dense_min_separation, distance_to_polyline
 
 from auvplan.deconfliction import (
     CoordinationProblem,
-    CoordinationStatus,
     arrival_times_of,
     certify_separation,
     deconflict,
     retime_for_arrival,
     timed_positions,
 )
-from auvplan.errors import InputError
+from auvplan.errors import InfeasibleError, InputError
 
 
 def four_way() -> CoordinationProblem:
@@ -113,7 +112,7 @@ def test_retime_rejects_a_final_time_before_the_makespan() -> None:
         retime_for_arrival(result, problem, result.makespan - 1.0)
 
 
-def test_uncertified_schedule_is_flagged() -> None:
+def test_uncertified_schedule_is_never_returned() -> None:
     problem = four_way()
     result = deconflict(problem, method="prioritized")
     nominal = np.minimum(
@@ -121,10 +120,8 @@ def test_uncertified_schedule_is_flagged() -> None:
     )
     nominal[:, -1] = problem.path_lengths
     collide = dataclasses.replace(result, progress=nominal)
-    retimed = retime_for_arrival(collide, problem, result.makespan + 1.0)
-    assert retimed.status is CoordinationStatus.UNCERTIFIED
-    assert not retimed.success
-    assert "NOT certified" in retimed.message
+    with pytest.raises(InfeasibleError, match=r"vehicles \d and \d .*not certified"):
+        retime_for_arrival(collide, problem, result.makespan + 1.0)
 
 
 def test_arrival_times_of_requires_arrival() -> None:

@@ -11,26 +11,29 @@ from auvplan.deconfliction.conflicts import (
     build_conflict_table,
     check_endpoint_clearance,
 )
-from auvplan.deconfliction.coordination import deconflict
+from auvplan.deconfliction.coordination import AstarHeuristic, deconflict
 from auvplan.deconfliction.problem import CoordinationProblem, headings_along, positions_along
 from auvplan.deconfliction.result import (
     CoordinationResult,
     CoordinationStatus,
+    DeconflictionMethod,
     SeparationCertificate,
 )
+from auvplan.deconfliction.retime import retime_for_arrival
 from auvplan.deconfliction.schedule import (
     arrival_times_of,
     certify_separation,
-    retime_for_arrival,
     timed_headings,
     timed_positions,
 )
 
 __all__ = [
+    "AstarHeuristic",
     "ConflictTable",
     "CoordinationProblem",
     "CoordinationResult",
     "CoordinationStatus",
+    "DeconflictionMethod",
     "SeparationCertificate",
     "arrival_times_of",
     "build_conflict_table",

@@ -21,14 +21,28 @@ pair in the per-row interval lists when it is generated; the N-D grid is never s
 
 from __future__ import annotations
 
+import enum
+
 import numba
 import numpy as np
 import numpy.typing as npt
 
 from auvplan._typing import FloatArray, IntArray
+from auvplan.deconfliction._buffers import grow
 from auvplan.deconfliction._conflict_kernels import DEAD_END
 
 EMPTY = -1
+
+
+class AstarOutcome(enum.IntEnum):
+    """How :func:`astar_coordination` ended."""
+
+    FOUND = 0
+    """The goal was reached; the path is returned."""
+    NO_SCHEDULE = 1
+    """The open list ran empty: no collision-free schedule exists on the grid."""
+    BUDGET_EXHAUSTED = 2
+    """``max_expanded`` expansions or ``max_stored`` nodes without reaching the goal."""
 
 
 @numba.njit(cache=True)
@@ -131,7 +145,8 @@ def astar_coordination(
     heur_excess: npt.NDArray[np.uint16],
     weight: float,
     max_expanded: int,
-) -> tuple[int, IntArray, int]:
+    max_stored: int,
+) -> tuple[AstarOutcome, IntArray, int]:
     """Weighted A* from ``(0, …, 0)`` to ``(n_1, …, n_N)``.
 
     Parameters
@@ -149,11 +164,13 @@ def astar_coordination(
         Heuristic weight (>= 1).
     max_expanded : int
         Expansion budget.
+    max_stored : int
+        Memory budget: the largest number of stored nodes, and of heap entries.
 
     Returns
     -------
-    code : int
-        0 found, 1 open list exhausted (no collision-free grid schedule), 2 budget exhausted.
+    outcome : AstarOutcome
+        Found, no collision-free grid schedule, or budget exhausted.
     path : ndarray of shape (n_moves + 1, N)
         Grid indices along the found path (empty when not found).
     n_expanded : int
@@ -173,7 +190,7 @@ def astar_coordination(
     node_steps = np.empty(cap_nodes, dtype=np.int64)
     node_waits = np.empty(cap_nodes, dtype=np.int64)
     node_parent = np.empty(cap_nodes, dtype=np.int64)
-    node_closed = np.zeros(cap_nodes, dtype=np.bool_)
+    node_closed = np.empty(cap_nodes, dtype=np.bool_)
     node_h = np.empty(cap_nodes, dtype=np.int64)
     n_nodes = 0
     # hash table key -> node id
@@ -196,15 +213,16 @@ def astar_coordination(
     all_moved = np.ones(n, dtype=np.int64)
 
     if not _is_free(k, all_moved, pair_base, row_ptr, lo, hi):
-        return 1, np.zeros((0, n), dtype=np.int64), 0
+        return AstarOutcome.NO_SCHEDULE, np.zeros((0, n), dtype=np.int64), 0
 
     h0 = _heuristic(k, n_steps, heur_base, heur_first, heur_start, heur_len, heur_excess)
     if h0 < 0:
-        return 1, np.zeros((0, n), dtype=np.int64), 0
+        return AstarOutcome.NO_SCHEDULE, np.zeros((0, n), dtype=np.int64), 0
     node_key[0] = 0
     node_steps[0] = 0
     node_waits[0] = 0
     node_parent[0] = -1
+    node_closed[0] = False
     node_h[0] = h0
     n_nodes = 1
     slot = _find_slot(table_keys, 0, mask)
@@ -252,7 +270,7 @@ def astar_coordination(
         node_closed[current] = True
         n_expanded += 1
         if n_expanded > max_expanded:
-            return 2, np.zeros((0, n), dtype=np.int64), n_expanded - 1
+            return AstarOutcome.BUDGET_EXHAUSTED, np.zeros((0, n), dtype=np.int64), n_expanded - 1
         # decode
         rest = node_key[current]
         n_active = 0
@@ -300,32 +318,21 @@ def astar_coordination(
                 )
                 if h < 0:
                     continue  # dead end: some pair can no longer reach its goal
-                if n_nodes >= cap_nodes:
-                    new_cap = 2 * cap_nodes
-                    grown_key = np.empty(new_cap, dtype=np.int64)
-                    grown_key[:n_nodes] = node_key[:n_nodes]
-                    node_key = grown_key
-                    grown_steps = np.empty(new_cap, dtype=np.int64)
-                    grown_steps[:n_nodes] = node_steps[:n_nodes]
-                    node_steps = grown_steps
-                    grown_waits = np.empty(new_cap, dtype=np.int64)
-                    grown_waits[:n_nodes] = node_waits[:n_nodes]
-                    node_waits = grown_waits
-                    grown_parent = np.empty(new_cap, dtype=np.int64)
-                    grown_parent[:n_nodes] = node_parent[:n_nodes]
-                    node_parent = grown_parent
-                    grown_closed = np.zeros(new_cap, dtype=np.bool_)
-                    grown_closed[:n_nodes] = node_closed[:n_nodes]
-                    node_closed = grown_closed
-                    grown_h = np.empty(new_cap, dtype=np.int64)
-                    grown_h[:n_nodes] = node_h[:n_nodes]
-                    node_h = grown_h
-                    cap_nodes = new_cap
+                if n_nodes >= max_stored:
+                    return AstarOutcome.BUDGET_EXHAUSTED, np.zeros((0, n), np.int64), n_expanded
+                if n_nodes >= node_key.shape[0]:
+                    node_key = grow(node_key, n_nodes, 0)
+                    node_steps = grow(node_steps, n_nodes, 0)
+                    node_waits = grow(node_waits, n_nodes, 0)
+                    node_parent = grow(node_parent, n_nodes, 0)
+                    node_closed = grow(node_closed, n_nodes, 0)
+                    node_h = grow(node_h, n_nodes, 0)
                 target = n_nodes
                 node_key[target] = key
                 node_steps[target] = steps
                 node_waits[target] = waits
                 node_parent[target] = current
+                node_closed[target] = False
                 node_h[target] = h
                 n_nodes += 1
                 table_keys[slot] = key
@@ -340,21 +347,13 @@ def astar_coordination(
                         table_keys[s] = node_key[m]
                         table_node[s] = m
             # push
-            if heap_size >= cap_heap:
-                new_cap = 2 * cap_heap
-                grown_f = np.empty(new_cap)
-                grown_f[:heap_size] = heap_f[:heap_size]
-                heap_f = grown_f
-                grown_w = np.empty(new_cap, dtype=np.int64)
-                grown_w[:heap_size] = heap_w[:heap_size]
-                heap_w = grown_w
-                grown_g = np.empty(new_cap, dtype=np.int64)
-                grown_g[:heap_size] = heap_g[:heap_size]
-                heap_g = grown_g
-                grown_node = np.empty(new_cap, dtype=np.int64)
-                grown_node[:heap_size] = heap_node[:heap_size]
-                heap_node = grown_node
-                cap_heap = new_cap
+            if heap_size >= max_stored:
+                return AstarOutcome.BUDGET_EXHAUSTED, np.zeros((0, n), np.int64), n_expanded
+            if heap_size >= heap_f.shape[0]:
+                heap_f = grow(heap_f, heap_size, 0)
+                heap_w = grow(heap_w, heap_size, 0)
+                heap_g = grow(heap_g, heap_size, 0)
+                heap_node = grow(heap_node, heap_size, 0)
             pos = heap_size
             heap_f[pos] = steps + weight * h
             heap_w[pos] = waits
@@ -369,7 +368,7 @@ def astar_coordination(
                 else:
                     break
     if found < 0:
-        return 1, np.zeros((0, n), dtype=np.int64), n_expanded
+        return AstarOutcome.NO_SCHEDULE, np.zeros((0, n), dtype=np.int64), n_expanded
     length = node_steps[found] + 1
     path = np.empty((length, n), dtype=np.int64)
     node = found
@@ -379,4 +378,4 @@ def astar_coordination(
             path[m, i] = rest // stride[i]
             rest -= path[m, i] * stride[i]
         node = node_parent[node]
-    return 0, path, n_expanded
+    return AstarOutcome.FOUND, path, n_expanded

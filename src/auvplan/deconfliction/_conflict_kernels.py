@@ -15,6 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from auvplan._typing import FloatArray, IntArray
+from auvplan.deconfliction._buffers import grow
 
 ROW_BLOCK = 64
 SEGMENT_BLOCK = 32
@@ -38,13 +39,6 @@ def _bounding_circle(points: FloatArray, first: int, stop: int) -> tuple[float, 
     for r in range(first, stop):
         radius = max(radius, np.hypot(points[r, 0] - c_n, points[r, 1] - c_e))
     return c_n, c_e, radius
-
-
-@numba.njit(cache=True)
-def _grow(array: IntArray, size: int) -> IntArray:
-    bigger = np.empty(2 * size + 16, dtype=np.int64)
-    bigger[:size] = array[:size]
-    return bigger
 
 
 @numba.njit(cache=True)
@@ -90,9 +84,8 @@ def pair_intervals(
         stop = min(n_seg, first + SEGMENT_BLOCK) + 1
         sb_n[b], sb_e[b], sb_r[b] = _bounding_circle(vertices_j, first, stop)
     row_ptr = np.zeros(n_rows + 2, dtype=np.int64)
-    capacity = 1024
-    out_lo = np.empty(capacity, dtype=np.int64)
-    out_hi = np.empty(capacity, dtype=np.int64)
+    out_lo = np.empty(1024, dtype=np.int64)
+    out_hi = np.empty(1024, dtype=np.int64)
     count = 0
     candidates = np.empty(n_seg, dtype=np.int64)
     buf_lo = np.empty(n_seg + 1, dtype=np.int64)
@@ -159,10 +152,9 @@ def pair_intervals(
                 if q < n_buf and buf_lo[q] <= cur_hi + 1:
                     cur_hi = max(cur_hi, buf_hi[q])
                     continue
-                if count >= capacity:
-                    out_lo = _grow(out_lo, count)
-                    out_hi = _grow(out_hi, count)
-                    capacity = out_lo.shape[0]
+                if count >= out_lo.shape[0]:
+                    out_lo = grow(out_lo, count, 0)
+                    out_hi = grow(out_hi, count, 0)
                 out_lo[count] = cur_lo
                 out_hi[count] = cur_hi
                 count += 1
@@ -232,6 +224,41 @@ def pair_reachability(
     return True, -1, -1
 
 
+@numba.njit(cache=True)
+def shadow_cells(
+    row_ptr: IntArray, lo: IntArray, hi: IntArray, n_i: int, n_j: int
+) -> int:  # pragma: no cover - compiled
+    """Cells of the pair grid on a diagonal before its last forbidden cell (an estimate).
+
+    A node ``(a, b)`` has a cost-to-go above the free bound only if the forbidden set blocks
+    its optimal monotone paths, the straightest of which runs along its diagonal
+    ``d = b - a``; :func:`pair_cost_to_go` computes about this many cells. Diagonal ``d``
+    starts at row ``max(0, -d)``, so it contributes ``a_last(d) - max(0, -d) + 1`` cells,
+    ``a_last(d)`` the last row of a forbidden cell on it. Rows are visited from the last, and
+    a "next unvisited diagonal" forest skips the diagonals already counted, so the work is
+    linear in the rows, intervals and diagonals.
+    """
+    n_diagonals = n_i + n_j + 1
+    next_free = np.arange(n_diagonals + 1, dtype=np.int64)  # union-find "next uncounted"
+    total = 0
+    for a in range(n_i, -1, -1):
+        for q in range(row_ptr[a], row_ptr[a + 1]):
+            d = lo[q] - a + n_i  # diagonal index, 0 … n_i + n_j
+            stop = hi[q] - a + n_i
+            while True:
+                root = d
+                while next_free[root] != root:
+                    root = next_free[root]
+                while next_free[d] != root:  # path compression
+                    d, next_free[d] = next_free[d], root
+                d = root
+                if d > stop:
+                    break
+                total += a - max(0, n_i - d) + 1
+                next_free[d] = d + 1
+    return total
+
+
 UNREACHABLE: Final[int] = 1 << 40
 #: Stored excess values are uint16: ``DEAD_END`` marks nodes that cannot reach the goal and
 #: larger excesses are capped at ``EXCESS_CAP`` (``min`` of consistent heuristics stays
@@ -249,7 +276,8 @@ def pair_cost_to_go(
     n_j: int,
     values: npt.NDArray[np.uint16],
     count: int,
-) -> tuple[IntArray, IntArray, IntArray, npt.NDArray[np.uint16], int]:
+    max_cells: int,
+) -> tuple[IntArray, IntArray, IntArray, npt.NDArray[np.uint16], int, int]:
     r"""Exact two-vehicle cost-to-go (makespan) on the pair's free grid, stored by its excess.
 
     Backward dynamic programme over rows ``a = n_i … 0``:
@@ -264,7 +292,9 @@ def pair_cost_to_go(
     right of ``N_hi`` (the span of its forbidden and non-zero cells), and row ``a`` has no
     forbidden cell outside ``[F_lo, F_hi]``, then ``E(a, b) = 0`` for
     ``b < min(N_lo, F_lo) - 1`` (the diagonal move is free and optimal) and for
-    ``b > max(N_hi, F_hi)``. Rows without obstacles nearby cost nothing.
+    ``b > max(N_hi, F_hi)``. Rows without obstacles nearby cost nothing. The programme stops
+    (``n_cells > max_cells``) before its windows exceed ``max_cells`` cells in total, so that
+    neither its time nor its buffer can outgrow that budget.
 
     Returns
     -------
@@ -278,6 +308,9 @@ def pair_cost_to_go(
         The (possibly grown) buffer.
     count : int
         Number of used entries of ``values``.
+    n_cells : int
+        Number of window cells computed; ``> max_cells`` when the programme stopped at its
+        budget (the rows are then unusable).
     """
     inf = UNREACHABLE
     next_row = np.zeros(n_j + 1, dtype=np.int64)
@@ -286,11 +319,11 @@ def pair_cost_to_go(
     row_first = np.zeros(n_i + 1, dtype=np.int64)
     row_len = np.zeros(n_i + 1, dtype=np.int64)
     starts = np.zeros(n_i + 1, dtype=np.int64)
-    capacity = values.shape[0]
     next_lo = n_j + 1  # window of row a + 1 (empty)
     next_hi = -1
     span_lo = n_j + 1  # span of forbidden / non-zero cells of row a + 1
     span_hi = -1
+    n_cells = 0
     for a in range(n_i, -1, -1):
         f_first = row_ptr[a]
         f_stop = row_ptr[a + 1]
@@ -302,6 +335,9 @@ def pair_cost_to_go(
         w_lo = max(w_lo - 1, 0)
         w_hi = min(w_hi, n_j)
         starts[a] = count
+        n_cells += max(w_hi - w_lo + 1, 0)
+        if n_cells > max_cells:
+            return row_first, starts, row_len, values, count, n_cells
         if w_hi < w_lo:
             next_lo, next_hi = n_j + 1, -1
             span_lo, span_hi = n_j + 1, -1
@@ -345,11 +381,8 @@ def pair_cost_to_go(
                     last_nz = b
         if last_nz >= 0:
             length = last_nz - first_nz + 1
-            while count + length > capacity:
-                grown = np.empty(2 * capacity + length, dtype=np.uint16)
-                grown[:count] = values[:count]
-                values = grown
-                capacity = values.shape[0]
+            if count + length > values.shape[0]:
+                values = grow(values, count, count + length)
             for b in range(first_nz, last_nz + 1):
                 if forbidden[b]:
                     values[count] = 0  # never queried
@@ -365,4 +398,4 @@ def pair_cost_to_go(
             span_lo, span_hi = n_j + 1, -1
         next_lo, next_hi = w_lo, w_hi
         next_row, current = current, next_row
-    return row_first, starts, row_len, values, count
+    return row_first, starts, row_len, values, count, n_cells

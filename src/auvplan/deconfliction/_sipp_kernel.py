@@ -16,6 +16,7 @@ import numba
 import numpy as np
 
 from auvplan._typing import IntArray
+from auvplan.deconfliction._buffers import grow
 
 NEVER = np.int64(1) << np.int64(60)
 
@@ -66,15 +67,13 @@ def earliest_arrival_schedule(
     """
     n_others = others.shape[0]
     # blocked time intervals of one row, then safe intervals
-    cap_buf = 64
-    blk_start = np.empty(cap_buf, dtype=np.int64)
-    blk_end = np.empty(cap_buf, dtype=np.int64)
+    blk_start = np.empty(64, dtype=np.int64)
+    blk_end = np.empty(64, dtype=np.int64)
     # safe intervals of all rows (growable)
-    cap = 4 * (n_steps_i + 1) + 64
-    safe_start = np.empty(cap, dtype=np.int64)
-    safe_end = np.empty(cap, dtype=np.int64)
-    earliest = np.empty(cap, dtype=np.int64)
-    parent = np.empty(cap, dtype=np.int64)
+    safe_start = np.empty(4 * (n_steps_i + 1) + 64, dtype=np.int64)
+    safe_end = np.empty_like(safe_start)
+    earliest = np.empty_like(safe_start)
+    parent = np.empty_like(safe_start)
     row_first = np.empty(n_steps_i + 2, dtype=np.int64)
     n_safe = 0
     for k in range(n_steps_i + 1):
@@ -94,14 +93,9 @@ def earliest_arrival_schedule(
                 t1 = NEVER if hi[q] >= goal else _first_at_least(sched, hi[q] + 1) - 1
                 if t1 < t0:
                     continue
-                if n_blk >= cap_buf:
-                    grown_s = np.empty(2 * cap_buf, dtype=np.int64)
-                    grown_e = np.empty(2 * cap_buf, dtype=np.int64)
-                    grown_s[:n_blk] = blk_start[:n_blk]
-                    grown_e[:n_blk] = blk_end[:n_blk]
-                    blk_start = grown_s
-                    blk_end = grown_e
-                    cap_buf *= 2
+                if n_blk >= blk_start.shape[0]:
+                    blk_start = grow(blk_start, n_blk, 0)
+                    blk_end = grow(blk_end, n_blk, 0)
                 pos = n_blk
                 while pos > 0 and blk_start[pos - 1] > t0:
                     blk_start[pos] = blk_start[pos - 1]
@@ -130,21 +124,11 @@ def earliest_arrival_schedule(
             else:
                 end = NEVER
                 next_free = NEVER
-            if n_safe >= cap:
-                new_cap = 2 * cap
-                for_copy = np.empty(new_cap, dtype=np.int64)
-                for_copy[:n_safe] = safe_start[:n_safe]
-                safe_start = for_copy
-                for_copy = np.empty(new_cap, dtype=np.int64)
-                for_copy[:n_safe] = safe_end[:n_safe]
-                safe_end = for_copy
-                for_copy = np.empty(new_cap, dtype=np.int64)
-                for_copy[:n_safe] = earliest[:n_safe]
-                earliest = for_copy
-                for_copy = np.empty(new_cap, dtype=np.int64)
-                for_copy[:n_safe] = parent[:n_safe]
-                parent = for_copy
-                cap = new_cap
+            if n_safe >= safe_start.shape[0]:
+                safe_start = grow(safe_start, n_safe, 0)
+                safe_end = grow(safe_end, n_safe, 0)
+                earliest = grow(earliest, n_safe, 0)
+                parent = grow(parent, n_safe, 0)
             safe_start[n_safe] = free_from
             safe_end[n_safe] = end
             earliest[n_safe] = NEVER

@@ -24,10 +24,12 @@ import numpy as np
 import numpy.typing as npt
 
 from auvplan._typing import FloatArray, IntArray
+from auvplan.deconfliction._budget import MAX_HEURISTIC_CELLS
 from auvplan.deconfliction._conflict_kernels import (
     pair_cost_to_go,
     pair_intervals,
     pair_reachability,
+    shadow_cells,
 )
 from auvplan.deconfliction.problem import CoordinationProblem
 from auvplan.errors import InfeasibleError
@@ -243,9 +245,28 @@ class PairHeuristic:
     excess: npt.NDArray[np.uint16]
 
 
-def build_pair_heuristic(problem: CoordinationProblem, table: ConflictTable) -> PairHeuristic:
-    """Backward dynamic programme on every pair's 2-D grid (see ``pair_cost_to_go``)."""
+def build_pair_heuristic(
+    problem: CoordinationProblem, table: ConflictTable, *, max_cells: int = MAX_HEURISTIC_CELLS
+) -> PairHeuristic | None:
+    """Backward dynamic programme on every pair's 2-D grid (see ``pair_cost_to_go``).
+
+    Returns None when the pairs need more than ``max_cells`` cells together (the budget of
+    :mod:`auvplan.deconfliction._budget`): estimated before anything is allocated (cells in
+    the diagonal shadow of the forbidden sets, :func:`shadow_cells`), and enforced while
+    computing (the programme stops at the budget).
+    """
     n = problem.n_vehicles
+    pairs = [(i, j) for i in range(n) for j in range(i + 1, n)]
+    rows_of = {
+        (i, j): table.row_ptr[table.pair_base[i * n + j] :][: int(problem.n_steps[i]) + 2]
+        for i, j in pairs
+    }
+    estimate = sum(
+        shadow_cells(rows_of[i, j], table.lo, table.hi, problem.n_steps[i], problem.n_steps[j])
+        for i, j in pairs
+    )
+    if estimate > max_cells:
+        return None
     base = np.full(n * n, -1, dtype=np.int64)
     firsts: list[IntArray] = []
     starts: list[IntArray] = []
@@ -253,27 +274,28 @@ def build_pair_heuristic(problem: CoordinationProblem, table: ConflictTable) -> 
     values = np.empty(1 << 20, dtype=np.uint16)
     count = 0
     n_rows = 0
-    for i in range(n):
-        for j in range(i + 1, n):
-            n_i = int(problem.n_steps[i])
-            pair_rows = table.row_ptr[table.pair_base[i * n + j] :]
-            before = count
-            first, start, length, values, count = pair_cost_to_go(
-                pair_rows[: n_i + 2],
-                table.lo,
-                table.hi,
-                n_i,
-                int(problem.n_steps[j]),
-                values,
-                count,
-            )
-            if count == before:
-                continue  # the pair never interacts: the individual bound is exact
-            base[i * n + j] = n_rows
-            firsts.append(first)
-            starts.append(start)
-            lengths.append(length)
-            n_rows += n_i + 1
+    for i, j in pairs:
+        before = count
+        first, start, length, values, count, n_cells = pair_cost_to_go(
+            rows_of[i, j],
+            table.lo,
+            table.hi,
+            int(problem.n_steps[i]),
+            int(problem.n_steps[j]),
+            values,
+            count,
+            max_cells,
+        )
+        max_cells -= n_cells
+        if max_cells < 0:
+            return None
+        if count == before:
+            continue  # the pair never interacts: the individual bound is exact
+        base[i * n + j] = n_rows
+        firsts.append(first)
+        starts.append(start)
+        lengths.append(length)
+        n_rows += int(problem.n_steps[i]) + 1
     empty = np.zeros(0, dtype=np.int64)
     return PairHeuristic(
         pair_base=base,

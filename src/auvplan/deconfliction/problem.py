@@ -49,6 +49,13 @@ class CoordinationProblem:
         Grid step ``dt`` [s], > 0 (the paper uses 0.01 s).
     names : tuple of str
         Optional vehicle names used in messages (default: the vehicle indices).
+    min_speeds : ndarray of shape (n_vehicles,), optional
+        Smallest useful speed along the path [m/s], ``0 <= min_speeds <= cruise_speeds``
+        (default 0). :func:`~auvplan.deconfliction.retime_for_arrival` keeps the speed above
+        it wherever the schedule allows (waiting by slowing down, not stopping).
+    max_accelerations : ndarray of shape (n_vehicles,), optional
+        Largest speed change along the path [m/s²], > 0 (default inf: no bound). The
+        retimed laws ramp their speed within it wherever the schedule allows.
 
     Examples
     --------
@@ -67,6 +74,8 @@ class CoordinationProblem:
     cruise_speeds: FloatArray
     time_step: float
     names: tuple[str, ...] = ()
+    min_speeds: FloatArray | None = None
+    max_accelerations: FloatArray | None = None
     # derived, filled in __post_init__ (not constructor arguments)
     arc_lengths: tuple[FloatArray, ...] = field(init=False, repr=False, compare=False)
     path_lengths: FloatArray = field(init=False, repr=False, compare=False)
@@ -113,23 +122,48 @@ class CoordinationProblem:
         if not (np.isfinite(self.time_step) and self.time_step > 0.0):
             raise InputError(f"time_step must be > 0 s, got {self.time_step}")
         speeds.flags.writeable = False
+        slowest = self._per_vehicle("min_speeds", self.min_speeds, 0.0)
+        if not np.all((slowest >= 0.0) & (slowest <= speeds)):
+            raise InputError(
+                f"min_speeds must lie in [0, cruise_speeds] m/s, got {slowest.tolist()}"
+            )
+        accelerations = self._per_vehicle("max_accelerations", self.max_accelerations, np.inf)
+        if not np.all(accelerations > 0.0):
+            raise InputError(f"max_accelerations must be > 0 m/s², got {accelerations.tolist()}")
         lengths = np.array([arc[-1] for arc in arcs])
         steps = speeds * self.time_step
-        # the small tolerance keeps L = 60.0, h = 0.01 at 6000 steps, not 6001 by rounding
-        n_steps = np.ceil(lengths / steps * (1.0 - 1e-12)).astype(np.int64)
-        n_steps = np.maximum(n_steps, 1)
-        if np.any(n_steps > MAX_STEPS_PER_VEHICLE):
-            worst = int(np.argmax(n_steps))
+        # in floating point first: a tiny speed must not overflow the integer step count.
+        # The small tolerance keeps L = 60.0, h = 0.01 at 6000 steps, not 6001 by rounding
+        n_float = np.ceil(lengths / steps * (1.0 - 1e-12))
+        if not np.all(n_float <= MAX_STEPS_PER_VEHICLE):  # also catches inf and nan
+            worst = int(np.argmax(np.where(np.isfinite(n_float), n_float, np.inf)))
             raise InputError(
-                f"vehicle {self.label(worst)} needs {int(n_steps[worst])} time steps "
-                f"(> {MAX_STEPS_PER_VEHICLE}); increase time_step={self.time_step} s"
+                f"vehicle {self.label(worst)} needs {n_float[worst]:.3g} grid steps "
+                f"(> {MAX_STEPS_PER_VEHICLE}) for its {lengths[worst]:.0f} m path at "
+                f"{speeds[worst]:.3g} m/s with time_step = {self.time_step:g} s; raise the "
+                "cruise speed (fleet.cruise_speed, or a shorter fleet.horizon_s) or "
+                "deconfliction.time_step_s"
             )
+        n_steps = np.maximum(n_float.astype(np.int64), 1)
         object.__setattr__(self, "paths", tuple(cleaned))
         object.__setattr__(self, "cruise_speeds", speeds)
+        object.__setattr__(self, "min_speeds", slowest)
+        object.__setattr__(self, "max_accelerations", accelerations)
         object.__setattr__(self, "arc_lengths", tuple(arcs))
         object.__setattr__(self, "path_lengths", lengths)
         object.__setattr__(self, "step_lengths", steps)
         object.__setattr__(self, "n_steps", n_steps)
+
+    def _per_vehicle(self, name: str, values: FloatArray | None, default: float) -> FloatArray:
+        """``values`` as a read-only float array of shape (n_vehicles,), or ``default``."""
+        n_vehicles = len(self.paths)
+        array = np.full(n_vehicles, default) if values is None else np.array(values, dtype=float)
+        if array.shape != (n_vehicles,) or np.any(np.isnan(array)):
+            raise InputError(
+                f"{name} must have shape ({n_vehicles},) without NaN, got {array.shape}"
+            )
+        array.flags.writeable = False
+        return array
 
     @property
     def n_vehicles(self) -> int:

@@ -8,8 +8,19 @@ from dataclasses import dataclass
 from auvplan._typing import FloatArray
 
 
+class DeconflictionMethod(enum.StrEnum):
+    """The coordination-space search; the plain strings are accepted too.
+
+    ``AUTO`` chooses and falls back by itself (:func:`auvplan.deconfliction.deconflict`).
+    """
+
+    AUTO = "auto"
+    ASTAR = "astar"
+    PRIORITIZED = "prioritized"
+
+
 class CoordinationStatus(enum.Enum):
-    """How good the returned schedule is (every status except ``UNCERTIFIED`` is safe)."""
+    """How good the returned schedule is (every returned schedule is certified safe)."""
 
     OPTIMAL = "optimal"
     """A* with ``weight = 1``: lexicographic (makespan, total delay) optimum on the grid."""
@@ -17,8 +28,6 @@ class CoordinationStatus(enum.Enum):
     """Weighted A*: makespan at most ``weight`` times the grid optimum."""
     FEASIBLE = "feasible"
     """Prioritised planning: safe, each vehicle arrives as early as the earlier ones allow."""
-    UNCERTIFIED = "uncertified"
-    """The continuous separation certificate failed (a bug or a hand-made schedule)."""
 
 
 @dataclass(frozen=True)
@@ -66,8 +75,8 @@ class CoordinationResult:
         Quality of the schedule.
     message : str
         One line for humans.
-    method : str
-        ``"astar"`` or ``"prioritized"``.
+    method : DeconflictionMethod
+        The search that produced the schedule: ``ASTAR`` or ``PRIORITIZED``.
     weight : float
         Heuristic weight of A* (``nan`` for the prioritised method).
     time : ndarray of shape (n_t,)
@@ -90,7 +99,7 @@ class CoordinationResult:
 
     status: CoordinationStatus
     message: str
-    method: str
+    method: DeconflictionMethod
     weight: float
     time: FloatArray
     progress: FloatArray
@@ -99,11 +108,14 @@ class CoordinationResult:
     certificate: SeparationCertificate
     n_expanded: int
     objective: tuple[float, float]
+    fallback: str = ""
+    speeds: FloatArray | None = None
+    within_limits: tuple[bool, ...] = ()
 
     @property
     def success(self) -> bool:
         """True when the schedule is certified collision-free."""
-        return self.status is not CoordinationStatus.UNCERTIFIED
+        return self.certificate.holds
 
     @property
     def min_separation(self) -> float:

@@ -1,4 +1,4 @@
-r"""Timed schedules: positions, headings, the continuous separation certificate, retiming.
+r"""Timed schedules: positions, headings and the continuous separation certificate.
 
 A schedule is a common time grid ``t_m`` and per vehicle its arc-length progress
 ``s_i(t_m)``; in between, each vehicle moves linearly in arc length. During the step
@@ -17,21 +17,12 @@ is the *certified* separation: a lower bound on the true continuous minimum.
 
 from __future__ import annotations
 
-import dataclasses
-import logging
-
 import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.deconfliction.problem import CoordinationProblem, headings_along, positions_along
-from auvplan.deconfliction.result import (
-    CoordinationResult,
-    CoordinationStatus,
-    SeparationCertificate,
-)
+from auvplan.deconfliction.result import CoordinationResult, SeparationCertificate
 from auvplan.errors import InputError
-
-logger = logging.getLogger(__name__)
 
 #: Relative tolerance [-] on the path length when deciding that a vehicle has arrived.
 ARRIVAL_TOLERANCE = 1e-9
@@ -49,10 +40,14 @@ def _check_schedule(problem: CoordinationProblem, time: FloatArray, progress: Fl
         raise InputError("time must be strictly increasing")
 
 
-def _pair_bound(
+def pair_bound(
     pos_i: FloatArray, pos_j: FloatArray, moved_i: FloatArray, moved_j: FloatArray
 ) -> tuple[float, int, float, float]:
-    """Certified bound, its step, fraction of the step, and the sampled minimum of one pair."""
+    """Certified bound, its step, fraction of the step, and the sampled minimum of one pair.
+
+    ``pos_*`` are the positions ``(n_t, 2)`` [m] at the samples, ``moved_*`` the arc lengths
+    ``(n_t - 1,)`` [m] covered monotonically during each step (module notes).
+    """
     distance = np.hypot(pos_i[:, 0] - pos_j[:, 0], pos_i[:, 1] - pos_j[:, 1])
     sampled = float(distance.min())
     if distance.shape[0] == 1:
@@ -113,7 +108,7 @@ def certify_separation(
     best_sampled = np.inf
     for i in range(n):
         for j in range(i + 1, n):
-            bound, step, fraction, sampled = _pair_bound(
+            bound, step, fraction, sampled = pair_bound(
                 positions[i], positions[j], moved[i], moved[j]
             )
             best_sampled = min(best_sampled, sampled)
@@ -140,6 +135,28 @@ def arrival_times_of(
     return np.asarray(time[np.argmax(reached, axis=1)], dtype=np.float64)
 
 
+def progress_at(result: CoordinationResult, vehicle: int, times: FloatArray) -> FloatArray:
+    r"""Arc length [m] of ``vehicle`` at ``times`` [s] (clamped to the schedule's span).
+
+    Linear between samples, or, where ``result.speeds`` gives the vehicle's speeds,
+    quadratic: :math:`s = s_m + v_m \tau + (v_{m+1} - v_m) \tau^2 / (2 \Delta t_m)`,
+    :math:`\tau = t - t_m` (continuous speed, constant acceleration per step).
+    """
+    time = result.time
+    t = np.clip(np.asarray(times, dtype=np.float64), time[0], time[-1])
+    s = result.progress[vehicle]
+    if result.speeds is None or np.isnan(result.speeds[vehicle, 0]) or time.shape[0] == 1:
+        return np.asarray(np.interp(t, time, s), dtype=np.float64)
+    v = result.speeds[vehicle]
+    m = np.clip(np.searchsorted(time, t, side="right") - 1, 0, time.shape[0] - 2)
+    tau = t - time[m]
+    step = time[m + 1] - time[m]
+    return np.asarray(
+        np.minimum(s[m] + v[m] * tau + (v[m + 1] - v[m]) * tau**2 / (2.0 * step), s[m + 1]),
+        dtype=np.float64,
+    )
+
+
 def timed_positions(
     result: CoordinationResult, problem: CoordinationProblem, times: FloatArray
 ) -> FloatArray:
@@ -160,14 +177,9 @@ def timed_positions(
     >>> timed_positions(result, problem, np.array([0.0, result.time[-1]])).tolist()
     [[[-5.0, 0.0], [5.0, 0.0]], [[0.0, -5.0], [0.0, 5.0]]]
     """
-    times = np.asarray(times, dtype=np.float64)
     return np.stack(
         [
-            positions_along(
-                problem.paths[i],
-                problem.arc_lengths[i],
-                np.interp(times, result.time, result.progress[i]),
-            )
+            positions_along(problem.paths[i], problem.arc_lengths[i], progress_at(result, i, times))
             for i in range(problem.n_vehicles)
         ]
     )
@@ -186,149 +198,9 @@ def timed_headings(
     -------
     ndarray of shape (n_vehicles, n_t)
     """
-    times = np.asarray(times, dtype=np.float64)
     return np.stack(
         [
-            headings_along(
-                problem.paths[i],
-                problem.arc_lengths[i],
-                np.interp(times, result.time, result.progress[i]),
-            )
+            headings_along(problem.paths[i], problem.arc_lengths[i], progress_at(result, i, times))
             for i in range(problem.n_vehicles)
         ]
-    )
-
-
-def _tail_candidates(arrival_index: int) -> list[float]:
-    """Sample (possibly fractional) where a vehicle's slow-down may begin, smoothest first."""
-    a = float(arrival_index)
-    candidates = [0.0]
-    fraction = 0.5
-    while a * fraction >= 1.0 and len(candidates) < 6:
-        candidates.append(a * (1.0 - fraction))
-        fraction *= 0.5
-    candidates += [a - 1.0, a - 0.25]
-    return [b for b in candidates if 0.0 <= b < a]
-
-
-def retime_for_arrival(
-    result: CoordinationResult, problem: CoordinationProblem, final_time: float
-) -> CoordinationResult:
-    r"""Stretch a collision-free schedule so that every vehicle arrives at ``final_time``.
-
-    1. **Common time law.** The whole coordination-space path is replayed at the pace
-       ``makespan / final_time``: ``t' = t · final_time / makespan``. Every configuration, and
-       therefore the certified separation, is unchanged; every speed scales by
-       ``makespan / final_time <= 1``.
-    2. **No early arrivals.** A vehicle that reached its goal at sample ``a < M`` (it would
-       then wait there) is slowed down instead: from a sample ``b < a`` on, its old progress on
-       ``[b, a]`` is spread over ``[b, M]``. The earliest ``b`` (the gentlest slow-down)
-       whose schedule still passes the continuous certificate against all other vehicles is
-       taken; the last candidate moves the vehicle by at most a quarter grid step in the
-       stretched tail, which the grid's collision inflation ``(h_i + h_j)/2`` always allows
-       for schedules produced by :func:`auvplan.deconfliction.deconflict`. If no candidate
-       passes (only possible for schedules from elsewhere), the vehicle keeps waiting at its
-       goal and the message says so.
-
-    Guarantees: the paths are unchanged; speeds never exceed the input schedule's; the
-    returned certificate is recomputed and is at least ``2 r_c`` whenever the input's was.
-
-    Parameters
-    ----------
-    result : CoordinationResult
-        A schedule for ``problem``.
-    problem : CoordinationProblem
-        The paths.
-    final_time : float
-        Common arrival time [s], ``>=`` the schedule's makespan.
-
-    Returns
-    -------
-    CoordinationResult
-        Same status and search counters; new ``time`` (``M + 1`` samples, uniform on
-        ``[0, final_time]``), ``progress``, ``arrival_times``, ``delays`` and certificate.
-
-    Raises
-    ------
-    InputError
-        If ``final_time`` is below the makespan or not finite.
-    """
-    makespan = float(result.time[-1])
-    if not (np.isfinite(final_time) and final_time >= makespan * (1.0 - 1e-12)):
-        raise InputError(
-            f"final_time must be finite and >= the makespan {makespan:.6g} s, got {final_time}"
-        )
-    n_samples = result.time.shape[0]
-    if n_samples == 1:
-        raise InputError("cannot retime a schedule with a single sample")
-    time = result.time * (final_time / makespan)
-    progress = result.progress.copy()
-    last = n_samples - 1
-    samples = np.arange(n_samples, dtype=np.float64)
-    n = problem.n_vehicles
-    positions = [
-        positions_along(problem.paths[i], problem.arc_lengths[i], progress[i]) for i in range(n)
-    ]
-    early: list[int] = []
-    lengths = problem.path_lengths * (1.0 - ARRIVAL_TOLERANCE)
-    for i in range(n):
-        arrival_index = int(np.argmax(progress[i] >= lengths[i]))
-        if arrival_index >= last:
-            continue
-        accepted = False
-        for b in _tail_candidates(arrival_index):
-            first = int(np.floor(b))
-            tail = samples[first:]
-            old = np.interp(
-                b + (tail - b) * (arrival_index - b) / (last - b), samples, result.progress[i]
-            )
-            old[0] = progress[i, first]
-            trial_progress = progress[i].copy()
-            trial_progress[first:] = old
-            trial_progress[-1] = problem.path_lengths[i]
-            start = max(first - 1, 0)
-            trial_pos = positions_along(
-                problem.paths[i], problem.arc_lengths[i], trial_progress[start:]
-            )
-            moved_i = np.abs(np.diff(trial_progress[start:]))
-            ok = True
-            for j in range(n):
-                if j == i:
-                    continue
-                bound, _, _, _ = _pair_bound(
-                    trial_pos, positions[j][start:], moved_i, np.abs(np.diff(progress[j, start:]))
-                )
-                if bound < problem.separation - 1e-9:
-                    ok = False
-                    break
-            if ok:
-                progress[i] = trial_progress
-                positions[i] = positions_along(
-                    problem.paths[i], problem.arc_lengths[i], trial_progress
-                )
-                accepted = True
-                break
-        if not accepted:
-            early.append(i)
-    certificate = certify_separation(problem, time, progress)
-    arrivals = arrival_times_of(problem, time, progress)
-    status = result.status
-    message = f"{result.message}; retimed to arrive at {final_time:.6g} s"
-    if early:
-        message += f" (vehicles {early} arrive early and wait at their goals)"
-        logger.warning("retime_for_arrival: vehicles %s could not be slowed down safely", early)
-    if not certificate.holds:
-        status = CoordinationStatus.UNCERTIFIED
-        message += f"; separation NOT certified ({certificate.min_separation:.4g} m)"
-    delays = arrivals - problem.nominal_arrival_times
-    return dataclasses.replace(
-        result,
-        status=status,
-        message=message,
-        time=time,
-        progress=progress,
-        arrival_times=arrivals,
-        delays=delays,
-        certificate=certificate,
-        objective=(float(arrivals.max()), float(delays.sum())),
     )

@@ -108,7 +108,9 @@ def mission_summary(result: MissionResult) -> dict[str, Any]:
             "message": coordination.message,
             "objective": coordination.objective,
             "n_expanded": coordination.n_expanded,
-            "method": coordination.method,
+            "method": str(coordination.method),
+            "fallback": coordination.fallback,
+            "within_speed_limits": list(coordination.within_limits),
             "certified_min_separation_m": coordination.certificate.min_separation,
             "certificate": dataclasses.asdict(coordination.certificate),
         }

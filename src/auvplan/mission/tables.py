@@ -286,7 +286,9 @@ class DeconflictionConfig(TableModel):
     """Coordination-space deconfliction (see :func:`auvplan.deconfliction.deconflict`)."""
 
     method: Literal["auto", "astar", "prioritized"] = Field(
-        "auto", description="auto: exact A* for small fleets, else prioritized"
+        "auto",
+        description="auto: exact A* for up to 4 vehicles (coarser A* or prioritized when it "
+        "exceeds its budget), else prioritized",
     )
     weight: Number | None = Field(
         None, ge=1.0, le=100.0, description="A* heuristic weight (default sqrt(N))"

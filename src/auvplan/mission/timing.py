@@ -30,7 +30,12 @@ from auvplan.errors import InfeasibleError, InputError
 from auvplan.mission.config import DeconflictionConfig, FleetConfig
 from auvplan.mission.fleet import FleetLayout
 from auvplan.planning import path_length
-from auvplan.vehicle import reference_states, top_speed
+from auvplan.vehicle import (
+    max_surge_acceleration,
+    minimum_useful_speed,
+    reference_states,
+    top_speed,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -38,8 +43,6 @@ logger = logging.getLogger(__name__)
 SPEED_MARGIN: Final = 0.85
 #: Speed-raising rounds when deconfliction overruns a fixed horizon.
 HORIZON_ATTEMPTS: Final = 4
-#: Fleets up to this size use the coordination-space A* under ``method = "auto"``.
-AUTO_ASTAR_MAX_VEHICLES: Final = 4
 #: Largest working memory [bytes] the optimiser may need before the mission is refused.
 MEMORY_BUDGET: Final = 16 * 2**30
 #: Dense arrays of size ``(n_x + n_u)²`` the optimiser keeps per solver step (Jacobians,
@@ -113,12 +116,6 @@ def _nominal_speeds(
     return speeds, horizon
 
 
-def _method(settings: DeconflictionConfig, n_vehicles: int) -> str:
-    if settings.method != "auto":
-        return settings.method
-    return "astar" if n_vehicles <= AUTO_ASTAR_MAX_VEHICLES else "prioritized"
-
-
 def run_deconfliction(
     layout: FleetLayout,
     paths: tuple[FloatArray, ...],
@@ -147,6 +144,8 @@ def run_deconfliction(
     lengths = np.array([path_length(path) for path in paths])
     limits = np.array([SPEED_MARGIN * top_speed(model) for model in layout.models])
     speeds, horizon = _nominal_speeds(fleet, lengths, limits, names)
+    slowest = np.array([minimum_useful_speed(model) for model in layout.models])
+    accelerations = np.array([max_surge_acceleration(model) for model in layout.models])
     for _attempt in range(HORIZON_ATTEMPTS):
         problem = CoordinationProblem(
             paths=paths,
@@ -154,10 +153,12 @@ def run_deconfliction(
             cruise_speeds=speeds,
             time_step=settings.time_step,
             names=names,
+            min_speeds=np.minimum(slowest, speeds),
+            max_accelerations=accelerations,
         )
         coordination = deconflict(
             problem,
-            method=_method(settings, len(paths)),
+            method=settings.method,
             weight=settings.weight,
             coarsening=settings.coarsening,
         )
@@ -180,8 +181,9 @@ def run_deconfliction(
     time = dt * np.arange(n_steps + 1, dtype=np.float64)
     desired = desired_states(layout, problem, coordination, time, start_headings)
     logger.info(
-        "deconfliction (%s): horizon %.1f s, delays %s s, min separation %.2f m",
+        "deconfliction (%s%s): horizon %.1f s, delays %s s, min separation %.2f m",
         coordination.method,
+        f", {coordination.fallback}" if coordination.fallback else "",
         horizon,
         ", ".join(f"{delay:.1f}" for delay in coordination.delays),
         coordination.certificate.min_separation,

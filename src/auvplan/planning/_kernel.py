@@ -17,7 +17,8 @@ Heuristic at a cell ``(r, c)`` with :math:`a = |r - r_g|`, :math:`b = |c - c_g|`
 * crossed: :math:`h = \rho (k \ell_d + (a - k) \Delta_n + (b - k) \Delta_e)` (octile
   distance in metres, the exact shortest 8-connected path length on the anisotropic grid).
 
-Two open lists, both exact (they close every cell with its optimal cost):
+Two open lists, both exact (they close every cell with its optimal cost), served by one
+search loop (:func:`_astar`):
 
 ``astar_heap``
     binary min-heap of ``(f, cell)`` with lazy deletion (stale duplicates are skipped when
@@ -172,92 +173,7 @@ def astar_heap(
     Returns the path as flat padded indices from start to goal (empty if unreachable), its
     cost (``inf`` if unreachable) and the number of expanded cells.
     """
-    offsets, d_row, d_col, length = _moves(n_cols, spacing_north, spacing_east)
-    diagonal = length[0]
-    closed = _open_mask(cost)
-    g = np.full(cost.size, np.inf)
-    parent = np.full(cost.size, -1, np.int32)
-    goal_row = goal // n_cols
-    goal_col = goal - goal_row * n_cols
-
-    capacity = 1024
-    keys = np.empty(capacity)
-    nodes = np.empty(capacity, np.int64)
-    keys[0] = 0.0
-    nodes[0] = start
-    size = 1
-    g[start] = 0.0
-    n_expanded = 0
-    while size > 0:
-        # pop: sink the hole at the root to a leaf, then sift the last entry up into it
-        u = nodes[0]
-        size -= 1
-        key = keys[size]
-        node = nodes[size]
-        i = 0
-        child = 1
-        while child < size:
-            if child + 1 < size and keys[child + 1] < keys[child]:
-                child += 1
-            keys[i] = keys[child]
-            nodes[i] = nodes[child]
-            i = child
-            child = 2 * i + 1
-        while i > 0:
-            up = (i - 1) >> 1
-            if keys[up] <= key:
-                break
-            keys[i] = keys[up]
-            nodes[i] = nodes[up]
-            i = up
-        keys[i] = key
-        nodes[i] = node
-
-        if closed[u]:
-            continue
-        closed[u] = True
-        n_expanded += 1
-        if u == goal:
-            return _trace_path(parent, start, goal), g[goal], n_expanded
-        g_u = g[u]
-        c_u = cost[u]
-        row = u // n_cols
-        col = u - row * n_cols
-        for k in range(8):
-            v = u + offsets[k]
-            if closed[v]:
-                continue
-            g_v = g_u + (length[k] * 0.5 * (c_u + cost[v]) if crossed else cost[v])
-            if g_v < g[v]:
-                g[v] = g_v
-                parent[v] = u
-                f_v = g_v + _heuristic(
-                    row + d_row[k],
-                    col + d_col[k],
-                    goal_row,
-                    goal_col,
-                    crossed,
-                    rate,
-                    spacing_north,
-                    spacing_east,
-                    diagonal,
-                )
-                if size == capacity:
-                    capacity *= 2
-                    keys = np.concatenate((keys, np.empty(size)))
-                    nodes = np.concatenate((nodes, np.empty(size, np.int64)))
-                i = size
-                while i > 0:
-                    up = (i - 1) >> 1
-                    if keys[up] <= f_v:
-                        break
-                    keys[i] = keys[up]
-                    nodes[i] = nodes[up]
-                    i = up
-                keys[i] = f_v
-                nodes[i] = v
-                size += 1
-    return np.empty(0, np.int64), np.inf, n_expanded
+    return _astar(cost, n_cols, start, goal, crossed, spacing_north, spacing_east, rate, 0, 0.0)
 
 
 @njit(cache=True)
@@ -279,44 +195,103 @@ def astar_buckets(
     ``largest reduced edge weight / width + 1`` (see the module docstring); otherwise the same
     arguments and returns as :func:`astar_heap`.
     """
+    return _astar(
+        cost, n_cols, start, goal, crossed, spacing_north, spacing_east, rate, n_buckets, width
+    )
+
+
+@njit(cache=True)
+def _astar(
+    cost: FloatArray,
+    n_cols: int,
+    start: int,
+    goal: int,
+    crossed: bool,
+    spacing_north: float,
+    spacing_east: float,
+    rate: float,
+    n_buckets: int,
+    width: float,
+) -> tuple[IntArray, float, int]:  # pragma: no cover - compiled
+    """A* with the bucket queue when ``n_buckets > 0``, else with the binary heap.
+
+    One search loop serves both open lists: the queue is chosen by a loop-invariant flag
+    (a call per push or pop would cost reference counting of the queue arrays).
+    """
     offsets, d_row, d_col, length = _moves(n_cols, spacing_north, spacing_east)
     diagonal = length[0]
     closed = _open_mask(cost)
-    inv_width = 1.0 / width
     g = np.full(cost.size, np.inf)
     parent = np.full(cost.size, -1, np.int32)
     goal_row = goal // n_cols
     goal_col = goal - goal_row * n_cols
-
-    capacity = 64
-    buckets = np.empty((n_buckets, capacity), np.int32)
-    counts = np.zeros(n_buckets, np.int64)
-    start_row = start // n_cols
-    h_start = _heuristic(
-        start_row,
-        start - start_row * n_cols,
-        goal_row,
-        goal_col,
-        crossed,
-        rate,
-        spacing_north,
-        spacing_east,
-        diagonal,
-    )
-    current = int(h_start * inv_width)  # absolute number of the lowest bucket
-    buckets[current % n_buckets, 0] = start
-    counts[current % n_buckets] = 1
-    n_open = 1
     g[start] = 0.0
+    use_buckets = n_buckets > 0
+
+    # binary heap of (f, cell)
+    capacity = 1024 if not use_buckets else 1
+    keys = np.empty(capacity)
+    nodes = np.empty(capacity, np.int64)
+    # bucket queue: row b holds the cells whose f lies in bucket b (mod n_buckets)
+    bucket_capacity = 64 if use_buckets else 1
+    buckets = np.empty((max(n_buckets, 1), bucket_capacity), np.int32)
+    counts = np.zeros(max(n_buckets, 1), np.int64)
+    inv_width = 1.0 / width if use_buckets else 0.0
+    current = 0  # absolute number of the lowest bucket
+    if use_buckets:
+        start_row = start // n_cols
+        h_start = _heuristic(
+            start_row,
+            start - start_row * n_cols,
+            goal_row,
+            goal_col,
+            crossed,
+            rate,
+            spacing_north,
+            spacing_east,
+            diagonal,
+        )
+        current = int(h_start * inv_width)
+        buckets[current % n_buckets, 0] = start
+        counts[current % n_buckets] = 1
+    else:
+        keys[0] = 0.0
+        nodes[0] = start
+    size = 1
     n_expanded = 0
-    while n_open > 0:
-        b = current % n_buckets
-        if counts[b] == 0:
-            current += 1
-            continue
-        counts[b] -= 1
-        n_open -= 1
-        u = buckets[b, counts[b]]
+    while size > 0:
+        if use_buckets:  # pop from the lowest non-empty bucket (LIFO)
+            b = current % n_buckets
+            if counts[b] == 0:
+                current += 1
+                continue
+            counts[b] -= 1
+            size -= 1
+            u = np.int64(buckets[b, counts[b]])
+        else:  # pop: sink the hole at the root to a leaf, then sift the last entry up into it
+            u = nodes[0]
+            size -= 1
+            key = keys[size]
+            node = nodes[size]
+            i = 0
+            child = 1
+            while child < size:
+                if child + 1 < size and keys[child + 1] < keys[child]:
+                    child += 1
+                keys[i] = keys[child]
+                nodes[i] = nodes[child]
+                i = child
+                child = 2 * i + 1
+            while i > 0:
+                up = (i - 1) >> 1
+                if keys[up] <= key:
+                    break
+                keys[i] = keys[up]
+                nodes[i] = nodes[up]
+                i = up
+            keys[i] = key
+            nodes[i] = node
+
         if closed[u]:
             continue
         closed[u] = True
@@ -332,27 +307,44 @@ def astar_buckets(
             if closed[v]:
                 continue
             g_v = g_u + (length[k] * 0.5 * (c_u + cost[v]) if crossed else cost[v])
-            if g_v < g[v]:
-                g[v] = g_v
-                parent[v] = u
-                f_v = g_v + _heuristic(
-                    row + d_row[k],
-                    col + d_col[k],
-                    goal_row,
-                    goal_col,
-                    crossed,
-                    rate,
-                    spacing_north,
-                    spacing_east,
-                    diagonal,
-                )
+            if g_v >= g[v]:
+                continue
+            g[v] = g_v
+            parent[v] = u
+            f_v = g_v + _heuristic(
+                row + d_row[k],
+                col + d_col[k],
+                goal_row,
+                goal_col,
+                crossed,
+                rate,
+                spacing_north,
+                spacing_east,
+                diagonal,
+            )
+            if use_buckets:  # push onto the bucket of f_v
                 target = int(f_v * inv_width) % n_buckets
-                if counts[target] == capacity:
-                    grown = np.empty((n_buckets, 2 * capacity), np.int32)
-                    grown[:, :capacity] = buckets
+                if counts[target] == bucket_capacity:
+                    grown = np.empty((n_buckets, 2 * bucket_capacity), np.int32)
+                    grown[:, :bucket_capacity] = buckets
                     buckets = grown
-                    capacity *= 2
+                    bucket_capacity *= 2
                 buckets[target, counts[target]] = v
                 counts[target] += 1
-                n_open += 1
+            else:  # push: sift up from the end of the heap
+                if size == capacity:
+                    capacity *= 2
+                    keys = np.concatenate((keys, np.empty(size)))
+                    nodes = np.concatenate((nodes, np.empty(size, np.int64)))
+                i = size
+                while i > 0:
+                    up = (i - 1) >> 1
+                    if keys[up] <= f_v:
+                        break
+                    keys[i] = keys[up]
+                    nodes[i] = nodes[up]
+                    i = up
+                keys[i] = f_v
+                nodes[i] = v
+            size += 1
     return np.empty(0, np.int64), np.inf, n_expanded

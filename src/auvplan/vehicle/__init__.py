@@ -31,6 +31,7 @@ from auvplan.vehicle.dynamics import (
     energy,
     vessel_dynamics,
 )
+from auvplan.vehicle.limits import max_surge_acceleration, minimum_useful_speed
 from auvplan.vehicle.params import HullParams, MotorParams, PropellerParams, VehicleParams
 from auvplan.vehicle.propulsion import (
     open_water_thrust_torque,
@@ -98,7 +99,9 @@ __all__ = [
     "energy_per_metre",
     "fastest_mode",
     "headings",
+    "max_surge_acceleration",
     "max_yaw_rate",
+    "minimum_useful_speed",
     "open_water_thrust_torque",
     "optimal_cruise_speed",
     "positions",
