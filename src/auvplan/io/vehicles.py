@@ -19,8 +19,8 @@ comment lines, a header ``k,A_T,B_T,A_Q,B_Q`` and one row per harmonic ``k = 0..
 
 from __future__ import annotations
 
-import tomllib
 from collections.abc import Mapping
+from dataclasses import dataclass
 from importlib import resources
 from importlib.resources.abc import Traversable
 from pathlib import Path
@@ -30,6 +30,7 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError, InputError
+from auvplan.io.text import read_text, read_toml
 from auvplan.vehicle.params import (
     DEFAULT_EPS_ABS_RATE,
     DEFAULT_EPS_ABS_SPEED,
@@ -64,26 +65,67 @@ _UNITS: Final[dict[str, dict[str, float]]] = {
     "rad/s": {"rad/s": 1.0},
 }
 
-_HULL_UNITS: Final = {
-    "m": "kg",
-    "I_z": "kg m^2",
-    "X_udot": "kg",
-    "Y_vdot": "kg",
-    "N_rdot": "kg m^2",
-    "X_u": "kg/s",
-    "Y_v": "kg/s",
-    "N_r": "kg m^2/s",
-    "X_uu": "kg/m",
-    "Y_vv": "kg/m",
-    "N_rr": "kg m^2",
-    "rho": "kg/m^3",
+
+@dataclass(frozen=True)
+class _Range:
+    """Canonical unit and physically meaningful closed range ``[low, high]`` of a number."""
+
+    unit: str
+    low: float
+    high: float
+
+
+# Ranges span every marine vehicle from a 0.1 kg model to a 10,000 t ship; they reject typos
+# and unit slips (n_max = 1e-9 rev/s, a density of 1.025 kg/m^3), not unusual designs.
+_HULL: Final = {
+    "m": _Range("kg", 0.1, 1e7),
+    "I_z": _Range("kg m^2", 1e-4, 1e12),
+    "X_udot": _Range("kg", -1e7, 0.0),
+    "Y_vdot": _Range("kg", -1e7, 0.0),
+    "N_rdot": _Range("kg m^2", -1e12, 0.0),
+    "X_u": _Range("kg/s", -1e7, 0.0),
+    "Y_v": _Range("kg/s", -1e7, 0.0),
+    "N_r": _Range("kg m^2/s", -1e12, 0.0),
+    "X_uu": _Range("kg/m", -1e7, 0.0),
+    "Y_vv": _Range("kg/m", -1e7, 0.0),
+    "N_rr": _Range("kg m^2", -1e12, 0.0),
+    "rho": _Range("kg/m^3", 950.0, 1100.0),
 }
+_PROPULSION: Final = {
+    "l": _Range("m", 0.005, 50.0),
+    "n_max": _Range("rev/s", 0.5, 1000.0),
+    "w_c": _Range("rev/s^2", 0.01, 1e5),
+}
+_PROPELLER: Final = {
+    "diameter": _Range("m", 0.005, 15.0),
+    "c_T": _Range("1", 0.1, 10.0),
+    "c_Q": _Range("1", 0.1, 10.0),
+}
+_MOTOR: Final = {
+    "R_a": _Range("ohm", 0.0, 1e3),
+    "K_e": _Range("V s/rad", 1e-5, 100.0),
+    "V_bus": _Range("V", 0.5, 1e4),
+    "I_0": _Range("A", 0.0, 1e3),
+}
+_CURRENT_CURVE: Final = {
+    "n": _Range("rev/s", 0.0, 1000.0),
+    "current": _Range("A", 0.0, 1e4),
+}
+_HOTEL: Final = _Range("W", 0.0, 1e7)
 _SMOOTHING: Final = {
-    "inflow": ("m/s", DEFAULT_EPS_INFLOW),
-    "abs_speed": ("m/s", DEFAULT_EPS_ABS_SPEED),
-    "abs_rate": ("rad/s", DEFAULT_EPS_ABS_RATE),
-    "sign_n": ("rev/s", DEFAULT_EPS_SIGN_N),
+    "inflow": _Range("m/s", 1e-6, 1.0),
+    "abs_speed": _Range("m/s", 1e-6, 1.0),
+    "abs_rate": _Range("rad/s", 1e-6, 1.0),
+    "sign_n": _Range("rev/s", 1e-6, 10.0),
 }
+_SMOOTHING_DEFAULTS: Final = {
+    "inflow": DEFAULT_EPS_INFLOW,
+    "abs_speed": DEFAULT_EPS_ABS_SPEED,
+    "abs_rate": DEFAULT_EPS_ABS_RATE,
+    "sign_n": DEFAULT_EPS_SIGN_N,
+}
+#: Largest magnitude of a Fourier coefficient of C_T* or C_Q* (published series stay below 2).
+_MAX_PROPELLER_COEFFICIENT: Final = 10.0
 
 
 def _data_dir(kind: str) -> Traversable:
@@ -128,8 +170,12 @@ def _normalise_unit(unit: str) -> str:
     return " ".join(unit.replace("*", " ").replace("·", " ").split())
 
 
-def _quantity(section: Mapping[str, object], key: str, where: str, unit: str) -> float | FloatArray:
+def _quantity(
+    section: Mapping[str, object], key: str, where: str, expected: _Range
+) -> float | FloatArray:
+    """The value of ``where.key`` in ``expected.unit``, every element inside its range."""
     qualified = f"{where}.{key}"
+    unit = expected.unit
     if key not in section:
         raise DataFormatError(f"missing key '{qualified}' in vehicle file")
     entry = section[key]
@@ -146,23 +192,58 @@ def _quantity(section: Mapping[str, object], key: str, where: str, unit: str) ->
     if isinstance(value, bool):
         raise DataFormatError(f"'{qualified}' must be a number, got {value!r}")
     if isinstance(value, int | float):
-        return float(value) * factor
-    if isinstance(value, list) and all(
+        result: float | FloatArray = float(value) * factor
+    elif isinstance(value, list) and all(
         isinstance(v, int | float) and not isinstance(v, bool) for v in value
     ):
-        return np.asarray(value, dtype=np.float64) * factor
-    raise DataFormatError(f"'{qualified}' must be a number or a list of numbers, got {value!r}")
+        result = np.asarray(value, dtype=np.float64) * factor
+    else:
+        raise DataFormatError(f"'{qualified}' must be a number or a list of numbers, got {value!r}")
+    _check_range(qualified, np.atleast_1d(result), expected)
+    return result
 
 
-def _scalar(section: Mapping[str, object], key: str, where: str, unit: str) -> float:
-    value = _quantity(section, key, where, unit)
+def _check_range(qualified: str, values: FloatArray, expected: _Range) -> None:
+    """Raise InputError naming the key, the first value outside ``expected`` and the range."""
+    span = f"range {expected.low:g} … {expected.high:g} {expected.unit}"
+    for value in values:
+        if not np.isfinite(value):
+            raise InputError(f"{qualified} must be finite ({span}), got {value}")
+        if value < expected.low:
+            raise InputError(
+                f"{qualified} must be >= {expected.low:g} {expected.unit} ({span}), got {value:g}"
+            )
+        if value > expected.high:
+            raise InputError(
+                f"{qualified} must be <= {expected.high:g} {expected.unit} ({span}), got {value:g}"
+            )
+
+
+def _scalar(section: Mapping[str, object], key: str, where: str, expected: _Range) -> float:
+    value = _quantity(section, key, where, expected)
     if not isinstance(value, float):
         raise DataFormatError(f"'{where}.{key}' must be a single number")
     return value
 
 
-def _vector(section: Mapping[str, object], key: str, where: str, unit: str) -> FloatArray:
-    value = _quantity(section, key, where, unit)
+def _scalars(
+    section: Mapping[str, object],
+    where: str,
+    expected: Mapping[str, _Range],
+    defaults: Mapping[str, float] | None = None,
+) -> dict[str, float]:
+    """Every key of ``expected`` read with :func:`_scalar`; absent keys take ``defaults``."""
+    defaults = defaults or {}
+    return {
+        key: defaults[key]
+        if key in defaults and key not in section
+        else _scalar(section, key, where, value_range)
+        for key, value_range in expected.items()
+    }
+
+
+def _vector(section: Mapping[str, object], key: str, where: str, expected: _Range) -> FloatArray:
+    value = _quantity(section, key, where, expected)
     if isinstance(value, float):
         raise DataFormatError(f"'{where}.{key}' must be a list of numbers")
     return value
@@ -198,6 +279,11 @@ def _parse_propeller_table(text: str, origin: str) -> tuple[FloatArray, FloatArr
         raise DataFormatError(f"propeller table {origin}: k must run 0, 1, 2, ... without gaps")
     if not np.all(np.isfinite(table)):
         raise DataFormatError(f"propeller table {origin}: non-finite coefficient")
+    if np.max(np.abs(table[:, 1:])) > _MAX_PROPELLER_COEFFICIENT:
+        raise DataFormatError(
+            f"propeller table {origin}: coefficient {np.max(np.abs(table[:, 1:])):g} beyond "
+            f"±{_MAX_PROPELLER_COEFFICIENT:g} (C_T*, C_Q* are of order 1)"
+        )
     return table[:, 0], table[:, 1:]
 
 
@@ -243,7 +329,7 @@ def load_propeller_table(
     """
     name = str(table)
     if name in packaged_propeller_tables():
-        text = _data_dir("propellers").joinpath(f"{name}.csv").read_text(encoding="utf-8")
+        text = read_text(_data_dir("propellers").joinpath(f"{name}.csv"), what="propeller table")
         source = f"packaged table {name}"
     else:
         path = Path(table)
@@ -254,7 +340,7 @@ def load_propeller_table(
                 f"propeller table {name!r} is neither packaged "
                 f"({', '.join(packaged_propeller_tables())}) nor an existing file"
             )
-        text = path.read_text(encoding="utf-8")
+        text = read_text(path, what="propeller table")
         name = path.stem
         source = str(path)
     _, coefficients = _parse_propeller_table(text, name)
@@ -279,9 +365,7 @@ def _parse_vehicle(document: Mapping[str, object], base_dir: Path | None) -> Veh
     if not isinstance(name, str) or not name:
         raise DataFormatError("missing key 'name' (a non-empty string) in vehicle file")
     hull_section = _section(document, "hull")
-    hull = HullParams(
-        **{key: _scalar(hull_section, key, "hull", unit) for key, unit in _HULL_UNITS.items()}
-    )
+    hull = HullParams(**_scalars(hull_section, "hull", _HULL))
     propulsion = _section(document, "propulsion")
     propeller_section = _section(document, "propeller")
     table = propeller_section.get("table")
@@ -290,11 +374,12 @@ def _parse_vehicle(document: Mapping[str, object], base_dir: Path | None) -> Veh
     order = propeller_section.get("order")
     if order is not None and (not isinstance(order, int) or isinstance(order, bool)):
         raise DataFormatError(f"'propeller.order' must be an integer, got {order!r}")
+    scaling = _scalars(propeller_section, "propeller", _PROPELLER)
     propeller = load_propeller_table(
         table,
-        diameter=_scalar(propeller_section, "diameter", "propeller", "m"),
-        c_T=_scalar(propeller_section, "c_T", "propeller", "1"),
-        c_Q=_scalar(propeller_section, "c_Q", "propeller", "1"),
+        diameter=scaling["diameter"],
+        c_T=scaling["c_T"],
+        c_Q=scaling["c_Q"],
         order=order,
         base_dir=base_dir,
     )
@@ -304,13 +389,14 @@ def _parse_vehicle(document: Mapping[str, object], base_dir: Path | None) -> Veh
     curve_amps: FloatArray | None = None
     if "current_curve" in motor_section:
         curve = _section(motor_section, "current_curve", "motor")
-        curve_n = _vector(curve, "n", "motor.current_curve", "rev/s")
-        curve_amps = _vector(curve, "current", "motor.current_curve", "A")
+        curve_n = _vector(curve, "n", "motor.current_curve", _CURRENT_CURVE["n"])
+        curve_amps = _vector(curve, "current", "motor.current_curve", _CURRENT_CURVE["current"])
+    electrics = _scalars(motor_section, "motor", _MOTOR, {"I_0": 0.0})
     motor = MotorParams(
-        R_a=_scalar(motor_section, "R_a", "motor", "ohm"),
-        K_e=_scalar(motor_section, "K_e", "motor", "V s/rad"),
-        V_bus=_scalar(motor_section, "V_bus", "motor", "V"),
-        I_0=_scalar(motor_section, "I_0", "motor", "A") if "I_0" in motor_section else 0.0,
+        R_a=electrics["R_a"],
+        K_e=electrics["K_e"],
+        V_bus=electrics["V_bus"],
+        I_0=electrics["I_0"],
         current_model=current_model,  # type: ignore[arg-type]  # validated by MotorParams
         current_curve_n=curve_n,
         current_curve_amps=curve_amps,
@@ -318,22 +404,18 @@ def _parse_vehicle(document: Mapping[str, object], base_dir: Path | None) -> Veh
     smoothing_section = document.get("smoothing", {})
     if not isinstance(smoothing_section, Mapping):
         raise DataFormatError("'smoothing' must be a table")
-    smoothing = {
-        key: _scalar(smoothing_section, key, "smoothing", unit)
-        if key in smoothing_section
-        else default
-        for key, (unit, default) in _SMOOTHING.items()
-    }
+    smoothing = _scalars(smoothing_section, "smoothing", _SMOOTHING, _SMOOTHING_DEFAULTS)
+    limits = _scalars(propulsion, "propulsion", _PROPULSION)
     description = document.get("description", "")
     return VehicleParams(
         name=name,
         hull=hull,
         propeller=propeller,
         motor=motor,
-        l=_scalar(propulsion, "l", "propulsion", "m"),
-        hotel_power=_scalar(_section(document, "power"), "hotel", "power", "W"),
-        n_max=_scalar(propulsion, "n_max", "propulsion", "rev/s"),
-        w_c=_scalar(propulsion, "w_c", "propulsion", "rev/s^2"),
+        l=limits["l"],
+        hotel_power=_scalar(_section(document, "power"), "hotel", "power", _HOTEL),
+        n_max=limits["n_max"],
+        w_c=limits["w_c"],
         eps_inflow=smoothing["inflow"],
         eps_abs_speed=smoothing["abs_speed"],
         eps_abs_rate=smoothing["abs_rate"],
@@ -370,23 +452,19 @@ def load_vehicle(type_or_path: str | Path) -> VehicleParams:
     """
     name = str(type_or_path)
     if isinstance(type_or_path, str) and name in packaged_vehicle_types():
-        text = _data_dir("vehicles").joinpath(f"{name}.toml").read_text(encoding="utf-8")
+        document = read_toml(_data_dir("vehicles").joinpath(f"{name}.toml"), what="vehicle file")
         base_dir: Path | None = None
         origin = f"packaged vehicle {name}"
     else:
         path = Path(type_or_path)
-        if not path.is_file():
+        if not path.exists():
             raise InputError(
                 f"unknown vehicle type or missing file {name!r} "
                 f"(packaged types: {', '.join(packaged_vehicle_types())})"
             )
-        text = path.read_text(encoding="utf-8")
+        document = read_toml(path, what="vehicle file")
         base_dir = path.resolve().parent
         origin = str(path)
-    try:
-        document = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        raise DataFormatError(f"vehicle file {origin} is not valid TOML: {error}") from None
     try:
         return _parse_vehicle(document, base_dir)
     except (DataFormatError, InputError) as error:
