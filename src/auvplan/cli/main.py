@@ -3,7 +3,8 @@
 Each verb lives in its own module under :mod:`auvplan.cli` with two functions:
 ``register(subparsers)`` adds its parser (argparse only, no heavy imports) and sets
 ``run=<callable(args) -> int>`` as the parser default. ``-q``/``-v`` are accepted before or
-after the verb.
+after the verb. A verb's ``-o/--output`` names an output folder; it is checked
+(:func:`~auvplan.io.output.check_output_dir`) before the verb runs.
 
 Failures are one line on stderr, never a traceback:
 
@@ -92,6 +93,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     try:
         with _sigterm_raises():
+            if getattr(args, "output", None) is not None:  # every verb's -o is a folder
+                from auvplan.io.output import check_output_dir  # heavy package: only now
+
+                check_output_dir(args.output)  # before any work: fail fast, write nothing
             code: int = args.run(args)
     except AuvplanError as error:
         print(f"auvplan: error: {error}", file=sys.stderr)

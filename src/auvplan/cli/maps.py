@@ -1,8 +1,9 @@
 """``auvplan maps``: terrain-information maps (paper Fig. 5) from a bathymetry file.
 
 Writes ``DIR/maps.nc`` and ``DIR/maps.png`` all-or-nothing: ``DIR`` is checked before any work
-and replaced as a whole at the end (:func:`auvplan.io.output.staged_output_dir`; other files
-already in ``DIR`` are kept); on any error nothing is written.
+(by :mod:`auvplan.cli.main`) and replaced as a whole at the end
+(:func:`auvplan.io.output.staged_output_dir`: other files already in ``DIR`` are kept); on any
+error nothing is written.
 """
 
 from __future__ import annotations
@@ -57,11 +58,10 @@ def run(args: argparse.Namespace) -> int:
     """Compute the maps and write them; returns the exit code."""
     from auvplan.io.bathymetry import read_bathymetry
     from auvplan.io.maps_file import write_maps_netcdf
-    from auvplan.io.output import check_output_dir, staged_output_dir
+    from auvplan.io.output import staged_output_dir
     from auvplan.terrain import MapParameters, compute_terrain_maps, synthetic_bank
     from auvplan.viz.maps import plot_terrain_maps
 
-    check_output_dir(args.output)
     parameters = MapParameters(
         exponent=args.exponent,
         block=(int(args.block[0]), int(args.block[1])),
