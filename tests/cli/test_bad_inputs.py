@@ -52,14 +52,29 @@ def _write(path: Path, content: str | bytes) -> str:
     return str(path)
 
 
-def _netcdf(path: Path, lat: np.ndarray, lon: np.ndarray, elevation: np.ndarray) -> str:
-    dataset = xr.Dataset(
-        {"elevation": (("lat", "lon"), elevation)}, coords={"lat": lat, "lon": lon}
-    )
-    dataset["lat"].attrs["units"] = "degrees_north"
-    dataset["lon"].attrs["units"] = "degrees_east"
-    dataset.to_netcdf(path)
-    return str(path)
+def _maps_on_netcdf(
+    name: str, lat: tuple[float, float], lon: tuple[float, float], elevation: float | np.ndarray
+) -> Callable[[Path], list[str]]:
+    """Arguments of ``auvplan maps`` on a 12 x 12 lat/lon NetCDF of ``elevation`` [m]."""
+
+    def build(tmp: Path) -> list[str]:
+        xr.Dataset(
+            {"elevation": (("lat", "lon"), np.broadcast_to(elevation, (12, 12)))},
+            coords={"lat": np.linspace(*lat, 12), "lon": np.linspace(*lon, 12)},
+        ).to_netcdf(tmp / name)
+        return ["maps", str(tmp / name), "-o", str(tmp / "out")]
+
+    return build
+
+
+def _maps_on_xyz(name: str, table: np.ndarray) -> Callable[[Path], list[str]]:
+    """Arguments of ``auvplan maps`` on an XYZ file of ``table``."""
+
+    def build(tmp: Path) -> list[str]:
+        np.savetxt(tmp / name, table, fmt="%.3f")
+        return ["maps", str(tmp / name), "-o", str(tmp / "out")]
+
+    return build
 
 
 def _survey(n: int = 300, offset: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
@@ -68,11 +83,6 @@ def _survey(n: int = 300, offset: tuple[float, float] = (0.0, 0.0)) -> np.ndarra
     return np.column_stack(
         [500_000.0 + offset[0] + east, 4_100_000.0 + offset[1] + north, 30.0 + 0.05 * north]
     )
-
-
-def _xyz(path: Path, table: np.ndarray) -> str:
-    np.savetxt(path, table, fmt="%.3f")
-    return str(path)
 
 
 def _previous_output(tmp: Path) -> Path:
@@ -112,64 +122,24 @@ CASES: dict[str, tuple[Callable[[Path], list[str]], str]] = {
     ),
     # 2. XYZ surveys: degenerate geometry, absurd grid size
     "collinear soundings": (
-        lambda tmp: [
-            "maps",
-            _xyz(tmp / "line.xyz", _survey()[:, [0, 0, 2]]),
-            "-o",
-            str(tmp / "out"),
-        ],
+        _maps_on_xyz("line.xyz", _survey()[:, [0, 0, 2]]),
         "line.xyz: the 300 soundings lie on one line",
     ),
     "xyz over two far areas": (
-        lambda tmp: [
-            "maps",
-            _xyz(tmp / "two.xyz", np.vstack([_survey(), _survey(offset=(2e6, 3e6))])),
-            "-o",
-            str(tmp / "out"),
-        ],
+        _maps_on_xyz("two.xyz", np.vstack([_survey(), _survey(offset=(2e6, 3e6))])),
         "two.xyz: the grid would need",
     ),
     # 3. NetCDF off the Earth or without a valid value
     "netcdf latitude > 90": (
-        lambda tmp: [
-            "maps",
-            _netcdf(
-                tmp / "pole.nc",
-                np.linspace(89.5, 95.0, 12),
-                np.linspace(10.0, 10.1, 12),
-                np.full((12, 12), -50.0),
-            ),
-            "-o",
-            str(tmp / "out"),
-        ],
+        _maps_on_netcdf("pole.nc", (89.5, 95.0), (10.0, 10.1), -50.0),
         "pole.nc: latitudes 89.5 … 95 deg are outside [-90, 90] deg",
     ),
     "netcdf longitude 400": (
-        lambda tmp: [
-            "maps",
-            _netcdf(
-                tmp / "lon.nc",
-                np.linspace(40.0, 40.1, 12),
-                np.linspace(400.0, 400.1, 12),
-                np.full((12, 12), -50.0),
-            ),
-            "-o",
-            str(tmp / "out"),
-        ],
+        _maps_on_netcdf("lon.nc", (40.0, 40.1), (400.0, 400.1), -50.0),
         "lon.nc: longitudes 400 … 400.1 deg are outside [-180, 360] deg",
     ),
     "netcdf all -1e308": (
-        lambda tmp: [
-            "maps",
-            _netcdf(
-                tmp / "huge.nc",
-                np.linspace(40.0, 40.1, 12),
-                np.linspace(10.0, 10.1, 12),
-                np.full((12, 12), -1e308),
-            ),
-            "-o",
-            str(tmp / "out"),
-        ],
+        _maps_on_netcdf("huge.nc", (40.0, 40.1), (10.0, 10.1), -1e308),
         "huge.nc: no valid value: all 144 values are no data or beyond ±12000 m",
     ),
     # 4. vehicle numbers outside their physical range
@@ -316,21 +286,19 @@ def test_stray_fix_and_absurd_values_are_warnings_not_errors(
     """One (0, 0) fix among a survey, and -1e308 in a NetCDF: mapped, with a counted warning."""
     survey = _survey()
     survey[7] = (0.0, 0.0, 31.0)
-    lat, lon = np.linspace(40.0, 40.01, 20), np.linspace(10.0, 10.01, 20)
-    elevation = -50.0 - 500.0 * np.add.outer(lat - 40.0, lon - 10.0)
+    elevation = -50.0 - 0.5 * np.add.outer(np.arange(12.0), np.arange(12.0))
     elevation[4, 4] = -1e308
-    inputs = {
-        "stray.xyz": _xyz(tmp_path / "stray.xyz", survey),
-        "absurd.nc": _netcdf(tmp_path / "absurd.nc", lat, lon, elevation),
-    }
+    builds = [
+        _maps_on_xyz("stray.xyz", survey),
+        _maps_on_netcdf("absurd.nc", (40.0, 40.01), (10.0, 10.01), elevation),
+    ]
     with caplog.at_level(logging.WARNING):
-        for name, path in inputs.items():
-            code, _, err = _run(
-                ["maps", path, "-q", "-o", str(tmp_path / name.replace(".", "_"))], capsys
-            )
+        for build in builds:
+            code, _, err = _run([*build(tmp_path), "-q"], capsys)
             assert (code, err) == (0, "")
+            assert (tmp_path / "out" / "maps.png").is_file()
     assert "stray.xyz: dropped 1 of 300 soundings" in caplog.text
-    assert "absurd.nc: 1 of 400 values beyond ±12000 m treated as no data" in caplog.text
+    assert "absurd.nc: 1 of 144 values beyond ±12000 m treated as no data" in caplog.text
 
 
 # --- SIGTERM on a real process ---------------------------------------------------------------

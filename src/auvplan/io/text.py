@@ -67,10 +67,8 @@ def read_toml(path: Path | Traversable, *, what: str) -> dict[str, Any]:
 
     Parameters
     ----------
-    path : Path or Traversable
-        The file (a path or a packaged resource).
-    what : str
-        What the file is meant to be, for messages (``"mission file"``).
+    path, what
+        As for :func:`read_text` (e.g. ``what="mission file"``).
 
     Returns
     -------
