@@ -11,30 +11,24 @@ resampled onto a metric grid in a transverse Mercator frame centred on the map
 from __future__ import annotations
 
 import logging
-import warnings
-from collections.abc import Hashable
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Final, Literal
+from typing import Final, Literal
 
 import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import AuvplanError, DataFormatError, InputError
+from auvplan.io._gridded import read_netcdf, read_rasterio
 from auvplan.io._raster import (
     Raster,
     check_geographic_range,
     first_line,
-    increasing,
-    looks_geographic,
 )
 from auvplan.io._xyz import XyzCoordinates, read_xyz
 from auvplan.terrain.grid import BathymetryGrid, GridGeometry
 from auvplan.terrain.projection import LocalProjection
 from auvplan.terrain.resample import grid_scattered_points, project_geographic_grid
-
-if TYPE_CHECKING:
-    import xarray as xr
 
 logger = logging.getLogger(__name__)
 
@@ -44,10 +38,6 @@ BathymetryFormat = Literal["netcdf", "geotiff", "ascii", "xyz"]
 #: Largest physical elevation or depth magnitude [m] (Challenger Deep 10,935 m, Everest 8,849 m);
 #: values beyond it (fill values such as -32767 or -1e308 without a ``_FillValue``) are no data.
 MAX_ABS_ELEVATION: Final = 12_000.0
-
-_LAT_NAMES = ("lat", "latitude", "y")
-_LON_NAMES = ("lon", "longitude", "x")
-_DATA_NAMES = ("depth", "elevation", "z", "Band1", "topo", "height", "bathymetry", "altitude")
 
 
 def read_bathymetry(
@@ -144,9 +134,9 @@ def _read(
     kind = detect_format(path)
     try:
         if kind == "netcdf":
-            raster = _read_netcdf(path)
+            raster = read_netcdf(path)
         elif kind in ("geotiff", "ascii"):
-            raster = _read_rasterio(path)
+            raster = read_rasterio(path)
         else:
             raster = read_xyz(path, xyz_coordinates)
     except (ValueError, KeyError, TypeError, IndexError, RuntimeError) as error:
@@ -212,148 +202,6 @@ def detect_format(path: Path) -> BathymetryFormat:
             return "xyz"
         break
     raise DataFormatError("unrecognised format (text without 3 numeric columns)")
-
-
-# --- NetCDF --------------------------------------------------------------------------------
-
-
-def _read_netcdf(path: Path) -> Raster:
-    import xarray as xr
-
-    try:
-        dataset = xr.open_dataset(path, decode_times=False, cache=False)
-    except (OSError, ValueError, RuntimeError, TypeError, KeyError) as error:
-        raise DataFormatError(f"unreadable NetCDF ({first_line(error)})") from None
-    with dataset:
-        names = set(dataset.variables)
-        if {"north", "east"} <= names:
-            lat_name, lon_name, is_geographic = "north", "east", False
-        else:
-            lat_name = next((n for n in _LAT_NAMES if n in names), "")
-            lon_name = next((n for n in _LON_NAMES if n in names), "")
-            if not lat_name or not lon_name:
-                raise DataFormatError(
-                    "no lat/lon (or north/east) coordinate variables; "
-                    f"has {sorted(map(str, names))}"
-                )
-            units = str(dataset[lon_name].attrs.get("units", "")).lower()
-            # Without units, variables named lat/lon are geographic; x/y are if they look so.
-            is_geographic = "deg" in units or (
-                units in ("", "1")
-                and (
-                    (lat_name, lon_name) != ("y", "x")
-                    or looks_geographic(dataset[lat_name].values, dataset[lon_name].values)
-                )
-            )
-        lat_var, lon_var = dataset[lat_name], dataset[lon_name]
-        if lat_var.ndim != 1 or lon_var.ndim != 1:
-            raise DataFormatError(f"coordinates {lat_name}/{lon_name} must be 1-D")
-        lat_dim, lon_dim = lat_var.dims[0], lon_var.dims[0]
-        data_name = _pick_data_variable(dataset, lat_dim, lon_dim)
-        data = dataset[data_name].squeeze(drop=True)
-        if set(data.dims) != {lat_dim, lon_dim}:
-            raise DataFormatError(
-                f"variable {data_name} has dimensions {data.dims}, not ({lat_dim}, {lon_dim})"
-            )
-        values = np.asarray(data.transpose(lat_dim, lon_dim).values, dtype=np.float64)
-        positive = str(data.attrs.get("positive", "")).lower()
-        is_depth: bool | None = (
-            True
-            if data_name == "depth" or positive == "down"
-            else False
-            if data_name == "elevation" or positive == "up"
-            else None
-        )
-        attributes = {"variable": str(data_name)}
-        for key in ("title", "source", "license"):
-            if key in dataset.attrs:
-                attributes[key] = first_line(dataset.attrs[key])
-        projection = _projection_from_attributes(dict(dataset.attrs)) if not is_geographic else None
-        north_axis = np.asarray(lat_var.values, dtype=np.float64)
-        east_axis = np.asarray(lon_var.values, dtype=np.float64)
-    values, north_axis, east_axis = increasing(values, north_axis, east_axis)
-    return Raster(
-        values,
-        north_axis,
-        east_axis,
-        is_geographic,
-        is_depth,
-        projection,
-        None if projection is None else projection.to_local,
-        attributes,
-    )
-
-
-def _pick_data_variable(dataset: xr.Dataset, lat_dim: Hashable, lon_dim: Hashable) -> str:
-    candidates = [
-        str(name)
-        for name, variable in dataset.data_vars.items()
-        if {lat_dim, lon_dim} <= set(variable.dims)
-        and variable.size == (dataset.sizes[lat_dim] * dataset.sizes[lon_dim])
-    ]
-    for name in _DATA_NAMES:
-        if name in candidates:
-            return name
-    if len(candidates) == 1:
-        return candidates[0]
-    raise DataFormatError(
-        f"cannot tell the elevation/depth variable on ({lat_dim}, {lon_dim}) among {candidates}"
-    )
-
-
-def _projection_from_attributes(attributes: dict[str, object]) -> LocalProjection | None:
-    """The LocalProjection recorded by :func:`auvplan.io.maps_file.write_maps_netcdf`."""
-    keys = (
-        "projection_lat_0",
-        "projection_lon_0",
-        "projection_offset_north",
-        "projection_offset_east",
-    )
-    if not all(key in attributes for key in keys):
-        return None
-    lat_0, lon_0, offset_north, offset_east = (float(attributes[k]) for k in keys)  # type: ignore[arg-type]
-    ellipsoid = str(attributes.get("projection_ellipsoid", "WGS84"))
-    return LocalProjection(lat_0, lon_0, offset_north, offset_east, ellipsoid)
-
-
-# --- GeoTIFF and ESRI ASCII grid -----------------------------------------------------------
-
-
-def _read_rasterio(path: Path) -> Raster:
-    import rasterio
-    from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
-
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", NotGeoreferencedWarning)
-            with rasterio.open(path) as source:
-                band = source.read(1, masked=True)
-                transform, crs = source.transform, source.crs
-    except (RasterioIOError, ValueError, IndexError) as error:
-        raise DataFormatError(f"unreadable raster ({first_line(error)})") from None
-    values = np.asarray(np.ma.filled(band.astype(np.float64), np.nan))
-    if transform.b != 0.0 or transform.d != 0.0:
-        raise DataFormatError("rotated rasters are not supported")
-    n_rows, n_cols = values.shape
-    east_axis = transform.c + transform.a * (np.arange(n_cols) + 0.5)
-    north_axis = transform.f + transform.e * (np.arange(n_rows) + 0.5)
-    values, north_axis, east_axis = increasing(values, north_axis, east_axis)
-    attributes: dict[str, str] = {}
-    to_native = None
-    if crs is not None:
-        attributes["crs"] = crs.to_string()
-        is_geographic = bool(crs.is_geographic)
-        if not is_geographic:
-            from pyproj import Transformer
-
-            transformer = Transformer.from_crs("EPSG:4326", crs, always_xy=True)
-
-            def to_native(lat: FloatArray, lon: FloatArray) -> tuple[FloatArray, FloatArray]:
-                east, north = transformer.transform(lon, lat)
-                return np.asarray(north), np.asarray(east)
-    else:
-        is_geographic = looks_geographic(north_axis, east_axis)
-    return Raster(values, north_axis, east_axis, is_geographic, None, None, to_native, attributes)
 
 
 # --- Common conversion ---------------------------------------------------------------------

@@ -12,15 +12,14 @@ A vehicle is named either by a packaged type (``"medusa"``) or by the path of a 
     [power]       hotel
     [smoothing]   inflow, abs_speed, abs_rate, sign_n (all optional)
 
-Every number is a table ``{ value = ..., unit = "..." }``; the unit is checked (a few
-conversions are accepted at this edge: rpm, mm, ...). A propeller table is a CSV with ``#``
+Every number is a table ``{ value = ..., unit = "..." }``; its unit and physical range are
+checked (:mod:`auvplan.io._vehicle_schema`). A propeller table is a CSV with ``#``
 comment lines, a header ``k,A_T,B_T,A_Q,B_Q`` and one row per harmonic ``k = 0..K``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from importlib import resources
 from importlib.resources.abc import Traversable
 from pathlib import Path
@@ -30,12 +29,22 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError, InputError
+from auvplan.io._vehicle_schema import (
+    CURRENT_CURVE,
+    HOTEL,
+    HULL,
+    MOTOR,
+    PROPELLER,
+    PROPULSION,
+    SMOOTHING,
+    SMOOTHING_DEFAULTS,
+    scalar,
+    scalars,
+    section,
+    vector,
+)
 from auvplan.io.text import read_text, read_toml
 from auvplan.vehicle.params import (
-    DEFAULT_EPS_ABS_RATE,
-    DEFAULT_EPS_ABS_SPEED,
-    DEFAULT_EPS_INFLOW,
-    DEFAULT_EPS_SIGN_N,
     HullParams,
     MotorParams,
     PropellerParams,
@@ -44,86 +53,6 @@ from auvplan.vehicle.params import (
 
 PROPELLER_COLUMNS: Final = ("k", "A_T", "B_T", "A_Q", "B_Q")
 
-# canonical unit -> accepted spellings and the factor to the canonical unit
-_UNITS: Final[dict[str, dict[str, float]]] = {
-    "kg": {"kg": 1.0},
-    "kg m^2": {"kg m^2": 1.0, "kg m2": 1.0},
-    "kg/s": {"kg/s": 1.0},
-    "kg m^2/s": {"kg m^2/s": 1.0, "kg m2/s": 1.0},
-    "kg/m": {"kg/m": 1.0},
-    "kg/m^3": {"kg/m^3": 1.0, "kg/m3": 1.0},
-    "m": {"m": 1.0, "cm": 1e-2, "mm": 1e-3},
-    "rev/s": {"rev/s": 1.0, "rps": 1.0, "rpm": 1.0 / 60.0, "rev/min": 1.0 / 60.0},
-    "rev/s^2": {"rev/s^2": 1.0, "rev/s2": 1.0},
-    "1": {"1": 1.0, "-": 1.0, "": 1.0},
-    "ohm": {"ohm": 1.0, "Ω": 1.0},
-    "V s/rad": {"V s/rad": 1.0, "N m/A": 1.0},
-    "V": {"V": 1.0},
-    "A": {"A": 1.0},
-    "W": {"W": 1.0},
-    "m/s": {"m/s": 1.0},
-    "rad/s": {"rad/s": 1.0},
-}
-
-
-@dataclass(frozen=True)
-class _Range:
-    """Canonical unit and physically meaningful closed range ``[low, high]`` of a number."""
-
-    unit: str
-    low: float
-    high: float
-
-
-# Ranges span every marine vehicle from a 0.1 kg model to a 10,000 t ship; they reject typos
-# and unit slips (n_max = 1e-9 rev/s, a density of 1.025 kg/m^3), not unusual designs.
-_HULL: Final = {
-    "m": _Range("kg", 0.1, 1e7),
-    "I_z": _Range("kg m^2", 1e-4, 1e12),
-    "X_udot": _Range("kg", -1e7, 0.0),
-    "Y_vdot": _Range("kg", -1e7, 0.0),
-    "N_rdot": _Range("kg m^2", -1e12, 0.0),
-    "X_u": _Range("kg/s", -1e7, 0.0),
-    "Y_v": _Range("kg/s", -1e7, 0.0),
-    "N_r": _Range("kg m^2/s", -1e12, 0.0),
-    "X_uu": _Range("kg/m", -1e7, 0.0),
-    "Y_vv": _Range("kg/m", -1e7, 0.0),
-    "N_rr": _Range("kg m^2", -1e12, 0.0),
-    "rho": _Range("kg/m^3", 950.0, 1100.0),
-}
-_PROPULSION: Final = {
-    "l": _Range("m", 0.005, 50.0),
-    "n_max": _Range("rev/s", 0.5, 1000.0),
-    "w_c": _Range("rev/s^2", 0.01, 1e5),
-}
-_PROPELLER: Final = {
-    "diameter": _Range("m", 0.005, 15.0),
-    "c_T": _Range("1", 0.1, 10.0),
-    "c_Q": _Range("1", 0.1, 10.0),
-}
-_MOTOR: Final = {
-    "R_a": _Range("ohm", 0.0, 1e3),
-    "K_e": _Range("V s/rad", 1e-5, 100.0),
-    "V_bus": _Range("V", 0.5, 1e4),
-    "I_0": _Range("A", 0.0, 1e3),
-}
-_CURRENT_CURVE: Final = {
-    "n": _Range("rev/s", 0.0, 1000.0),
-    "current": _Range("A", 0.0, 1e4),
-}
-_HOTEL: Final = _Range("W", 0.0, 1e7)
-_SMOOTHING: Final = {
-    "inflow": _Range("m/s", 1e-6, 1.0),
-    "abs_speed": _Range("m/s", 1e-6, 1.0),
-    "abs_rate": _Range("rad/s", 1e-6, 1.0),
-    "sign_n": _Range("rev/s", 1e-6, 10.0),
-}
-_SMOOTHING_DEFAULTS: Final = {
-    "inflow": DEFAULT_EPS_INFLOW,
-    "abs_speed": DEFAULT_EPS_ABS_SPEED,
-    "abs_rate": DEFAULT_EPS_ABS_RATE,
-    "sign_n": DEFAULT_EPS_SIGN_N,
-}
 #: Largest magnitude of a Fourier coefficient of C_T* or C_Q* (published series stay below 2).
 _MAX_PROPELLER_COEFFICIENT: Final = 10.0
 
@@ -164,99 +93,6 @@ def packaged_propeller_tables() -> tuple[str, ...]:
             if entry.name.endswith(".csv")
         )
     )
-
-
-def _normalise_unit(unit: str) -> str:
-    return " ".join(unit.replace("*", " ").replace("·", " ").split())
-
-
-def _quantity(
-    section: Mapping[str, object], key: str, where: str, expected: _Range
-) -> float | FloatArray:
-    """The value of ``where.key`` in ``expected.unit``, every element inside its range."""
-    qualified = f"{where}.{key}"
-    unit = expected.unit
-    if key not in section:
-        raise DataFormatError(f"missing key '{qualified}' in vehicle file")
-    entry = section[key]
-    if not isinstance(entry, Mapping) or "value" not in entry or "unit" not in entry:
-        raise DataFormatError(
-            f"'{qualified}' must be a table {{ value = ..., unit = \"{unit}\" }}, got {entry!r}"
-        )
-    given = entry["unit"]
-    accepted = {_normalise_unit(k): v for k, v in _UNITS[unit].items()}
-    if not isinstance(given, str) or _normalise_unit(given) not in accepted:
-        raise DataFormatError(f"'{qualified}' has unit {given!r}, expected {unit!r}")
-    factor = accepted[_normalise_unit(given)]
-    value = entry["value"]
-    if isinstance(value, bool):
-        raise DataFormatError(f"'{qualified}' must be a number, got {value!r}")
-    if isinstance(value, int | float):
-        result: float | FloatArray = float(value) * factor
-    elif isinstance(value, list) and all(
-        isinstance(v, int | float) and not isinstance(v, bool) for v in value
-    ):
-        result = np.asarray(value, dtype=np.float64) * factor
-    else:
-        raise DataFormatError(f"'{qualified}' must be a number or a list of numbers, got {value!r}")
-    _check_range(qualified, np.atleast_1d(result), expected)
-    return result
-
-
-def _check_range(qualified: str, values: FloatArray, expected: _Range) -> None:
-    """Raise InputError naming the key, the first value outside ``expected`` and the range."""
-    span = f"range {expected.low:g} … {expected.high:g} {expected.unit}"
-    for value in values:
-        if not np.isfinite(value):
-            raise InputError(f"{qualified} must be finite ({span}), got {value}")
-        if value < expected.low:
-            raise InputError(
-                f"{qualified} must be >= {expected.low:g} {expected.unit} ({span}), got {value:g}"
-            )
-        if value > expected.high:
-            raise InputError(
-                f"{qualified} must be <= {expected.high:g} {expected.unit} ({span}), got {value:g}"
-            )
-
-
-def _scalar(section: Mapping[str, object], key: str, where: str, expected: _Range) -> float:
-    value = _quantity(section, key, where, expected)
-    if not isinstance(value, float):
-        raise DataFormatError(f"'{where}.{key}' must be a single number")
-    return value
-
-
-def _scalars(
-    section: Mapping[str, object],
-    where: str,
-    expected: Mapping[str, _Range],
-    defaults: Mapping[str, float] | None = None,
-) -> dict[str, float]:
-    """Every key of ``expected`` read with :func:`_scalar`; absent keys take ``defaults``."""
-    defaults = defaults or {}
-    return {
-        key: defaults[key]
-        if key in defaults and key not in section
-        else _scalar(section, key, where, value_range)
-        for key, value_range in expected.items()
-    }
-
-
-def _vector(section: Mapping[str, object], key: str, where: str, expected: _Range) -> FloatArray:
-    value = _quantity(section, key, where, expected)
-    if isinstance(value, float):
-        raise DataFormatError(f"'{where}.{key}' must be a list of numbers")
-    return value
-
-
-def _section(document: Mapping[str, object], key: str, where: str = "") -> Mapping[str, object]:
-    qualified = f"{where}.{key}" if where else key
-    if key not in document:
-        raise DataFormatError(f"missing section '[{qualified}]' in vehicle file")
-    section = document[key]
-    if not isinstance(section, Mapping):
-        raise DataFormatError(f"'{qualified}' must be a table")
-    return section
 
 
 def _parse_propeller_table(text: str, origin: str) -> tuple[FloatArray, FloatArray]:
@@ -364,17 +200,17 @@ def _parse_vehicle(document: Mapping[str, object], base_dir: Path | None) -> Veh
     name = document.get("name")
     if not isinstance(name, str) or not name:
         raise DataFormatError("missing key 'name' (a non-empty string) in vehicle file")
-    hull_section = _section(document, "hull")
-    hull = HullParams(**_scalars(hull_section, "hull", _HULL))
-    propulsion = _section(document, "propulsion")
-    propeller_section = _section(document, "propeller")
+    hull_section = section(document, "hull")
+    hull = HullParams(**scalars(hull_section, "hull", HULL))
+    propulsion = section(document, "propulsion")
+    propeller_section = section(document, "propeller")
     table = propeller_section.get("table")
     if not isinstance(table, str):
         raise DataFormatError("missing key 'propeller.table' (packaged name or CSV path)")
     order = propeller_section.get("order")
     if order is not None and (not isinstance(order, int) or isinstance(order, bool)):
         raise DataFormatError(f"'propeller.order' must be an integer, got {order!r}")
-    scaling = _scalars(propeller_section, "propeller", _PROPELLER)
+    scaling = scalars(propeller_section, "propeller", PROPELLER)
     propeller = load_propeller_table(
         table,
         diameter=scaling["diameter"],
@@ -383,15 +219,15 @@ def _parse_vehicle(document: Mapping[str, object], base_dir: Path | None) -> Veh
         order=order,
         base_dir=base_dir,
     )
-    motor_section = _section(document, "motor")
+    motor_section = section(document, "motor")
     current_model = motor_section.get("current_model", "torque")
     curve_n: FloatArray | None = None
     curve_amps: FloatArray | None = None
     if "current_curve" in motor_section:
-        curve = _section(motor_section, "current_curve", "motor")
-        curve_n = _vector(curve, "n", "motor.current_curve", _CURRENT_CURVE["n"])
-        curve_amps = _vector(curve, "current", "motor.current_curve", _CURRENT_CURVE["current"])
-    electrics = _scalars(motor_section, "motor", _MOTOR, {"I_0": 0.0})
+        curve = section(motor_section, "current_curve", "motor")
+        curve_n = vector(curve, "n", "motor.current_curve", CURRENT_CURVE["n"])
+        curve_amps = vector(curve, "current", "motor.current_curve", CURRENT_CURVE["current"])
+    electrics = scalars(motor_section, "motor", MOTOR, {"I_0": 0.0})
     motor = MotorParams(
         R_a=electrics["R_a"],
         K_e=electrics["K_e"],
@@ -404,8 +240,8 @@ def _parse_vehicle(document: Mapping[str, object], base_dir: Path | None) -> Veh
     smoothing_section = document.get("smoothing", {})
     if not isinstance(smoothing_section, Mapping):
         raise DataFormatError("'smoothing' must be a table")
-    smoothing = _scalars(smoothing_section, "smoothing", _SMOOTHING, _SMOOTHING_DEFAULTS)
-    limits = _scalars(propulsion, "propulsion", _PROPULSION)
+    smoothing = scalars(smoothing_section, "smoothing", SMOOTHING, SMOOTHING_DEFAULTS)
+    limits = scalars(propulsion, "propulsion", PROPULSION)
     description = document.get("description", "")
     return VehicleParams(
         name=name,
@@ -413,7 +249,7 @@ def _parse_vehicle(document: Mapping[str, object], base_dir: Path | None) -> Veh
         propeller=propeller,
         motor=motor,
         l=limits["l"],
-        hotel_power=_scalar(_section(document, "power"), "hotel", "power", _HOTEL),
+        hotel_power=scalar(section(document, "power"), "hotel", "power", HOTEL),
         n_max=limits["n_max"],
         w_c=limits["w_c"],
         eps_inflow=smoothing["inflow"],
