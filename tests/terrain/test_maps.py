@@ -179,6 +179,10 @@ def test_cost_and_shift_values() -> None:
         {"omega": -3.0},
         {"weight": -0.1},
         {"weight": float("inf")},
+        {"omega": 1.7e308},
+        {"weight": 1e7},
+        {"exponent": 1e300},
+        {"exponent": 1e-300},
     ],
 )
 def test_map_parameters_validation(kwargs: dict[str, object]) -> None:

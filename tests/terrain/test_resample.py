@@ -78,3 +78,21 @@ def test_scattered_lattice_is_reproduced_at_its_nodes(rng: np.random.Generator) 
 def test_too_few_points() -> None:
     with pytest.raises(InputError, match="at least 3"):
         grid_scattered_points(np.array([0.0, 1.0]), np.array([0.0, 1.0]), np.array([5.0, 6.0]))
+
+
+def test_absurd_grid_sizes_are_refused_before_allocating() -> None:
+    """A 6000 x 6000 lon/lat source (a zero-stride view: no memory) would need 36 M nodes."""
+    lat = 10.0 + 0.001 * np.arange(6000)
+    lon = 20.0 + 0.001 * np.arange(6000)
+    depth = np.broadcast_to(np.float64(50.0), (6000, 6000))
+    with pytest.raises(InputError, match=r"the grid would need 59\d\d x 59\d\d nodes"):
+        project_geographic_grid(depth, lat, lon)
+    north, east = np.array([0.0, 1.0, 0.0, 1e5]), np.array([0.0, 0.0, 1.0, 1e5])
+    with pytest.raises(InputError, match=r"at most 2\.5e\+07\): remove stray positions"):
+        grid_scattered_points(north, east, np.full(4, 30.0))
+
+
+def test_collinear_soundings_are_an_input_error() -> None:
+    t = np.linspace(0.0, 50.0, 20)
+    with pytest.raises(InputError, match="the 20 soundings lie on one line"):
+        grid_scattered_points(2.0 * t, t, np.full(20, 30.0))

@@ -84,3 +84,9 @@ def test_roughness_has_the_requested_power_law(rng: np.random.Generator) -> None
 def test_bad_arguments(kwargs: dict[str, object]) -> None:
     with pytest.raises(InputError):
         synthetic_bank(**kwargs)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("seed", [-1, 1.5, True, "7"])
+def test_seed_must_be_a_non_negative_integer(seed: object) -> None:
+    with pytest.raises(InputError, match="seed must be an integer >= 0"):
+        synthetic_bank(seed=seed)  # type: ignore[arg-type]

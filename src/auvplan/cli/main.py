@@ -2,9 +2,18 @@
 
 Each verb lives in its own module under :mod:`auvplan.cli` with two functions:
 ``register(subparsers)`` adds its parser (argparse only, no heavy imports) and sets
-``run=<callable(args) -> int>`` as the parser default. Every :class:`~auvplan.errors.AuvplanError`
-and every file-system error is reported as one line on stderr with exit code 2; nothing else
-is printed on failure.
+``run=<callable(args) -> int>`` as the parser default. ``-q``/``-v`` are accepted before or
+after the verb. A verb's ``-o/--output`` names an output folder; it is checked
+(:func:`~auvplan.io.output.check_output_dir`) before the verb runs.
+
+Failures are one line on stderr, never a traceback:
+
+* a usage error (unknown option, bad number), every :class:`~auvplan.errors.AuvplanError` and
+  every file-system error: exit code 2;
+* SIGINT (Ctrl-C): exit code 130; SIGTERM: exit code 143 (128 + the signal number, as a
+  shell reports a process killed by it). Both are turned into exceptions, so the output
+  writers (:func:`auvplan.io.output.staged_output_dir`) delete their staging files and leave
+  the output folder as it was.
 """
 
 from __future__ import annotations
@@ -12,8 +21,13 @@ from __future__ import annotations
 import argparse
 import importlib
 import logging
+import signal
 import sys
-from collections.abc import Sequence
+import threading
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from types import FrameType
+from typing import Any, NoReturn
 
 from auvplan import __version__
 from auvplan.errors import AuvplanError
@@ -22,20 +36,46 @@ from auvplan.errors import AuvplanError
 COMMAND_MODULES = ("maps", "plan", "vehicle", "keys")
 
 EXIT_USER_ERROR = 2
+EXIT_INTERRUPTED = 128 + signal.SIGINT
+EXIT_TERMINATED = 128 + signal.SIGTERM
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one line (``prog: error: ...``), exit 2."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(EXIT_USER_ERROR, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+class _Terminated(BaseException):
+    """SIGTERM, raised in the main thread like KeyboardInterrupt is for SIGINT."""
+
+
+def _add_verbosity(parser: argparse.ArgumentParser, *, default: Any) -> None:
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument(
+        "-q", "--quiet", action="store_true", default=default, help="print nothing but errors"
+    )
+    group.add_argument(
+        "-v", "--verbose", action="store_true", default=default, help="also print debug messages"
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The full argument parser with every verb registered."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="auvplan",
         description="Cooperative, energy-optimal, terrain-aware trajectory planning for "
         "fleets of marine vehicles.",
     )
     parser.add_argument("--version", action="version", version=f"auvplan {__version__}")
-    parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    _add_verbosity(parser, default=False)
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in COMMAND_MODULES:
         importlib.import_module(f"auvplan.cli.{name}").register(subparsers)
+    # After the verb, -q/-v only override what was given before it (SUPPRESS: no default).
+    for verb_parser in {id(p): p for p in subparsers.choices.values()}.values():
+        _add_verbosity(verb_parser, default=argparse.SUPPRESS)
     return parser
 
 
@@ -43,13 +83,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Parse ``argv``, run the verb, and turn user errors into one-line messages."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    logging.basicConfig(
-        level=logging.WARNING if args.quiet else logging.INFO,
-        format="%(message)s",
-        stream=sys.stderr,
+    if args.quiet and args.verbose:
+        parser.error("-q/--quiet and -v/--verbose exclude each other")
+    logging.basicConfig(level=logging.WARNING, format="%(message)s", stream=sys.stderr)
+    logger = logging.getLogger("auvplan")
+    level = logger.level
+    logger.setLevel(
+        logging.WARNING if args.quiet else logging.DEBUG if args.verbose else logging.INFO
     )
     try:
-        code: int = args.run(args)
+        with _sigterm_raises():
+            if getattr(args, "output", None) is not None:  # every verb's -o is a folder
+                from auvplan.io.output import check_output_dir  # heavy package: only now
+
+                check_output_dir(args.output)  # before any work: fail fast, write nothing
+            code: int = args.run(args)
     except AuvplanError as error:
         print(f"auvplan: error: {error}", file=sys.stderr)
         return EXIT_USER_ERROR
@@ -59,8 +107,30 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_USER_ERROR
     except KeyboardInterrupt:
         print("auvplan: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
+    except _Terminated:
+        print("auvplan: terminated", file=sys.stderr)
+        return EXIT_TERMINATED
+    finally:
+        logger.setLevel(level)
     return code
+
+
+@contextmanager
+def _sigterm_raises() -> Iterator[None]:
+    """While the block runs, SIGTERM raises :class:`_Terminated` in the main thread."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def terminate(_signum: int, _frame: FrameType | None) -> NoReturn:
+        raise _Terminated
+
+    previous = signal.signal(signal.SIGTERM, terminate)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,9 @@
 """``auvplan maps``: terrain-information maps (paper Fig. 5) from a bathymetry file.
 
-Writes ``DIR/maps.nc`` and ``DIR/maps.png`` all-or-nothing (nothing is written on error).
+Writes ``DIR/maps.nc`` and ``DIR/maps.png`` all-or-nothing: ``DIR`` is checked before any work
+(by :mod:`auvplan.cli.main`) and replaced as a whole at the end
+(:func:`auvplan.io.output.staged_output_dir`: other files already in ``DIR`` are kept); on any
+error nothing is written.
 """
 
 from __future__ import annotations

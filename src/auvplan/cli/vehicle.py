@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -44,7 +45,12 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
         help="packaged vehicle type or vehicle file (default: medusa)",
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    parser.add_argument("--figure", metavar="PATH", help="write the validation figure (PNG, PDF)")
+    parser.add_argument(
+        "--figure",
+        metavar="PATH",
+        type=Path,
+        help="write the validation figure (format from the extension: .png, .pdf, .svg, ...)",
+    )
     parser.add_argument(
         "--order",
         type=int,
@@ -57,21 +63,23 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
 def run(args: argparse.Namespace) -> int:
     """Compute and print the characteristics; returns the exit code."""
     import json
-    from pathlib import Path
 
     from auvplan.io.vehicles import load_vehicle
     from auvplan.vehicle.dynamics import build_vehicle_model
     from auvplan.vehicle.trim import vehicle_characteristics
 
+    if args.figure is not None:
+        _check_figure_path(args.figure)
     params = load_vehicle(args.vehicle)
     model = build_vehicle_model(params, propeller_order=args.order)
     table = vehicle_characteristics(model)
     if args.figure is not None:
+        from auvplan.io.output import staged_output_file
         from auvplan.viz.vehicle import plot_vehicle_validation
 
         figure = plot_vehicle_validation(model)
-        path = Path(args.figure)
-        figure.savefig(path, dpi=120)
+        with staged_output_file(args.figure) as staging:
+            figure.savefig(staging, dpi=120)
     if args.json:
         document = {"characteristics": table.to_dict(), "units": UNITS}
         print(json.dumps(document, indent=2))
@@ -80,6 +88,23 @@ def run(args: argparse.Namespace) -> int:
     if args.figure is not None and not args.quiet and not args.json:
         print(f"wrote                      {args.figure}")
     return 0
+
+
+def _check_figure_path(path: Path) -> None:
+    """Refuse, before any work, a figure path that is a folder or has an unknown extension."""
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    from auvplan.errors import InputError
+    from auvplan.io.output import check_output_file
+
+    check_output_file(path)
+    supported = sorted(FigureCanvasBase.get_supported_filetypes())
+    extension = path.suffix.lower().removeprefix(".")
+    if extension not in supported:
+        raise InputError(
+            f"--figure {path}: unsupported extension {path.suffix!r} "
+            f"(supported: {', '.join('.' + name for name in supported)})"
+        )
 
 
 def _print_table(table: VehicleCharacteristics) -> None:

@@ -10,35 +10,34 @@ resampled onto a metric grid in a transverse Mercator frame centred on the map
 
 from __future__ import annotations
 
-import io
-import warnings
-from collections.abc import Callable, Hashable
-from dataclasses import dataclass, field, replace
+import logging
+from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Literal
+from typing import Final, Literal
 
 import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import AuvplanError, DataFormatError, InputError
+from auvplan.io._gridded import read_netcdf, read_rasterio
+from auvplan.io._raster import (
+    Raster,
+    check_geographic_range,
+    first_line,
+)
+from auvplan.io._xyz import XyzCoordinates, read_xyz
 from auvplan.terrain.grid import BathymetryGrid, GridGeometry
 from auvplan.terrain.projection import LocalProjection
 from auvplan.terrain.resample import grid_scattered_points, project_geographic_grid
 
-if TYPE_CHECKING:
-    import xarray as xr
+logger = logging.getLogger(__name__)
 
 Vertical = Literal["auto", "elevation", "depth"]
-XyzCoordinates = Literal["auto", "geographic", "metric"]
 BathymetryFormat = Literal["netcdf", "geotiff", "ascii", "xyz"]
 
-#: A coordinate step below this many units is taken as degrees, not metres, when a file does
-#: not say (no CRS / units): 0.05 deg is 5.5 km, and no metric survey has 5 cm spacing.
-_GEOGRAPHIC_STEP_LIMIT = 0.05
-
-_LAT_NAMES = ("lat", "latitude", "y")
-_LON_NAMES = ("lon", "longitude", "x")
-_DATA_NAMES = ("depth", "elevation", "z", "Band1", "topo", "height", "bathymetry", "altitude")
+#: Largest physical elevation or depth magnitude [m] (Challenger Deep 10,935 m, Everest 8,849 m);
+#: values beyond it (fill values such as -32767 or -1e308 without a ``_FillValue``) are no data.
+MAX_ABS_ELEVATION: Final = 12_000.0
 
 
 def read_bathymetry(
@@ -90,7 +89,9 @@ def read_bathymetry(
     ------
     DataFormatError
         If the file is missing, of unknown format, lacks the needed variables, has irregular
-        coordinates, or has no water cell left.
+        coordinates or latitudes/longitudes off the Earth, has no valid value or no water cell
+        left, or its soundings are degenerate (collinear) or would need an absurdly large grid
+        (:data:`~auvplan.terrain.resample.MAX_GRID_NODES`).
     InputError
         If a window is empty or outside the map, or a lat/lon window is given for a grid
         without a geographic reference.
@@ -99,7 +100,10 @@ def read_bathymetry(
     -----
     XYZ point clouds that form a regular lattice (possibly with holes) are read as that grid
     exactly; other clouds are gridded with
-    :func:`~auvplan.terrain.resample.grid_scattered_points`.
+    :func:`~auvplan.terrain.resample.grid_scattered_points`. A few stray position fixes far
+    outside an XYZ survey are dropped (:func:`auvplan.io._xyz.drop_stray_fixes`), and values
+    beyond ±12,000 m (:data:`MAX_ABS_ELEVATION`) are no data; both are logged as warnings with
+    their count.
     """
     path = Path(path)
     try:
@@ -113,20 +117,6 @@ def read_bathymetry(
             f"bathymetry {path}: no water cell (depth > {min_depth:g} m) in the selected area"
         )
     return grid
-
-
-@dataclass(frozen=True)
-class _Raster:
-    """A raster as read, before conversion: rows along ``axis_north``, columns along east."""
-
-    values: FloatArray
-    axis_north: FloatArray  # lat [deg] or north [m], increasing
-    axis_east: FloatArray  # lon [deg] or east [m], increasing
-    is_geographic: bool
-    is_depth: bool | None  # None: decide from the values
-    projection: LocalProjection | None = None
-    to_native: Callable[[FloatArray, FloatArray], tuple[FloatArray, FloatArray]] | None = None
-    attributes: dict[str, str] = field(default_factory=dict)
 
 
 def _read(
@@ -144,28 +134,37 @@ def _read(
     kind = detect_format(path)
     try:
         if kind == "netcdf":
-            raster = _read_netcdf(path)
+            raster = read_netcdf(path)
         elif kind in ("geotiff", "ascii"):
-            raster = _read_rasterio(path)
+            raster = read_rasterio(path)
         else:
-            raster = _read_xyz(path, xyz_coordinates)
+            raster = read_xyz(path, xyz_coordinates)
     except (ValueError, KeyError, TypeError, IndexError, RuntimeError) as error:
         # Anything the libraries raise on a malformed file that the readers did not foresee.
         if isinstance(error, AuvplanError):
             raise
-        raise DataFormatError(f"malformed {kind} file ({_first_line(error)})") from None
+        raise DataFormatError(f"malformed {kind} file ({first_line(error)})") from None
     raster = replace(
         raster, attributes={"source_file": str(path), "format": kind, **raster.attributes}
     )
+    if raster.is_geographic:
+        check_geographic_range(raster.axis_north, raster.axis_east)
     raster = _crop_geographic(raster, window_lat, window_lon)
     depth = _to_depth(raster, vertical, min_depth)
-    if raster.is_geographic and raster.attributes.get("scattered") == "yes":
-        return _geographic_scattered(raster, depth, path.name)
-    if raster.is_geographic:
-        return project_geographic_grid(
-            depth, raster.axis_north, raster.axis_east, name=path.name, attributes=raster.attributes
-        )
-    return _metric_grid(depth, raster, path.name)
+    try:
+        if raster.is_geographic and raster.attributes.get("scattered") == "yes":
+            return _geographic_scattered(raster, depth, path.name)
+        if raster.is_geographic:
+            return project_geographic_grid(
+                depth,
+                raster.axis_north,
+                raster.axis_east,
+                name=path.name,
+                attributes=raster.attributes,
+            )
+        return _metric_grid(depth, raster, path.name)
+    except InputError as error:  # the file's geometry, not a user's value, is at fault
+        raise DataFormatError(str(error)) from None
 
 
 def detect_format(path: Path) -> BathymetryFormat:
@@ -205,231 +204,12 @@ def detect_format(path: Path) -> BathymetryFormat:
     raise DataFormatError("unrecognised format (text without 3 numeric columns)")
 
 
-# --- NetCDF --------------------------------------------------------------------------------
-
-
-def _read_netcdf(path: Path) -> _Raster:
-    import xarray as xr
-
-    try:
-        dataset = xr.open_dataset(path, decode_times=False, cache=False)
-    except (OSError, ValueError, RuntimeError, TypeError, KeyError) as error:
-        raise DataFormatError(f"unreadable NetCDF ({_first_line(error)})") from None
-    with dataset:
-        names = set(dataset.variables)
-        if {"north", "east"} <= names:
-            lat_name, lon_name, is_geographic = "north", "east", False
-        else:
-            lat_name = next((n for n in _LAT_NAMES if n in names), "")
-            lon_name = next((n for n in _LON_NAMES if n in names), "")
-            if not lat_name or not lon_name:
-                raise DataFormatError(
-                    "no lat/lon (or north/east) coordinate variables; "
-                    f"has {sorted(map(str, names))}"
-                )
-            units = str(dataset[lon_name].attrs.get("units", "")).lower()
-            is_geographic = "deg" in units or (
-                units in ("", "1")
-                and _looks_geographic(dataset[lat_name].values, dataset[lon_name].values)
-            )
-        lat_var, lon_var = dataset[lat_name], dataset[lon_name]
-        if lat_var.ndim != 1 or lon_var.ndim != 1:
-            raise DataFormatError(f"coordinates {lat_name}/{lon_name} must be 1-D")
-        lat_dim, lon_dim = lat_var.dims[0], lon_var.dims[0]
-        data_name = _pick_data_variable(dataset, lat_dim, lon_dim)
-        data = dataset[data_name].squeeze(drop=True)
-        if set(data.dims) != {lat_dim, lon_dim}:
-            raise DataFormatError(
-                f"variable {data_name} has dimensions {data.dims}, not ({lat_dim}, {lon_dim})"
-            )
-        values = np.asarray(data.transpose(lat_dim, lon_dim).values, dtype=np.float64)
-        positive = str(data.attrs.get("positive", "")).lower()
-        is_depth: bool | None = (
-            True
-            if data_name == "depth" or positive == "down"
-            else False
-            if data_name == "elevation" or positive == "up"
-            else None
-        )
-        attributes = {"variable": str(data_name)}
-        for key in ("title", "source", "license"):
-            if key in dataset.attrs:
-                attributes[key] = _first_line(dataset.attrs[key])
-        projection = _projection_from_attributes(dict(dataset.attrs)) if not is_geographic else None
-        north_axis = np.asarray(lat_var.values, dtype=np.float64)
-        east_axis = np.asarray(lon_var.values, dtype=np.float64)
-    values, north_axis, east_axis = _increasing(values, north_axis, east_axis)
-    return _Raster(
-        values,
-        north_axis,
-        east_axis,
-        is_geographic,
-        is_depth,
-        projection,
-        None if projection is None else projection.to_local,
-        attributes,
-    )
-
-
-def _pick_data_variable(dataset: xr.Dataset, lat_dim: Hashable, lon_dim: Hashable) -> str:
-    candidates = [
-        str(name)
-        for name, variable in dataset.data_vars.items()
-        if {lat_dim, lon_dim} <= set(variable.dims)
-        and variable.size == (dataset.sizes[lat_dim] * dataset.sizes[lon_dim])
-    ]
-    for name in _DATA_NAMES:
-        if name in candidates:
-            return name
-    if len(candidates) == 1:
-        return candidates[0]
-    raise DataFormatError(
-        f"cannot tell the elevation/depth variable on ({lat_dim}, {lon_dim}) among {candidates}"
-    )
-
-
-def _projection_from_attributes(attributes: dict[str, object]) -> LocalProjection | None:
-    """The LocalProjection recorded by :func:`auvplan.io.maps_file.write_maps_netcdf`."""
-    keys = (
-        "projection_lat_0",
-        "projection_lon_0",
-        "projection_offset_north",
-        "projection_offset_east",
-    )
-    if not all(key in attributes for key in keys):
-        return None
-    lat_0, lon_0, offset_north, offset_east = (float(attributes[k]) for k in keys)  # type: ignore[arg-type]
-    ellipsoid = str(attributes.get("projection_ellipsoid", "WGS84"))
-    return LocalProjection(lat_0, lon_0, offset_north, offset_east, ellipsoid)
-
-
-# --- GeoTIFF and ESRI ASCII grid -----------------------------------------------------------
-
-
-def _read_rasterio(path: Path) -> _Raster:
-    import rasterio
-    from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
-
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", NotGeoreferencedWarning)
-            with rasterio.open(path) as source:
-                band = source.read(1, masked=True)
-                transform, crs = source.transform, source.crs
-    except (RasterioIOError, ValueError, IndexError) as error:
-        raise DataFormatError(f"unreadable raster ({_first_line(error)})") from None
-    values = np.asarray(np.ma.filled(band.astype(np.float64), np.nan))
-    if transform.b != 0.0 or transform.d != 0.0:
-        raise DataFormatError("rotated rasters are not supported")
-    n_rows, n_cols = values.shape
-    east_axis = transform.c + transform.a * (np.arange(n_cols) + 0.5)
-    north_axis = transform.f + transform.e * (np.arange(n_rows) + 0.5)
-    values, north_axis, east_axis = _increasing(values, north_axis, east_axis)
-    attributes: dict[str, str] = {}
-    to_native = None
-    if crs is not None:
-        attributes["crs"] = crs.to_string()
-        is_geographic = bool(crs.is_geographic)
-        if not is_geographic:
-            from pyproj import Transformer
-
-            transformer = Transformer.from_crs("EPSG:4326", crs, always_xy=True)
-
-            def to_native(lat: FloatArray, lon: FloatArray) -> tuple[FloatArray, FloatArray]:
-                east, north = transformer.transform(lon, lat)
-                return np.asarray(north), np.asarray(east)
-    else:
-        is_geographic = _looks_geographic(north_axis, east_axis)
-    return _Raster(values, north_axis, east_axis, is_geographic, None, None, to_native, attributes)
-
-
-# --- XYZ point clouds ----------------------------------------------------------------------
-
-
-def _read_xyz(path: Path, coordinates: XyzCoordinates) -> _Raster:
-    try:
-        text = path.read_text(encoding="utf-8", errors="strict")
-        lines = [line.split("#", 1)[0].replace(",", " ") for line in text.splitlines()]
-        numeric = [line for line in lines if line.strip() and _is_numeric(line)]
-        table = np.loadtxt(io.StringIO("\n".join(numeric)), ndmin=2, usecols=(0, 1, 2))
-    except (UnicodeDecodeError, ValueError) as error:
-        raise DataFormatError(f"unreadable XYZ text ({_first_line(error)})") from None
-    if table.shape[0] < 4:
-        raise DataFormatError(f"XYZ file has {table.shape[0]} points, need at least 4")
-    first, second, z = table[:, 0], table[:, 1], table[:, 2]
-    if coordinates == "auto":
-        is_geographic = _looks_geographic(second, first)
-    else:
-        is_geographic = coordinates == "geographic"
-    lattice = _as_lattice(first, second, z)
-    if lattice is not None:
-        values, east_axis, north_axis = lattice
-        return _Raster(values, north_axis, east_axis, is_geographic, None)
-    # Scattered points: keep them as a one-row "raster" of points, gridded after conversion.
-    return _Raster(z[None, :], second, first, is_geographic, None, attributes={"scattered": "yes"})
-
-
-def _is_numeric(line: str) -> bool:
-    try:
-        [float(word) for word in line.split()]
-    except ValueError:
-        return False
-    return True
-
-
-def _as_lattice(
-    east: FloatArray, north: FloatArray, z: FloatArray
-) -> tuple[FloatArray, FloatArray, FloatArray] | None:
-    """``(values, east_axis, north_axis)`` if the points lie on a regular lattice, else None."""
-    axes = []
-    for coordinate in (east, north):
-        unique = np.unique(coordinate)
-        if unique.size < 2:
-            return None
-        steps = np.diff(unique)
-        step = float(np.median(steps))
-        if np.max(np.abs(steps - step)) > 0.05 * step:
-            return None
-        axes.append(unique[0] + step * np.arange(unique.size))
-    east_axis, north_axis = axes
-    if east_axis.size * north_axis.size > 4 * z.size:
-        return None  # too sparse to be a gridded export
-    col = np.rint((east - east_axis[0]) / (east_axis[1] - east_axis[0])).astype(np.int64)
-    row = np.rint((north - north_axis[0]) / (north_axis[1] - north_axis[0])).astype(np.int64)
-    values = np.full((north_axis.size, east_axis.size), np.nan)
-    values[row, col] = z
-    return values, east_axis, north_axis
-
-
 # --- Common conversion ---------------------------------------------------------------------
 
 
-def _looks_geographic(lat: FloatArray, lon: FloatArray) -> bool:
-    lat, lon = np.asarray(lat, dtype=np.float64), np.asarray(lon, dtype=np.float64)
-    if not (np.all(np.abs(lat) <= 90.0) and np.all(lon >= -180.0) and np.all(lon <= 360.0)):
-        return False
-    steps = [np.diff(np.unique(a)) for a in (lat, lon)]
-    step = min((float(np.median(s)) for s in steps if s.size), default=np.inf)
-    return step < _GEOGRAPHIC_STEP_LIMIT
-
-
-def _increasing(
-    values: FloatArray, north_axis: FloatArray, east_axis: FloatArray
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Flip rows/columns so both coordinate axes increase (row 0 = south, col 0 = west)."""
-    if north_axis.size > 1 and north_axis[1] < north_axis[0]:
-        values, north_axis = values[::-1], north_axis[::-1]
-    if east_axis.size > 1 and east_axis[1] < east_axis[0]:
-        values, east_axis = values[:, ::-1], east_axis[::-1]
-    for axis, name in ((north_axis, "north/lat"), (east_axis, "east/lon")):
-        if axis.size > 1 and not np.all(np.diff(axis) > 0.0):
-            raise DataFormatError(f"{name} coordinates are not monotonic")
-    return np.ascontiguousarray(values), north_axis.copy(), east_axis.copy()
-
-
 def _crop_geographic(
-    raster: _Raster, window_lat: tuple[float, float] | None, window_lon: tuple[float, float] | None
-) -> _Raster:
+    raster: Raster, window_lat: tuple[float, float] | None, window_lon: tuple[float, float] | None
+) -> Raster:
     """Apply a lat/lon window to the raster (in its native coordinates)."""
     if window_lat is None and window_lon is None:
         return raster
@@ -482,9 +262,30 @@ def _range(axis: FloatArray, bounds: tuple[float, float] | None, name: str) -> s
     return slice(int(inside[0]), int(inside[-1]) + 1)
 
 
-def _to_depth(raster: _Raster, vertical: Vertical, min_depth: float) -> FloatArray:
-    """Depth [m], positive down, NaN for no data and for depth <= ``min_depth``."""
-    values = np.where(np.isfinite(raster.values), raster.values, np.nan)
+def _to_depth(raster: Raster, vertical: Vertical, min_depth: float) -> FloatArray:
+    """Depth [m], positive down, NaN for no data, for depth <= ``min_depth`` and beyond ±12 km.
+
+    Values whose magnitude exceeds :data:`MAX_ABS_ELEVATION` are no data (logged with their
+    count); a raster without any valid value is a DataFormatError.
+    """
+    values = raster.values
+    with np.errstate(invalid="ignore"):
+        is_valid = np.abs(values) <= MAX_ABS_ELEVATION  # False for NaN and ±inf
+    n_absurd = int(np.count_nonzero(np.isfinite(values) & ~is_valid))
+    if not is_valid.any():
+        raise DataFormatError(
+            f"no valid value: all {values.size} values are no data or beyond "
+            f"±{MAX_ABS_ELEVATION:g} m"
+        )
+    if n_absurd:
+        logger.warning(
+            "bathymetry %s: %d of %d values beyond ±%g m treated as no data",
+            raster.attributes.get("source_file", "?"),
+            n_absurd,
+            values.size,
+            MAX_ABS_ELEVATION,
+        )
+    values = np.where(is_valid, values, np.nan)
     if vertical == "depth":
         is_depth = True
     elif vertical == "elevation":
@@ -500,7 +301,7 @@ def _to_depth(raster: _Raster, vertical: Vertical, min_depth: float) -> FloatArr
     return np.asarray(depth, dtype=np.float64)
 
 
-def _metric_grid(depth: FloatArray, raster: _Raster, name: str) -> BathymetryGrid:
+def _metric_grid(depth: FloatArray, raster: Raster, name: str) -> BathymetryGrid:
     if raster.attributes.get("scattered") == "yes":
         return grid_scattered_points(
             raster.axis_north,
@@ -530,7 +331,7 @@ def _metric_grid(depth: FloatArray, raster: _Raster, name: str) -> BathymetryGri
     return BathymetryGrid(depth, geometry, projection, None, name, dict(raster.attributes))
 
 
-def _geographic_scattered(raster: _Raster, depth: FloatArray, name: str) -> BathymetryGrid:
+def _geographic_scattered(raster: Raster, depth: FloatArray, name: str) -> BathymetryGrid:
     lat, lon = raster.axis_north, raster.axis_east
     centre = LocalProjection(
         float(0.5 * (lat.min() + lat.max())), float(0.5 * (lon.min() + lon.max()))
@@ -540,8 +341,3 @@ def _geographic_scattered(raster: _Raster, depth: FloatArray, name: str) -> Bath
     return grid_scattered_points(
         north, east, depth[0], projection=centre, name=name, attributes=attributes
     )
-
-
-def _first_line(value: object) -> str:
-    lines = str(value).strip().splitlines()
-    return lines[0] if lines else type(value).__name__

@@ -1,43 +1,98 @@
-"""Reading text and TOML files defensively: every failure is one line naming the file."""
+"""Reading user text files defensively: one place that turns every way of failing into one line.
+
+Vehicle files, propeller tables and mission files are text written by people. Whatever goes
+wrong while reading one (missing, a folder, unreadable, not UTF-8, not TOML, nested deeper than
+the parser's recursion allows, an integer literal longer than Python converts) becomes a
+:class:`~auvplan.errors.DataFormatError` whose one-line message names what the file is meant to
+be and where it is, e.g. ``vehicle file boat.toml: not UTF-8 text (byte 0xff at offset 9)``.
+"""
 
 from __future__ import annotations
 
 import tomllib
+from importlib.resources.abc import Traversable
 from pathlib import Path
 from typing import Any
 
 from auvplan.errors import DataFormatError
 
 
-def read_text(path: Path, *, what: str) -> str:
-    """The UTF-8 text of ``path``; ``what`` names the file's role in error messages.
+def read_text(path: Path | Traversable, *, what: str) -> str:
+    """The content of a UTF-8 text file (a leading byte-order mark is dropped).
+
+    Parameters
+    ----------
+    path : Path or Traversable
+        The file (a path or a packaged resource).
+    what : str
+        What the file is meant to be, for messages (``"vehicle file"``).
+
+    Returns
+    -------
+    str
+        The decoded text.
 
     Raises
     ------
     DataFormatError
-        Missing, unreadable or not UTF-8.
+        If the file is missing, a folder, unreadable, or not UTF-8; the message names ``what``
+        and the file.
+
+    Examples
+    --------
+    >>> read_text(Path("no/such/file.toml"), what="vehicle file")
+    Traceback (most recent call last):
+    ...
+    auvplan.errors.DataFormatError: vehicle file no/such/file.toml: file not found
     """
     try:
-        return Path(path).read_text(encoding="utf-8")
+        data = path.read_bytes()
     except FileNotFoundError:
-        raise DataFormatError(f"{what} not found: {path}") from None
+        raise DataFormatError(f"{what} {path}: file not found") from None
+    except IsADirectoryError:
+        raise DataFormatError(f"{what} {path}: is a folder, not a file") from None
+    except OSError as error:
+        raise DataFormatError(f"{what} {path}: cannot read ({error.strerror or error})") from None
+    try:
+        return data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
         raise DataFormatError(
-            f"{what} {path} is not UTF-8 text (byte {error.start}: {error.reason})"
+            f"{what} {path}: not UTF-8 text (byte 0x{data[error.start]:02x} at offset "
+            f"{error.start}); save it as UTF-8"
         ) from None
-    except OSError as error:
-        raise DataFormatError(f"cannot read {what} {path}: {error.strerror}") from None
 
 
-def read_toml(path: Path, *, what: str) -> dict[str, Any]:
-    """The TOML document in ``path`` (see :func:`read_text`; also invalid or too-deep TOML)."""
+def read_toml(path: Path | Traversable, *, what: str) -> dict[str, Any]:
+    """The document of a TOML file, read with :func:`read_text` and parsed by :mod:`tomllib`.
+
+    Parameters
+    ----------
+    path, what
+        As for :func:`read_text` (e.g. ``what="mission file"``).
+
+    Returns
+    -------
+    dict
+        The parsed document (tables are dicts, arrays are lists).
+
+    Raises
+    ------
+    DataFormatError
+        If the file cannot be read as text (see :func:`read_text`), is not valid TOML, nests
+        arrays or tables deeper than the parser can follow, or holds an integer with more
+        digits than Python converts; the message names ``what``, the file and the cause.
+    """
     text = read_text(path, what=what)
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
-        raise DataFormatError(f"{Path(path).name}: not valid TOML ({error})") from None
+        raise DataFormatError(f"{what} {path}: not valid TOML ({error})") from None
     except RecursionError:
-        raise DataFormatError(f"{Path(path).name}: not valid TOML (nested too deeply)") from None
+        raise DataFormatError(
+            f"{what} {path}: not valid TOML (arrays or tables nested too deeply)"
+        ) from None
+    except ValueError as error:  # e.g. an integer literal beyond sys.get_int_max_str_digits()
+        raise DataFormatError(f"{what} {path}: not valid TOML ({error})") from None
 
 
 __all__ = ["read_text", "read_toml"]

@@ -107,9 +107,13 @@ class GridGeometry:
         return row, col
 
     def to_index(self, north: FloatArray, east: FloatArray) -> tuple[IntArray, IntArray]:
-        """World ``(north, east)`` [m] to the index of the containing cell (may be out of range)."""
+        """World ``(north, east)`` [m] to the index of the containing cell.
+
+        A point outside the grid gets an out-of-range index: ``-1`` or ``n`` along the axis
+        where it is outside (NaN gives ``-1``), so that far-away points (1e300 m) cast safely.
+        """
         row, col = self.to_fractional_index(north, east)
-        return np.floor(row + 0.5).astype(np.int64), np.floor(col + 0.5).astype(np.int64)
+        return _cell_index(row, self.n_rows), _cell_index(col, self.n_cols)
 
     def contains(self, north: FloatArray, east: FloatArray) -> FloatArray:
         """Boolean array, true where the point lies inside the grid's cells."""
@@ -216,6 +220,12 @@ class BathymetryGrid:
             self.name,
             dict(self.attributes),
         )
+
+
+def _cell_index(fractional: FloatArray, n_cells: int) -> IntArray:
+    """``floor(fractional + 0.5)`` clipped to ``[-1, n_cells]`` (NaN -> -1), as int64."""
+    index = np.clip(np.floor(fractional + 0.5), -1.0, float(n_cells))
+    return np.where(np.isnan(index), -1.0, index).astype(np.int64)
 
 
 def _index_range(centres: FloatArray, bounds: tuple[float, float] | None, axis: str) -> slice:

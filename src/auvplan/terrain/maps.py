@@ -14,12 +14,19 @@ NaN cells (land, no data) stay NaN in every map: they are no-go cells downstream
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Final
 
 import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
 from auvplan.terrain.grid import BathymetryGrid, GridGeometry
+
+#: Range of the information exponent s (eq. 13): beyond it M_I is all 0 or all 1 in practice.
+MIN_EXPONENT: Final = 0.01
+MAX_EXPONENT: Final = 100.0
+#: Upper bound of the cost shift omega and the cost weight w (eq. 15).
+MAX_COST_TERM: Final = 1e6
 
 
 @dataclass(frozen=True)
@@ -29,16 +36,19 @@ class MapParameters:
     Parameters
     ----------
     exponent : float
-        Exponent :math:`s > 0` of the information map (eq. 13); 1 in the paper.
+        Exponent :math:`s` of the information map (eq. 13), in [0.01, 100]; 1 in the paper.
     block : tuple of int
         Block size :math:`(r_n, r_e)` in cells (north, east) of the excitation map (eq. 14),
         both >= 1.
     omega : float
-        Shift :math:`\omega > 0` of the cost map (eq. 15). The paper's Euclidean A* heuristic
-        needs :math:`\omega \ge \sqrt 2` to be admissible; that is a property of that heuristic,
-        not of the map, so smaller positive values are accepted here. Paper figure: 10.
+        Shift :math:`\omega` of the cost map (eq. 15), in (0, 1e6]. The paper's Euclidean A*
+        heuristic needs :math:`\omega \ge \sqrt 2` to be admissible; that is a property of
+        that heuristic, not of the map, so smaller positive values are accepted here. Paper
+        figure: 10.
     weight : float
-        Weight :math:`w \ge 0` of the cost map in the shifted cost (eq. 15); 10 in the paper.
+        Weight :math:`w` of the cost map in the shifted cost (eq. 15), in [0, 1e6]; 10 in the
+        paper. The bounds on :math:`\omega` and :math:`w` keep path costs (sums of
+        :math:`\omega + w M_C` over up to millions of cells) far from overflow.
 
     Raises
     ------
@@ -57,18 +67,23 @@ class MapParameters:
     weight: float = 10.0
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.exponent) and self.exponent > 0.0):
-            raise InputError(f"information exponent s must be > 0, got {self.exponent}")
+        if not MIN_EXPONENT <= self.exponent <= MAX_EXPONENT:
+            raise InputError(
+                f"information exponent s must be in [{MIN_EXPONENT:g}, {MAX_EXPONENT:g}], "
+                f"got {self.exponent}"
+            )
         if (
             len(self.block) != 2
             or any(int(b) != b or b < 1 for b in self.block)
             or any(isinstance(b, bool) for b in self.block)
         ):
             raise InputError(f"block must be two integers >= 1 (r_n, r_e), got {self.block}")
-        if not (np.isfinite(self.omega) and self.omega > 0.0):
-            raise InputError(f"cost shift omega must be > 0, got {self.omega}")
-        if not (np.isfinite(self.weight) and self.weight >= 0.0):
-            raise InputError(f"cost weight w must be >= 0, got {self.weight}")
+        if not 0.0 < self.omega <= MAX_COST_TERM:
+            raise InputError(
+                f"cost shift omega must be in (0, {MAX_COST_TERM:g}], got {self.omega}"
+            )
+        if not 0.0 <= self.weight <= MAX_COST_TERM:
+            raise InputError(f"cost weight w must be in [0, {MAX_COST_TERM:g}], got {self.weight}")
 
 
 @dataclass(frozen=True)

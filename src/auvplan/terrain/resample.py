@@ -11,6 +11,8 @@ Two array-in, grid-out functions used by the bathymetry readers (:mod:`auvplan.i
 
 from __future__ import annotations
 
+from typing import Final
+
 import numpy as np
 
 from auvplan._typing import FloatArray
@@ -25,6 +27,43 @@ _EDGE_TOLERANCE_CELLS = 0.01
 
 #: A node of a gridded point cloud is NaN when no sounding lies within this many spacings.
 _MAX_GAP_SPACINGS = 2.0
+
+#: Largest grid (nodes) either function builds: 25 M nodes are 200 MB per float64 map, and the
+#: terrain maps, A* and the figures hold several such arrays. Checked before any allocation.
+MAX_GRID_NODES: Final = 25_000_000
+
+
+def check_grid_size(n_rows: int, n_cols: int, spacing_north: float, spacing_east: float) -> None:
+    """Raise InputError if a grid of ``n_rows x n_cols`` nodes exceeds :data:`MAX_GRID_NODES`.
+
+    Parameters
+    ----------
+    n_rows, n_cols : int
+        Planned grid shape.
+    spacing_north, spacing_east : float
+        Planned node spacing [m], named in the message with the extent it implies.
+
+    Raises
+    ------
+    InputError
+        Naming the shape, spacing and extent, and what to change.
+
+    Examples
+    --------
+    >>> check_grid_size(100_000, 100_000, 1.0, 1.0)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    auvplan.errors.InputError: the grid would need 100000 x 100000 nodes at 1 m x 1 m spacing ...
+    """
+    n_nodes = n_rows * n_cols
+    if n_nodes > MAX_GRID_NODES:
+        raise InputError(
+            f"the grid would need {n_rows} x {n_cols} nodes at {spacing_north:.3g} m x "
+            f"{spacing_east:.3g} m spacing ({n_nodes:.3g} nodes over "
+            f"{n_rows * spacing_north / 1e3:.4g} km x {n_cols * spacing_east / 1e3:.4g} km; "
+            f"at most {MAX_GRID_NODES:.3g}): remove stray positions far from the data, "
+            "or split or crop the file"
+        )
 
 
 def project_geographic_grid(
@@ -96,6 +135,7 @@ def project_geographic_grid(
     n_cols = int(np.floor((east_max - east_min) / spacing_east + _EDGE_TOLERANCE_CELLS)) + 1
     if n_rows < 2 or n_cols < 2:
         raise InputError(f"projected grid is smaller than 2 x 2 nodes ({n_rows} x {n_cols})")
+    check_grid_size(n_rows, n_cols, spacing_north, spacing_east)
 
     geometry = GridGeometry(n_rows, n_cols, spacing_north, spacing_east)
     projection = centre.shifted(north_min, east_min)
@@ -178,10 +218,11 @@ def grid_scattered_points(
     Raises
     ------
     InputError
-        If fewer than 3 distinct finite soundings remain or the spacing is not positive.
+        If fewer than 3 distinct finite soundings remain, they span no area (all on one line),
+        the spacing is not positive, or the grid would exceed :data:`MAX_GRID_NODES`.
     """
     from scipy.interpolate import griddata  # imported here: slow to import, rarely needed
-    from scipy.spatial import cKDTree
+    from scipy.spatial import QhullError, cKDTree
 
     north = np.asarray(north, dtype=np.float64)
     east = np.asarray(east, dtype=np.float64)
@@ -205,11 +246,17 @@ def grid_scattered_points(
         raise InputError(
             f"soundings span fewer than 2 x 2 nodes at {spacing:g} m spacing ({n_rows} x {n_cols})"
         )
+    check_grid_size(n_rows, n_cols, spacing, spacing)
     geometry = GridGeometry(n_rows, n_cols, spacing, spacing)
     node_north, node_east = np.meshgrid(
         north_min + geometry.north, east_min + geometry.east, indexing="ij"
     )
-    values = griddata(points, depth, (node_north, node_east), method="linear")
+    try:
+        values = griddata(points, depth, (node_north, node_east), method="linear")
+    except QhullError:
+        raise InputError(
+            f"the {points.shape[0]} soundings lie on one line (no area to interpolate over)"
+        ) from None
     gap, _ = tree.query(np.column_stack([node_north.ravel(), node_east.ravel()]))
     values[(gap > _MAX_GAP_SPACINGS * spacing).reshape(values.shape)] = np.nan
     shifted = None if projection is None else projection.shifted(north_min, east_min)

@@ -22,6 +22,7 @@ import numpy as np
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
 from auvplan.terrain.grid import BathymetryGrid, GridGeometry
+from auvplan.terrain.resample import check_grid_size
 
 #: Centre of the crater [m] (north, east) on the default 400 m x 800 m map.
 BANK_CENTRE_NORTH = 200.0
@@ -70,7 +71,9 @@ def synthetic_bank(
     Raises
     ------
     InputError
-        If a size, the spacing or the depth range is not positive / ordered.
+        If the seed is not a non-negative integer, a size, the spacing or the depth range is
+        not positive / ordered, or the grid would exceed
+        :data:`~auvplan.terrain.resample.MAX_GRID_NODES`.
 
     Notes
     -----
@@ -89,6 +92,8 @@ def synthetic_bank(
     >>> round(float(bank.depth.min()), 6), round(float(bank.depth.max()), 6)
     (20.0, 60.0)
     """
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise InputError(f"synthetic bank seed must be an integer >= 0, got {seed!r}")
     if not (extent_north > 0.0 and extent_east > 0.0 and spacing > 0.0):
         raise InputError(
             f"synthetic bank extents and spacing must be positive, got "
@@ -103,6 +108,7 @@ def synthetic_bank(
     n_cols = round(extent_east / spacing) + 1
     if n_rows < 8 or n_cols < 8:
         raise InputError(f"synthetic bank needs at least 8 x 8 nodes, got {n_rows} x {n_cols}")
+    check_grid_size(n_rows, n_cols, spacing, spacing)
     geometry = GridGeometry(n_rows, n_cols, spacing, spacing)
     rng = np.random.default_rng(seed)
 

@@ -1,0 +1,363 @@
+"""Every bad input found by the user-fuzzing pass: exit 2, one stderr line, nothing left behind.
+
+Each case builds its input files in ``tmp_path``, runs the command line in-process, and checks
+the exact contract: exit code 2, exactly one line on stderr naming the cause, nothing on
+stdout, no traceback, and ``tmp_path`` (inputs, an earlier output folder) byte-for-byte as it
+was, with no new file or folder. SIGTERM is sent to a real ``auvplan`` process.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from auvplan.cli.main import EXIT_TERMINATED, main
+
+MEDUSA = resources.files("auvplan").joinpath("data", "vehicles", "medusa.toml").read_text()
+DEMO = resources.files("auvplan").joinpath("data", "missions", "demo.toml").read_text()
+
+
+def _tree(root: Path) -> dict[str, bytes | None]:
+    """Every entry below ``root``: relative path -> file content (None for folders)."""
+    return {
+        str(path.relative_to(root)): path.read_bytes() if path.is_file() else None
+        for path in sorted(root.rglob("*"))
+    }
+
+
+def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    try:
+        code = main(argv)
+    except SystemExit as exit_:  # usage errors leave through argparse
+        code = int(exit_.code or 0)
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def _write(path: Path, content: str | bytes) -> str:
+    if isinstance(content, str):
+        content = content.encode()
+    path.write_bytes(content)
+    return str(path)
+
+
+def _maps_on_netcdf(
+    name: str, lat: tuple[float, float], lon: tuple[float, float], elevation: float | np.ndarray
+) -> Callable[[Path], list[str]]:
+    """Arguments of ``auvplan maps`` on a 12 x 12 lat/lon NetCDF of ``elevation`` [m]."""
+
+    def build(tmp: Path) -> list[str]:
+        xr.Dataset(
+            {"elevation": (("lat", "lon"), np.broadcast_to(elevation, (12, 12)))},
+            coords={"lat": np.linspace(*lat, 12), "lon": np.linspace(*lon, 12)},
+        ).to_netcdf(tmp / name)
+        return ["maps", str(tmp / name), "-o", str(tmp / "out")]
+
+    return build
+
+
+def _maps_on_xyz(name: str, table: np.ndarray) -> Callable[[Path], list[str]]:
+    """Arguments of ``auvplan maps`` on an XYZ file of ``table``."""
+
+    def build(tmp: Path) -> list[str]:
+        np.savetxt(tmp / name, table, fmt="%.3f")
+        return ["maps", str(tmp / name), "-o", str(tmp / "out")]
+
+    return build
+
+
+def _survey(n: int = 300, offset: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
+    rng = np.random.default_rng(5)
+    east, north = rng.uniform(0.0, 300.0, n), rng.uniform(0.0, 200.0, n)
+    return np.column_stack(
+        [500_000.0 + offset[0] + east, 4_100_000.0 + offset[1] + north, 30.0 + 0.05 * north]
+    )
+
+
+def _previous_output(tmp: Path) -> Path:
+    """An earlier run's output folder that a failed run must leave untouched."""
+    out = tmp / "out"
+    out.mkdir()
+    (out / "maps.nc").write_bytes(b"earlier maps")
+    (out / "notes.txt").write_text("mine")
+    return out
+
+
+def _propeller_not_utf8(tmp: Path) -> list[str]:
+    _write(
+        tmp / "prop.csv",
+        "# Wageningen, transcribed by Jürgen\nk,A_T,B_T,A_Q,B_Q\n".encode("latin-1"),
+    )
+    boat = MEDUSA.replace('"wageningen_b4-70_pd1.4"', '"prop.csv"')
+    return ["vehicle", _write(tmp / "boat.toml", boat)]
+
+
+def _clash(tmp: Path) -> list[str]:
+    (_previous_output(tmp) / "maps.png").mkdir()  # a folder where the run writes a file
+    return ["maps", "synthetic", "-o", str(tmp / "out")]
+
+
+#: case -> (argv builder, text the one stderr line must contain)
+CASES: dict[str, tuple[Callable[[Path], list[str]], str]] = {
+    # 1. text files that are not UTF-8 or not parseable
+    "vehicle toml not utf-8": (
+        lambda tmp: ["vehicle", _write(tmp / "boat.toml", MEDUSA.encode("utf-16"))],
+        "boat.toml: not UTF-8 text (byte 0xff at offset 0)",
+    ),
+    "propeller csv not utf-8": (_propeller_not_utf8, "prop.csv: not UTF-8 text (byte 0xfc"),
+    "5000-deep toml array": (
+        lambda tmp: ["vehicle", _write(tmp / "deep.toml", "a = " + "[" * 5000 + "]" * 5000)],
+        "deep.toml: not valid TOML (arrays or tables nested too deeply)",
+    ),
+    # 2. XYZ surveys: degenerate geometry, absurd grid size
+    "collinear soundings": (
+        _maps_on_xyz("line.xyz", _survey()[:, [0, 0, 2]]),
+        "line.xyz: the 300 soundings lie on one line",
+    ),
+    "xyz over two far areas": (
+        _maps_on_xyz("two.xyz", np.vstack([_survey(), _survey(offset=(2e6, 3e6))])),
+        "two.xyz: the grid would need",
+    ),
+    # 3. NetCDF off the Earth or without a valid value
+    "netcdf latitude > 90": (
+        _maps_on_netcdf("pole.nc", (89.5, 95.0), (10.0, 10.1), -50.0),
+        "pole.nc: latitudes 89.5 … 95 deg are outside [-90, 90] deg",
+    ),
+    "netcdf longitude 400": (
+        _maps_on_netcdf("lon.nc", (40.0, 40.1), (400.0, 400.1), -50.0),
+        "lon.nc: longitudes 400 … 400.1 deg are outside [-180, 360] deg",
+    ),
+    "netcdf all -1e308": (
+        _maps_on_netcdf("huge.nc", (40.0, 40.1), (10.0, 10.1), -1e308),
+        "huge.nc: no valid value: all 144 values are no data or beyond ±12000 m",
+    ),
+    # 4. vehicle numbers outside their physical range
+    "vehicle n_max = 1e-9": (
+        lambda tmp: [
+            "vehicle",
+            _write(tmp / "boat.toml", MEDUSA.replace("value = 75.0,", "value = 1e-9,")),
+        ],
+        "propulsion.n_max must be >= 0.5 rev/s (range 0.5 … 1000 rev/s), got 1e-09",
+    ),
+    # 5. command-line values
+    "maps --seed -1": (
+        lambda tmp: ["maps", "synthetic", "--seed", "-1", "-o", str(tmp / "out")],
+        "seed must be an integer >= 0, got -1",
+    ),
+    "maps --omega 1.7e308": (
+        lambda tmp: ["maps", "synthetic", "--omega", "1.7e308", "-o", str(tmp / "out")],
+        "omega must be in (0, 1e+06], got 1.7e+308",
+    ),
+    "maps --seed not a number": (
+        lambda tmp: ["maps", "synthetic", "--seed", "x", "-o", str(tmp / "out")],
+        "auvplan maps: error: argument --seed: invalid int value: 'x'",
+    ),
+    "vehicle --figure fig.xyz": (
+        lambda tmp: ["vehicle", "--figure", str(tmp / "fig.xyz")],
+        "unsupported extension '.xyz' (supported: .avif, .eps,",
+    ),
+    "vehicle --figure .": (
+        lambda tmp: ["vehicle", "--figure", str(tmp) + "/."],
+        "is a folder, not a file name",
+    ),
+    "vehicle --figure in a missing folder": (
+        lambda tmp: ["vehicle", "--figure", str(tmp / "nowhere" / "fig.png")],
+        "nowhere does not exist",
+    ),
+    # 6. -q and -v together
+    "-q before and -v after the verb": (
+        lambda tmp: ["-q", "maps", "synthetic", "-v", "-o", str(tmp / "out")],
+        "-q/--quiet and -v/--verbose exclude each other",
+    ),
+    # 7. output folders
+    "-o an existing file": (
+        lambda tmp: ["maps", "synthetic", "-o", _write(tmp / "maps.png", b"a file")],
+        "maps.png exists and is not a folder",
+    ),
+    "-o the mission file itself": (
+        lambda tmp: [
+            "plan",
+            _write(tmp / "m.toml", DEMO),
+            "-o",
+            str(tmp / "m.toml"),
+            "--stage",
+            "preplan",
+        ],
+        "m.toml exists and is not a folder",
+    ),
+    "-o below a file": (
+        lambda tmp: ["maps", "synthetic", "-o", _write(tmp / "f", b"x") + "/out"],
+        "f is not a folder",
+    ),
+    "-o an unwritable place": (
+        lambda tmp: ["maps", "synthetic", "-o", "/proc/auvplan-test/out"],
+        "/proc/auvplan-test",
+    ),
+    "-o holding a folder named like an output file": (
+        _clash,
+        "maps.png is a folder but the run writes a file",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_bad_input_exits_2_with_one_line_and_leaves_nothing(
+    case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    build, expected = CASES[case]
+    argv = build(tmp_path)
+    before = _tree(tmp_path)
+    code, out, err = _run(argv, capsys)
+    assert code == 2, err
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("auvplan"), err
+    assert expected in lines[0]
+    assert "Traceback" not in err
+    assert out == ""
+    assert _tree(tmp_path) == before
+    assert not Path("/proc/auvplan-test").exists()
+
+
+def test_current_folder_as_output_is_refused(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    code, _, err = _run(["maps", "synthetic", "-o", "."], capsys)
+    assert code == 2
+    assert err == "auvplan: error: output folder . is the current folder or contains it: " + (
+        "choose a new or dedicated folder\n"
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["-q", "maps", "synthetic", "--block", "8", "8"],
+        ["maps", "-q", "synthetic", "--block", "8", "8"],
+        ["maps", "synthetic", "--block", "8", "8", "-q"],
+    ],
+)
+def test_quiet_before_or_after_the_verb(
+    argv: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    previous = _previous_output(tmp_path)
+    code, out, err = _run([*argv, "-o", str(previous)], capsys)
+    assert (code, out, err) == (0, "", "")
+    assert sorted(p.name for p in previous.iterdir()) == ["maps.nc", "maps.png", "notes.txt"]
+    assert (previous / "notes.txt").read_text() == "mine"  # other files are kept
+    assert (previous / "maps.nc").read_bytes() != b"earlier maps"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
+def test_verbose_after_the_verb_enables_debug(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = _run(["vehicle", "--json", "-v"], capsys)
+    assert code == 0
+    assert '"characteristics"' in out
+    assert logging.getLogger("auvplan").level == logging.NOTSET  # restored after the run
+
+
+def test_plan_accepts_quiet_after_the_verb(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    mission = _write(tmp_path / "demo.toml", DEMO)
+    out = tmp_path / "out"
+    argv = ["plan", "-q", mission, "-o", str(out), "--stage", "preplan", "--no-figures"]
+    code, stdout, _ = _run(argv, capsys)
+    assert (code, stdout) == (0, "")
+    assert (out / "paths.geojson").is_file()
+
+
+def test_stray_fix_and_absurd_values_are_warnings_not_errors(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], caplog: pytest.LogCaptureFixture
+) -> None:
+    """One (0, 0) fix among a survey, and -1e308 in a NetCDF: mapped, with a counted warning."""
+    survey = _survey()
+    survey[7] = (0.0, 0.0, 31.0)
+    elevation = -50.0 - 0.5 * np.add.outer(np.arange(12.0), np.arange(12.0))
+    elevation[4, 4] = -1e308
+    builds = [
+        _maps_on_xyz("stray.xyz", survey),
+        _maps_on_netcdf("absurd.nc", (40.0, 40.01), (10.0, 10.01), elevation),
+    ]
+    with caplog.at_level(logging.WARNING):
+        for build in builds:
+            code, _, err = _run([*build(tmp_path), "-q"], capsys)
+            assert (code, err) == (0, "")
+            assert (tmp_path / "out" / "maps.png").is_file()
+    assert "stray.xyz: dropped 1 of 300 soundings" in caplog.text
+    assert "absurd.nc: 1 of 144 values beyond ±12000 m treated as no data" in caplog.text
+
+
+# --- SIGTERM on a real process ---------------------------------------------------------------
+
+
+def _start_maps(out: Path) -> subprocess.Popen[str]:
+    source = Path(__file__).parents[2] / "src"
+    env = {**os.environ, "PYTHONPATH": f"{source}{os.pathsep}{os.environ.get('PYTHONPATH', '')}"}
+    command = [sys.executable, "-m", "auvplan.cli.main", "-q", "maps", "synthetic", "-o", str(out)]
+    return subprocess.Popen(command, env=env, stderr=subprocess.PIPE, text=True)
+
+
+def _wait_for(condition: Callable[[], bool], process: subprocess.Popen[str]) -> bool:
+    deadline = time.monotonic() + 60.0
+    while time.monotonic() < deadline and process.poll() is None:
+        if condition():
+            return True
+        time.sleep(0.005)
+    return False
+
+
+def test_sigterm_while_writing_leaves_the_old_folder_intact(tmp_path: Path) -> None:
+    """SIGTERM once the staging folder exists: exit 143, one line, old output untouched.
+
+    If the signal lands during the final swap it is held until the swap ends, so the folder
+    is then completely new; either way it is never half-updated and nothing is left over.
+    """
+    for attempt in range(3):
+        root = tmp_path / f"attempt{attempt}"
+        root.mkdir()
+        previous = _previous_output(root)
+        before = _tree(root)
+        process = _start_maps(previous)
+        staged = _wait_for(lambda root=root: any(root.glob(".out.*.partial")), process)
+        assert staged, "the run never staged its output"
+        process.send_signal(signal.SIGTERM)
+        _, err = process.communicate(timeout=60)
+        assert process.returncode == EXIT_TERMINATED, err
+        assert err == "auvplan: terminated\n"
+        after = _tree(root)
+        if after == before:
+            return
+        assert sorted(after) == ["out", "out/maps.nc", "out/maps.png", "out/notes.txt"]
+    pytest.fail("SIGTERM never landed before the swap in 3 attempts")
+
+
+def _catches_sigterm(process: subprocess.Popen[str]) -> bool:
+    """True once the process has a SIGTERM handler installed (Linux: SigCgt in /proc)."""
+    status = Path(f"/proc/{process.pid}/status").read_text()
+    caught = next(line.split()[1] for line in status.splitlines() if line.startswith("SigCgt:"))
+    return bool(int(caught, 16) & (1 << (signal.SIGTERM - 1)))
+
+
+@pytest.mark.skipif(not Path("/proc/self/status").is_file(), reason="needs Linux /proc")
+def test_sigterm_before_writing_creates_nothing(tmp_path: Path) -> None:
+    out = tmp_path / "new" / "out"
+    process = _start_maps(out)
+    assert _wait_for(lambda: _catches_sigterm(process), process)
+    process.send_signal(signal.SIGTERM)  # while importing and computing: nothing written yet
+    _, err = process.communicate(timeout=60)
+    assert (process.returncode, err) == (EXIT_TERMINATED, "auvplan: terminated\n")
+    assert list(tmp_path.iterdir()) == []
