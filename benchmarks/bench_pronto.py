@@ -33,12 +33,12 @@ import numpy as np
 
 from auvplan.optimization import (
     IpoptResult,
+    ModelCache,
     PathConstraint,
     ProntoOptions,
     ProntoResult,
     Trajectory,
     TrajectoryProblem,
-    build_model,
     project_guess,
     solve_ipopt,
     solve_pronto,
@@ -256,27 +256,28 @@ def compare(
     ``(ε, δ)`` for the cost check.
     """
     guess = _zero_guess(problem) if guess is None else guess
+    cache = ModelCache()
     start = time.perf_counter()
-    model = build_model(problem)  # CasADi derivative functions (cached per problem)
+    model = cache.get(problem)  # CasADi derivative functions, kept in the cache
     cold_build = time.perf_counter() - start
     initial, _ = project_guess(model, guess, options)
     start = time.perf_counter()
-    solve_pronto(problem, initial, options=options)  # first call: + maps, numba cache load
+    solve_pronto(problem, initial, options=options, cache=cache)  # + maps, numba cache load
     pronto_cold_time = cold_build + time.perf_counter() - start
     start = time.perf_counter()
-    pronto = solve_pronto(problem, initial, options=options)
+    pronto = solve_pronto(problem, initial, options=options, cache=cache)
     pronto_time = time.perf_counter() - start
     threaded = dataclasses.replace(options, n_threads=2)
-    solve_pronto(problem, initial, options=threaded)
+    solve_pronto(problem, initial, options=threaded, cache=cache)
     start = time.perf_counter()
-    solve_pronto(problem, initial, options=threaded)
+    solve_pronto(problem, initial, options=threaded, cache=cache)
     pronto_threads_time = time.perf_counter() - start
     compiled = dataclasses.replace(options, compile_c=True)
     start = time.perf_counter()
-    solve_pronto(problem, initial, options=compiled)  # includes the one-off C compilation
+    solve_pronto(problem, initial, options=compiled, cache=cache)  # + the one-off C compilation
     pronto_c_cold_time = time.perf_counter() - start
     start = time.perf_counter()
-    pronto_c = solve_pronto(problem, initial, options=compiled)
+    pronto_c = solve_pronto(problem, initial, options=compiled, cache=cache)
     pronto_c_time = time.perf_counter() - start
     ipopt = solve_ipopt(problem, initial)
     ipopt_mx = solve_ipopt(problem, initial, expand=False)
@@ -365,16 +366,20 @@ class ToyProblems:
         }[name]
         self.problem, self.options = builder()
         self.guess = _zero_guess(self.problem)
-        solve_pronto(self.problem, self.guess, options=self.options)
+        self.cache = ModelCache()
+        self._solve()
+
+    def _solve(self) -> ProntoResult:
+        return solve_pronto(self.problem, self.guess, options=self.options, cache=self.cache)
 
     def time_pronto(self, name: str) -> None:  # noqa: ARG002
-        solve_pronto(self.problem, self.guess, options=self.options)
+        self._solve()
 
     def track_pronto_iterations(self, name: str) -> int:  # noqa: ARG002
-        return len(solve_pronto(self.problem, self.guess, options=self.options).history)
+        return len(self._solve().history)
 
     def track_pronto_cost(self, name: str) -> float:  # noqa: ARG002
-        return solve_pronto(self.problem, self.guess, options=self.options).cost
+        return self._solve().cost
 
 
 class MedusaCrossing:
@@ -384,24 +389,29 @@ class MedusaCrossing:
 
     def setup(self) -> None:
         self.problem, self.options, guess = medusa_crossing()
-        self.guess, _ = project_guess(build_model(self.problem), guess, self.options)
-        solve_pronto(self.problem, self.guess, options=self.options)
+        self.cache = ModelCache()
+        self.guess, _ = project_guess(self.cache.get(self.problem), guess, self.options)
+        self._solve()
+
+    def _solve(self) -> ProntoResult:
+        return solve_pronto(self.problem, self.guess, options=self.options, cache=self.cache)
 
     def time_pronto(self) -> None:
-        solve_pronto(self.problem, self.guess, options=self.options)
+        self._solve()
 
     def track_pronto_iterations(self) -> int:
-        return len(solve_pronto(self.problem, self.guess, options=self.options).history)
+        return len(self._solve().history)
 
     def time_ipopt(self) -> None:
         solve_ipopt(self.problem, self.guess)
 
 
 def _profile(problem: TrajectoryProblem, guess: Trajectory, options: ProntoOptions) -> str:
-    solve_pronto(problem, guess, options=options)  # warm
+    cache = ModelCache()
+    solve_pronto(problem, guess, options=options, cache=cache)  # warm
     profiler = cProfile.Profile()
     profiler.enable()
-    solve_pronto(problem, guess, options=options)
+    solve_pronto(problem, guess, options=options, cache=cache)
     profiler.disable()
     stream = io.StringIO()
     pstats.Stats(profiler, stream=stream).sort_stats("tottime").print_stats(12)
@@ -428,7 +438,7 @@ def main(argv: list[str]) -> int:
         problem, options, guess = medusa_crossing()
         rows.append(compare("MEDUSA 2-vehicle crossing", problem, options, guess))
         if args.profile:
-            initial, _ = project_guess(build_model(problem), guess, options)
+            initial, _ = project_guess(ModelCache().get(problem), guess, options)
             print("profile, CasADi virtual machine:")
             print(_profile(problem, initial, options))
             print("profile, compiled stage functions:")

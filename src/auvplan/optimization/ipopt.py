@@ -21,7 +21,7 @@ import casadi as ca
 import numpy as np
 
 from auvplan.errors import InputError
-from auvplan.optimization.barrier import barrier_expression
+from auvplan.optimization.barrier import BarrierKind, barrier_expression
 from auvplan.optimization.discretization import discretize_rk4
 from auvplan.optimization.problem import Trajectory, TrajectoryProblem
 
@@ -144,7 +144,8 @@ def solve_ipopt(
             inequalities.append(ca.vec(slack))
         if barrier is not None:
             epsilon, delta = barrier
-            values = barrier_expression(slack, delta, is_hockey=constraint.kind == "hockey")
+            is_hockey = constraint.kind is BarrierKind.HOCKEY
+            values = barrier_expression(slack, delta, is_hockey=is_hockey)
             barrier_term = barrier_term + epsilon * problem.dt * ca.sum1(ca.sum2(values))
     variables = ca.vertcat(ca.vec(states), ca.vec(inputs))
     n_ineq = sum(int(g.numel()) for g in inequalities)

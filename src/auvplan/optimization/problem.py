@@ -26,6 +26,8 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
+from auvplan.optimization.barrier import BarrierKind
+from auvplan.optimization.options import named_choice
 
 __all__ = ["PathConstraint", "Trajectory", "TrajectoryProblem"]
 
@@ -38,10 +40,11 @@ class PathConstraint:
     ----------
     function : casadi.Function
         ``c(x[n_x], u[n_u], p[n_p]) -> (n_c,)``; feasible when every component is ``>= 0``.
-    kind : {"plain", "hockey"}
+    kind : BarrierKind or {"plain", "hockey"}
         ``"hockey"`` composes the barrier with the hockey stick ``σ`` so it vanishes far
         from the constraint (use for non-convex constraints such as separations);
         ``"plain"`` uses ``β_δ(s)`` directly (convex constraints such as input bounds).
+        Strings are converted to :class:`BarrierKind`.
     scale : float
         Slack scale: the barrier sees ``s = c / scale``; choose it so that ``s ≈ 1`` is a
         meaningful margin (unit of ``c``).
@@ -50,7 +53,7 @@ class PathConstraint:
     """
 
     function: ca.Function
-    kind: Literal["plain", "hockey"] = "hockey"
+    kind: BarrierKind | Literal["plain", "hockey"] = BarrierKind.HOCKEY
     scale: float = 1.0
     name: str = "constraint"
 
@@ -59,8 +62,9 @@ class PathConstraint:
             raise InputError(
                 f"PathConstraint.function must be a casadi.Function, got {self.function!r}"
             )
-        if self.kind not in ("plain", "hockey"):
-            raise InputError(f"PathConstraint.kind must be 'plain' or 'hockey', got {self.kind!r}")
+        object.__setattr__(
+            self, "kind", named_choice(BarrierKind, self.kind, "PathConstraint.kind")
+        )
         if not (np.isfinite(self.scale) and self.scale > 0.0):
             raise InputError(f"PathConstraint.scale must be positive, got {self.scale!r}")
 
