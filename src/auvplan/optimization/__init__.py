@@ -30,6 +30,7 @@ from auvplan.optimization.barrier import (
 )
 from auvplan.optimization.constraints import ConstraintModel, discretize_constraints
 from auvplan.optimization.discretization import DiscreteModel, discretize_rk4
+from auvplan.optimization.integration import choose_substeps
 from auvplan.optimization.ipopt import IpoptResult, IpoptStatus, solve_ipopt
 from auvplan.optimization.linesearch import (
     ArmijoResult,
@@ -88,6 +89,7 @@ __all__ = [
     "armijo_step",
     "barrier_expression",
     "build_model",
+    "choose_substeps",
     "composed_barrier",
     "compute_costate",
     "compute_direction",

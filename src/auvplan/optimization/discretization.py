@@ -47,7 +47,7 @@ from auvplan.optimization._casadi import (
     with_symbol_fallback,
 )
 from auvplan.optimization._compile import compile_functions
-from auvplan.optimization.integration import rk4_step
+from auvplan.optimization.integration import check_substeps, rk4_step
 
 __all__ = ["DiscreteModel", "StageFunctions", "discretize_rk4"]
 
@@ -95,6 +95,8 @@ class DiscreteModel:
         State, input and stage-parameter dimensions.
     dt : float
         Control interval [s] (the length of one step of ``F``).
+    n_substeps : int
+        RK4 substeps per step (each ``dt / n_substeps`` long).
     functions : StageFunctions
         The single-stage Functions.
     parallelization : {"serial", "thread"}
@@ -107,6 +109,7 @@ class DiscreteModel:
     n_u: int
     n_p: int
     dt: float
+    n_substeps: int
     functions: StageFunctions = field(repr=False)
     parallelization: Parallelization = "serial"
     n_threads: int = 2
@@ -301,13 +304,14 @@ def _build_stage_functions(
     running_cost: ca.Function,
     sizes: list[int],
     dt: float,
+    n_substeps: int,
     use_sx: bool,
 ) -> StageFunctions:
     """Build every single-stage CasADi Function of the RK4 map (SX or MX symbols)."""
     x, u, p = symbols(sizes, _ARGS, use_sx)
     n_x, n_u = sizes[0], sizes[1]
     lam, alpha, mu, gains = symbols([n_x, n_x, n_u, n_u * n_x], ["lam", "alpha", "mu", "k"], use_sx)
-    x_next, stage_cost = rk4_step(dynamics, running_cost, x, u, p, dt)
+    x_next, stage_cost = rk4_step(dynamics, running_cost, x, u, p, dt, n_substeps)
     f_x = row_major(ca.jacobian(x_next, x))
     f_u = row_major(ca.jacobian(x_next, u))
     l_x = ca.gradient(stage_cost, x)
@@ -359,12 +363,13 @@ def discretize_rk4(
     running_cost: ca.Function,
     dt: float,
     *,
+    n_substeps: int = 1,
     parallelization: Parallelization = "serial",
     n_threads: int = 2,
     compile_c: bool = False,
     cache_dir: Path | None = None,
 ) -> DiscreteModel:
-    """Discretise ``ẋ = f(x, u, p)`` and the cost rate ``l`` by one RK4 step (zero-order hold).
+    """Discretise ``ẋ = f(x, u, p)`` and the cost rate ``l`` by RK4 steps (zero-order hold).
 
     Parameters
     ----------
@@ -373,7 +378,10 @@ def discretize_rk4(
     running_cost : casadi.Function
         ``l(x, u, p) -> scalar``: running-cost *rate* (cost per second).
     dt : float
-        Step length [s], > 0.
+        Control interval [s], > 0: the length of one step of ``F``.
+    n_substeps : int, optional
+        RK4 substeps of length ``dt / n_substeps`` per step (``u`` and ``p`` held); see
+        :func:`~auvplan.optimization.integration.choose_substeps`.
     parallelization : {"serial", "thread"}, optional
         Evaluation mode of the batched (``map``) functions.
     n_threads : int, optional
@@ -393,7 +401,8 @@ def discretize_rk4(
     Raises
     ------
     InputError
-        If the functions have the wrong arity or sizes, or ``dt`` is not positive.
+        If the functions have the wrong arity or sizes, ``dt`` is not positive or
+        ``n_substeps`` not a positive integer.
 
     Notes
     -----
@@ -412,6 +421,7 @@ def discretize_rk4(
     """
     if not np.isfinite(dt) or dt <= 0.0:
         raise InputError(f"dt must be a positive number of seconds, got {dt!r}")
+    check_substeps(n_substeps)
     sizes = signature_sizes(dynamics, "dynamics", 3, 1)
     cost_sizes = signature_sizes(running_cost, "running_cost", 3, 1)
     if cost_sizes != sizes:
@@ -421,7 +431,9 @@ def discretize_rk4(
     if running_cost.numel_out(0) != 1:
         raise InputError(f"running_cost must return a scalar, got {running_cost.size_out(0)}")
     functions = with_symbol_fallback(
-        lambda use_sx: _build_stage_functions(dynamics, running_cost, sizes, float(dt), use_sx)
+        lambda use_sx: _build_stage_functions(
+            dynamics, running_cost, sizes, float(dt), int(n_substeps), use_sx
+        )
     )
     if compile_c:
         functions = functions.compiled(cache_dir)
@@ -430,6 +442,7 @@ def discretize_rk4(
         n_u=sizes[1],
         n_p=sizes[2],
         dt=float(dt),
+        n_substeps=int(n_substeps),
         functions=functions,
         parallelization=parallelization,
         n_threads=n_threads,

@@ -1,8 +1,8 @@
 """CasADi + IPOPT bridge: the identical discretised problem by direct multiple shooting.
 
-The decision variables are all states ``x_0..x_N`` and inputs ``u_0..u_{N-1}`` on the same RK4
-grid; the defects ``F(x_k, u_k, p_k) − x_{k+1} = 0`` use the very same RK4 step Function as
-PRONTO, the objective the same stage cost ``Σ L_k + m(x_N)`` (see
+The decision variables are all states ``x_0..x_N`` and inputs ``u_0..u_{N-1}`` on the same
+grid; the defects ``F(x_k, u_k, p_k) − x_{k+1} = 0`` use the very same (substepped) RK4 step
+Function as PRONTO, the objective the same stage cost ``Σ L_k + m(x_N)`` (see
 :mod:`auvplan.optimization.problem`). Path constraints are hard inequalities
 ``c(x_k, u_k, p_k) / scale ≥ 0``; with ``barrier=(ε, δ)`` the objective also carries the
 identical approximate-barrier term ``ε dt Σ b(c / scale)`` so that costs are comparable with
@@ -128,7 +128,9 @@ def solve_ipopt(
         )
     if barrier is not None and not (barrier[0] > 0 and barrier[1] > 0):
         raise InputError(f"barrier must be (epsilon > 0, delta > 0), got {barrier!r}")
-    model = discretize_rk4(problem.dynamics, problem.running_cost, problem.dt)
+    model = discretize_rk4(
+        problem.dynamics, problem.running_cost, problem.dt, n_substeps=problem.n_substeps
+    )
     params = problem.parameters.T
     states = ca.MX.sym("X", n_x, n_steps + 1)
     inputs = ca.MX.sym("U", n_u, n_steps)

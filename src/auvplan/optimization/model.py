@@ -78,6 +78,7 @@ def build_model(
         problem.dynamics,
         problem.running_cost,
         problem.dt,
+        n_substeps=problem.n_substeps,
         parallelization="thread" if n_threads > 1 else "serial",
         n_threads=n_threads,
         compile_c=compile_c,

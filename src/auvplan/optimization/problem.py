@@ -9,11 +9,12 @@ IPOPT bridge is
         + ε\, dt \sum_j b_j\big(c_j(x_k, u_k, p_k) / \text{scale}_j\big) \Big] + m(x_N)
     \quad \text{s.t.}\quad x_{k+1} = F(x_k, u_k, p_k),\; x_0 = x0,
 
-with ``F`` one RK4 step and ``L`` the RK4 quadrature of the running-cost rate (see
-:mod:`auvplan.optimization.discretization`), ``b_j`` the approximate log barrier composed with
-the hockey stick (``kind="hockey"``) or not (``kind="plain"``), see
-:mod:`auvplan.optimization.barrier`. Path constraints are imposed at the nodes
-``k = 0..N-1`` (where an input exists); ``x_N`` is steered by the terminal cost.
+with ``F`` the flow of the dynamics over the control interval ``dt``, approximated by
+``n_substeps`` RK4 substeps (``u_k``, ``p_k`` held), and ``L`` the RK4 quadrature of the
+running-cost rate along the same substeps (see :mod:`auvplan.optimization.integration`),
+``b_j`` the approximate log barrier composed with the hockey stick (``kind="hockey"``) or not
+(``kind="plain"``), see :mod:`auvplan.optimization.barrier`. Path constraints are imposed at
+the nodes ``k = 0..N-1`` (where an input exists); ``x_N`` is steered by the terminal cost.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ import numpy as np
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
 from auvplan.optimization.barrier import BarrierKind
+from auvplan.optimization.integration import check_substeps
 from auvplan.optimization.options import named_choice
 
 __all__ = ["PathConstraint", "Trajectory", "TrajectoryProblem"]
@@ -88,7 +90,7 @@ def _as_matrix(value: FloatArray, size: int, name: str) -> FloatArray:
 
 @dataclass(frozen=True)
 class TrajectoryProblem:
-    """Fixed-horizon optimal-control problem on a uniform RK4 grid.
+    """Fixed-horizon optimal-control problem on a uniform grid of control intervals.
 
     Attributes
     ----------
@@ -101,7 +103,8 @@ class TrajectoryProblem:
     initial_state : ndarray of shape (n_x,)
         ``x0``.
     dt : float
-        Step length [s].
+        Control interval [s]: inputs and stage parameters are held over it, and the states
+        and inputs of a :class:`Trajectory` are sampled at this interval.
     n_steps : int
         Number of stages ``N`` (horizon ``T = N dt``).
     stage_parameters : ndarray of shape (n_steps, n_p)
@@ -112,6 +115,9 @@ class TrajectoryProblem:
         State weight of the projection regulator (diagonal when 1-D); default identity.
     regulator_R : ndarray of shape (n_u, n_u) or (n_u,)
         Input weight of the projection regulator; default identity.
+    n_substeps : int
+        RK4 substeps of length ``dt / n_substeps`` per control interval (default 1); see
+        :func:`~auvplan.optimization.integration.choose_substeps`.
     """
 
     dynamics: ca.Function
@@ -124,6 +130,7 @@ class TrajectoryProblem:
     constraints: tuple[PathConstraint, ...] = ()
     regulator_Q: FloatArray | None = field(default=None)
     regulator_R: FloatArray | None = field(default=None)
+    n_substeps: int = 1
 
     def __post_init__(self) -> None:
         for name in ("dynamics", "running_cost", "terminal_cost"):
@@ -138,6 +145,7 @@ class TrajectoryProblem:
             raise InputError(f"n_steps must be a positive integer, got {self.n_steps!r}")
         if not (np.isfinite(self.dt) and self.dt > 0.0):
             raise InputError(f"dt must be a positive number of seconds, got {self.dt!r}")
+        check_substeps(self.n_substeps)
         x0 = np.asarray(self.initial_state, dtype=np.float64).reshape(-1)
         if x0.shape != (n_x,) or not np.all(np.isfinite(x0)):
             raise InputError(f"initial_state must be finite with shape ({n_x},), got {x0.shape}")
