@@ -36,10 +36,10 @@ def test_cache_returns_the_same_model_per_problem_and_options() -> None:
 
 
 def test_cached_model_evaluates_like_a_fresh_one() -> None:
-    problem = crossing_problem()
+    problem = unicycle_problem()
     cache = ModelCache()
     guess = zero_guess(problem)
-    options = ProntoOptions(eps_final=1e-2)
+    options = ProntoOptions()
     first = solve_pronto(problem, guess, options=options, cache=cache)
     again = solve_pronto(problem, guess, options=options, cache=cache)
     fresh = solve_pronto(problem, guess, options=options)
