@@ -5,6 +5,7 @@ Run once and print the comparison table::
     .venv/bin/python benchmarks/bench_pronto.py            # toy problems + MEDUSA crossing
     .venv/bin/python benchmarks/bench_pronto.py --quick    # toy problems only
     .venv/bin/python benchmarks/bench_pronto.py --profile  # + cProfile of the MEDUSA solve
+    .venv/bin/python benchmarks/bench_pronto.py --substeps # stage-function cost per RK4 substeps
 
 Also usable with asv (classes with ``setup``, ``time_*`` and ``track_*``).
 
@@ -26,12 +27,14 @@ import pstats
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
 from auvplan.optimization import (
+    DiscreteModel,
     IpoptResult,
     ModelCache,
     PathConstraint,
@@ -39,10 +42,12 @@ from auvplan.optimization import (
     ProntoResult,
     Trajectory,
     TrajectoryProblem,
+    discretize_rk4,
     project_guess,
     solve_ipopt,
     solve_pronto,
 )
+from auvplan.optimization.stage_functions import SOLVER_FUNCTIONS
 
 # ---------------------------------------------------------------------------------------------
 # problems
@@ -406,6 +411,90 @@ class MedusaCrossing:
         solve_ipopt(self.problem, self.guess)
 
 
+SUBSTEPS = (1, 2, 4, 8)
+
+
+def _stage_points(
+    problem: TrajectoryProblem, guess: Trajectory
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Stage points near the guess (seeded), and costates, for timing the stage functions."""
+    rng = np.random.default_rng(0)
+    shape = (problem.n_steps, problem.n_states)
+    states = guess.states[:-1] + 0.01 * rng.standard_normal(shape)
+    inputs = 0.1 * rng.standard_normal((problem.n_steps, problem.n_inputs))
+    return states, inputs, problem.parameters, rng.standard_normal(shape)
+
+
+def _cpu_time(evaluate: Callable[[], object], repeats: int) -> float:
+    """Smallest CPU time of ``repeats`` calls (after one warm-up call) [s]."""
+    evaluate()
+    times = []
+    for _ in range(repeats):
+        start = time.process_time()
+        evaluate()
+        times.append(time.process_time() - start)
+    return min(times)
+
+
+def substep_timings(substeps: tuple[int, ...] = SUBSTEPS, repeats: int = 5) -> str:
+    """Cost of the stage functions of the MEDUSA crossing per number of RK4 substeps ``m``.
+
+    Build: ``discretize_rk4`` and the Functions a solve uses (CasADi graph, derivatives,
+    common-subexpression elimination; wall time).
+    Evaluation: CPU time of one batched call over all ``N`` stages (``process_time``, smallest
+    of ``repeats``), for the λ-weighted Lagrangian Hessians (``Q, S, R``), the first-order data
+    and the step.
+    """
+    problem, _, guess = medusa_crossing(propeller_order=3)
+    states, inputs, params, costates = _stage_points(problem, guess)
+    lines = [
+        (
+            f"MEDUSA crossing, 2 vehicles (n_x = {problem.n_states}, n_u = {problem.n_inputs}), "
+            f"N = {problem.n_steps}, dt = {problem.dt} s"
+        ),
+        "",
+        "| m | build s | Hessians s (µs/stage) | first order s | step s |",
+        "|---|---|---|---|---|",
+    ]
+    for m in substeps:
+        start = time.perf_counter()
+        model: DiscreteModel = discretize_rk4(
+            problem.dynamics, problem.running_cost, problem.dt, n_substeps=m
+        )
+        for name in SOLVER_FUNCTIONS:  # built on first use: build them here
+            getattr(model.functions, name)
+        build = time.perf_counter() - start
+        hessians = _cpu_time(
+            lambda model=model: model.lagrangian_hessians(states, inputs, params, costates),
+            repeats,
+        )
+        first = _cpu_time(lambda model=model: model.first_order(states, inputs, params), repeats)
+        step = _cpu_time(lambda model=model: model.step(states, inputs, params), repeats)
+        lines.append(
+            f"| {m} | {build:.2f} | {hessians:.3f} ({1e6 * hessians / problem.n_steps:.0f}) | "
+            f"{first:.3f} | {step:.4f} |"
+        )
+    return "\n".join(lines)
+
+
+class SubstepHessians:
+    """asv: the MEDUSA crossing's λ-weighted Hessians per number of RK4 substeps."""
+
+    params = SUBSTEPS
+    param_names = ("n_substeps",)
+    timeout = 600.0
+
+    def setup(self, n_substeps: int) -> None:
+        problem, _, guess = medusa_crossing(propeller_order=3)
+        self.points = _stage_points(problem, guess)
+        self.model = discretize_rk4(
+            problem.dynamics, problem.running_cost, problem.dt, n_substeps=n_substeps
+        )
+
+    def time_lagrangian_hessians(self, n_substeps: int) -> None:  # noqa: ARG002
+        self.model.lagrangian_hessians(*self.points)
+
+
 def _profile(problem: TrajectoryProblem, guess: Trajectory, options: ProntoOptions) -> str:
     cache = ModelCache()
     solve_pronto(problem, guess, options=options, cache=cache)  # warm
@@ -424,7 +513,13 @@ def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="toy problems only")
     parser.add_argument("--profile", action="store_true", help="profile the MEDUSA solve")
+    parser.add_argument(
+        "--substeps", action="store_true", help="only the stage-function cost per RK4 substeps"
+    )
     args = parser.parse_args(argv)
+    if args.substeps:
+        print(substep_timings())
+        return 0
     rows = []
     for name, builder in (
         ("pendulum swing-up", pendulum_swing_up),

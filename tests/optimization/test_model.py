@@ -65,3 +65,13 @@ def test_named_choices_accept_strings_and_reject_unknown_values() -> None:
     plain = PathConstraint(constraint.function, kind="plain")
     assert plain.kind is BarrierKind.PLAIN
     assert plain.kind == "plain"
+
+
+def test_a_solve_builds_only_the_functions_it_evaluates() -> None:
+    """Stage Functions are built on first use (building costs seconds for vehicle fleets)."""
+    problem = unicycle_problem()
+    cache = ModelCache()
+    solve_pronto(problem, zero_guess(problem), cache=cache)
+    built = set(vars(cache.get(problem).discrete.functions))
+    assert {"first_order", "lagrangian_hessian", "closed_loop_step"} <= built
+    assert not {"dyn_hessian", "cost_hessian", "cost_gradient"} & built

@@ -25,7 +25,7 @@ Every method takes and returns time-major arrays (layout: :mod:`auvplan.optimiza
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import casadi as ca
@@ -37,48 +37,16 @@ from auvplan.optimization._casadi import (
     Parallelization,
     StageEvaluator,
     check_stages,
-    dense_function,
     evaluate,
-    hessian_blocks,
     hessian_shapes,
-    row_major,
     signature_sizes,
     symbols,
     with_symbol_fallback,
 )
-from auvplan.optimization._compile import compile_functions
 from auvplan.optimization.integration import check_substeps, rk4_step
+from auvplan.optimization.stage_functions import StageFunctions
 
-__all__ = ["DiscreteModel", "StageFunctions", "discretize_rk4"]
-
-_ARGS = ["x", "u", "p"]
-_HESSIANS = ["h_xx", "h_xu", "h_uu"]
-
-
-@dataclass(frozen=True)
-class StageFunctions:
-    """Single-stage CasADi Functions of the discrete map (built by :func:`discretize_rk4`).
-
-    Every Function takes ``(x, u, p)``; the Hessians also the weights ``λ``, and
-    ``closed_loop_step`` takes ``(x, α, μ, K, p)``. Matrices are flattened row-major.
-    """
-
-    step: ca.Function
-    cost: ca.Function
-    jacobians: ca.Function
-    first_order: ca.Function
-    dyn_hessian: ca.Function
-    cost_gradient: ca.Function
-    cost_hessian: ca.Function
-    lagrangian_hessian: ca.Function
-    closed_loop_step: ca.Function
-
-    def compiled(self, cache_dir: Path | None) -> StageFunctions:
-        """The same Functions compiled to C (see :func:`compile_functions`)."""
-        compiled = compile_functions(
-            {item.name: getattr(self, item.name) for item in fields(self)}, cache_dir
-        )
-        return StageFunctions(**compiled)
+__all__ = ["DiscreteModel", "discretize_rk4"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -299,7 +267,7 @@ class DiscreteModel:
         return states, inputs
 
 
-def _build_stage_functions(
+def _stage_functions(
     dynamics: ca.Function,
     running_cost: ca.Function,
     sizes: list[int],
@@ -307,55 +275,10 @@ def _build_stage_functions(
     n_substeps: int,
     use_sx: bool,
 ) -> StageFunctions:
-    """Build every single-stage CasADi Function of the RK4 map (SX or MX symbols)."""
-    x, u, p = symbols(sizes, _ARGS, use_sx)
-    n_x, n_u = sizes[0], sizes[1]
-    lam, alpha, mu, gains = symbols([n_x, n_x, n_u, n_u * n_x], ["lam", "alpha", "mu", "k"], use_sx)
+    """The stage Functions of the RK4 map on SX or MX symbols."""
+    x, u, p = symbols(sizes, ["x", "u", "p"], use_sx)
     x_next, stage_cost = rk4_step(dynamics, running_cost, x, u, p, dt, n_substeps)
-    f_x = row_major(ca.jacobian(x_next, x))
-    f_u = row_major(ca.jacobian(x_next, u))
-    l_x = ca.gradient(stage_cost, x)
-    l_u = ca.gradient(stage_cost, u)
-    args = [x, u, p]
-    step = dense_function("rk4_step", args, [x_next], _ARGS, ["x_next"])
-    closed_u = mu + ca.reshape(gains, n_x, n_u).T @ (alpha - x)
-    return StageFunctions(
-        step=step,
-        cost=dense_function("rk4_cost", args, [stage_cost], _ARGS, ["l"]),
-        jacobians=dense_function("rk4_jac", args, [f_x, f_u], _ARGS, ["f_x", "f_u"]),
-        first_order=dense_function(
-            "rk4_first",
-            args,
-            [f_x, f_u, stage_cost, l_x, l_u],
-            _ARGS,
-            ["f_x", "f_u", "l", "l_x", "l_u"],
-        ),
-        dyn_hessian=dense_function(
-            "rk4_dyn_hess",
-            [*args, lam],
-            hessian_blocks(ca.dot(lam, x_next), x, u),
-            [*_ARGS, "lam"],
-            _HESSIANS,
-        ),
-        cost_gradient=dense_function("rk4_cost_grad", args, [l_x, l_u], _ARGS, ["l_x", "l_u"]),
-        cost_hessian=dense_function(
-            "rk4_cost_hess", args, hessian_blocks(stage_cost, x, u), _ARGS, _HESSIANS
-        ),
-        lagrangian_hessian=dense_function(
-            "rk4_lag_hess",
-            [*args, lam],
-            hessian_blocks(stage_cost + ca.dot(lam, x_next), x, u),
-            [*_ARGS, "lam"],
-            _HESSIANS,
-        ),
-        closed_loop_step=dense_function(
-            "rk4_closed_loop",
-            [x, alpha, mu, gains, p],
-            [step(x, closed_u, p)],
-            ["x", "alpha", "mu", "k", "p"],
-            ["x_next"],
-        ),
-    )
+    return StageFunctions(x, u, p, x_next, stage_cost, use_sx)
 
 
 def discretize_rk4(
@@ -431,7 +354,7 @@ def discretize_rk4(
     if running_cost.numel_out(0) != 1:
         raise InputError(f"running_cost must return a scalar, got {running_cost.size_out(0)}")
     functions = with_symbol_fallback(
-        lambda use_sx: _build_stage_functions(
+        lambda use_sx: _stage_functions(
             dynamics, running_cost, sizes, float(dt), int(n_substeps), use_sx
         )
     )
