@@ -161,17 +161,9 @@ def check_stages(array: FloatArray, n_cols: int, name: str, n_stages: int | None
 class StageEvaluator:
     """Evaluates single-stage Functions ``g(x, u, p[, w])`` over ``N`` stages in one call.
 
-    The mapped Functions (``g.map(N)``, ``"thread"`` mode when asked) are built on first use
+    ``(n_x, n_u, n_p)`` are the sizes of ``(x, u, p)``. The mapped Functions (``g.map(N)``,
+    with ``n_threads`` threads when ``parallelization == "thread"``) are built on first use
     and kept per ``(name, N)``.
-
-    Attributes
-    ----------
-    n_x, n_u, n_p : int
-        State, input and stage-parameter dimensions.
-    parallelization : {"serial", "thread"}
-        How CasADi's ``map`` evaluates the stages.
-    n_threads : int
-        Number of threads when ``parallelization == "thread"``.
     """
 
     n_x: int

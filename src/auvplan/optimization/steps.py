@@ -128,12 +128,8 @@ def compute_direction(
 
     Parameters
     ----------
-    model : ProntoModel
-        Evaluators.
-    trajectory : Trajectory
-        Current trajectory ``ξ``.
-    epsilon, delta : float
-        Barrier weight and switching point.
+    model, trajectory, epsilon, delta
+        As for :func:`local_model`.
     options : ProntoOptions, optional
         ``terminal_regulator``, ``fallback_model`` and ``eigenvalue_floor`` are used.
 
