@@ -5,6 +5,7 @@ Run once and print the comparison table::
     .venv/bin/python benchmarks/bench_pronto.py            # toy problems + MEDUSA crossing
     .venv/bin/python benchmarks/bench_pronto.py --quick    # toy problems only
     .venv/bin/python benchmarks/bench_pronto.py --profile  # + cProfile of the MEDUSA solve
+    .venv/bin/python benchmarks/bench_pronto.py --substeps # stage-function cost per RK4 substeps
 
 Also usable with asv (classes with ``setup``, ``time_*`` and ``track_*``).
 
@@ -26,23 +27,27 @@ import pstats
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
 from auvplan.optimization import (
+    DiscreteModel,
     IpoptResult,
+    ModelCache,
     PathConstraint,
     ProntoOptions,
     ProntoResult,
     Trajectory,
     TrajectoryProblem,
-    build_model,
+    discretize_rk4,
     project_guess,
     solve_ipopt,
     solve_pronto,
 )
+from auvplan.optimization.stage_functions import SOLVER_FUNCTIONS
 
 # ---------------------------------------------------------------------------------------------
 # problems
@@ -256,27 +261,28 @@ def compare(
     ``(ε, δ)`` for the cost check.
     """
     guess = _zero_guess(problem) if guess is None else guess
+    cache = ModelCache()
     start = time.perf_counter()
-    model = build_model(problem)  # CasADi derivative functions (cached per problem)
+    model = cache.get(problem)  # CasADi derivative functions, kept in the cache
     cold_build = time.perf_counter() - start
     initial, _ = project_guess(model, guess, options)
     start = time.perf_counter()
-    solve_pronto(problem, initial, options=options)  # first call: + maps, numba cache load
+    solve_pronto(problem, initial, options=options, cache=cache)  # + maps, numba cache load
     pronto_cold_time = cold_build + time.perf_counter() - start
     start = time.perf_counter()
-    pronto = solve_pronto(problem, initial, options=options)
+    pronto = solve_pronto(problem, initial, options=options, cache=cache)
     pronto_time = time.perf_counter() - start
     threaded = dataclasses.replace(options, n_threads=2)
-    solve_pronto(problem, initial, options=threaded)
+    solve_pronto(problem, initial, options=threaded, cache=cache)
     start = time.perf_counter()
-    solve_pronto(problem, initial, options=threaded)
+    solve_pronto(problem, initial, options=threaded, cache=cache)
     pronto_threads_time = time.perf_counter() - start
     compiled = dataclasses.replace(options, compile_c=True)
     start = time.perf_counter()
-    solve_pronto(problem, initial, options=compiled)  # includes the one-off C compilation
+    solve_pronto(problem, initial, options=compiled, cache=cache)  # + the one-off C compilation
     pronto_c_cold_time = time.perf_counter() - start
     start = time.perf_counter()
-    pronto_c = solve_pronto(problem, initial, options=compiled)
+    pronto_c = solve_pronto(problem, initial, options=compiled, cache=cache)
     pronto_c_time = time.perf_counter() - start
     ipopt = solve_ipopt(problem, initial)
     ipopt_mx = solve_ipopt(problem, initial, expand=False)
@@ -365,16 +371,20 @@ class ToyProblems:
         }[name]
         self.problem, self.options = builder()
         self.guess = _zero_guess(self.problem)
-        solve_pronto(self.problem, self.guess, options=self.options)
+        self.cache = ModelCache()
+        self._solve()
+
+    def _solve(self) -> ProntoResult:
+        return solve_pronto(self.problem, self.guess, options=self.options, cache=self.cache)
 
     def time_pronto(self, name: str) -> None:  # noqa: ARG002
-        solve_pronto(self.problem, self.guess, options=self.options)
+        self._solve()
 
     def track_pronto_iterations(self, name: str) -> int:  # noqa: ARG002
-        return len(solve_pronto(self.problem, self.guess, options=self.options).history)
+        return len(self._solve().history)
 
     def track_pronto_cost(self, name: str) -> float:  # noqa: ARG002
-        return solve_pronto(self.problem, self.guess, options=self.options).cost
+        return self._solve().cost
 
 
 class MedusaCrossing:
@@ -384,24 +394,113 @@ class MedusaCrossing:
 
     def setup(self) -> None:
         self.problem, self.options, guess = medusa_crossing()
-        self.guess, _ = project_guess(build_model(self.problem), guess, self.options)
-        solve_pronto(self.problem, self.guess, options=self.options)
+        self.cache = ModelCache()
+        self.guess, _ = project_guess(self.cache.get(self.problem), guess, self.options)
+        self._solve()
+
+    def _solve(self) -> ProntoResult:
+        return solve_pronto(self.problem, self.guess, options=self.options, cache=self.cache)
 
     def time_pronto(self) -> None:
-        solve_pronto(self.problem, self.guess, options=self.options)
+        self._solve()
 
     def track_pronto_iterations(self) -> int:
-        return len(solve_pronto(self.problem, self.guess, options=self.options).history)
+        return len(self._solve().history)
 
     def time_ipopt(self) -> None:
         solve_ipopt(self.problem, self.guess)
 
 
+SUBSTEPS = (1, 2, 4, 8)
+
+
+def _stage_points(
+    problem: TrajectoryProblem, guess: Trajectory
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Stage points near the guess (seeded), and costates, for timing the stage functions."""
+    rng = np.random.default_rng(0)
+    shape = (problem.n_steps, problem.n_states)
+    states = guess.states[:-1] + 0.01 * rng.standard_normal(shape)
+    inputs = 0.1 * rng.standard_normal((problem.n_steps, problem.n_inputs))
+    return states, inputs, problem.parameters, rng.standard_normal(shape)
+
+
+def _cpu_time(evaluate: Callable[[], object], repeats: int) -> float:
+    """Smallest CPU time of ``repeats`` calls (after one warm-up call) [s]."""
+    evaluate()
+    times = []
+    for _ in range(repeats):
+        start = time.process_time()
+        evaluate()
+        times.append(time.process_time() - start)
+    return min(times)
+
+
+def substep_timings(substeps: tuple[int, ...] = SUBSTEPS, repeats: int = 5) -> str:
+    """Cost of the stage functions of the MEDUSA crossing per number of RK4 substeps ``m``.
+
+    Build: ``discretize_rk4`` and the Functions a solve uses (CasADi graph, derivatives,
+    common-subexpression elimination; wall time).
+    Evaluation: CPU time of one batched call over all ``N`` stages (``process_time``, smallest
+    of ``repeats``), for the λ-weighted Lagrangian Hessians (``Q, S, R``), the first-order data
+    and the step.
+    """
+    problem, _, guess = medusa_crossing(propeller_order=3)
+    states, inputs, params, costates = _stage_points(problem, guess)
+    lines = [
+        (
+            f"MEDUSA crossing, 2 vehicles (n_x = {problem.n_states}, n_u = {problem.n_inputs}), "
+            f"N = {problem.n_steps}, dt = {problem.dt} s"
+        ),
+        "",
+        "| m | build s | Hessians s (µs/stage) | first order s | step s |",
+        "|---|---|---|---|---|",
+    ]
+    for m in substeps:
+        start = time.perf_counter()
+        model: DiscreteModel = discretize_rk4(
+            problem.dynamics, problem.running_cost, problem.dt, n_substeps=m
+        )
+        for name in SOLVER_FUNCTIONS:  # built on first use: build them here
+            getattr(model.functions, name)
+        build = time.perf_counter() - start
+        hessians = _cpu_time(
+            lambda model=model: model.lagrangian_hessians(states, inputs, params, costates),
+            repeats,
+        )
+        first = _cpu_time(lambda model=model: model.first_order(states, inputs, params), repeats)
+        step = _cpu_time(lambda model=model: model.step(states, inputs, params), repeats)
+        lines.append(
+            f"| {m} | {build:.2f} | {hessians:.3f} ({1e6 * hessians / problem.n_steps:.0f}) | "
+            f"{first:.3f} | {step:.4f} |"
+        )
+    return "\n".join(lines)
+
+
+class SubstepHessians:
+    """asv: the MEDUSA crossing's λ-weighted Hessians per number of RK4 substeps."""
+
+    params = SUBSTEPS
+    param_names = ("n_substeps",)
+    timeout = 600.0
+
+    def setup(self, n_substeps: int) -> None:
+        problem, _, guess = medusa_crossing(propeller_order=3)
+        self.points = _stage_points(problem, guess)
+        self.model = discretize_rk4(
+            problem.dynamics, problem.running_cost, problem.dt, n_substeps=n_substeps
+        )
+
+    def time_lagrangian_hessians(self, n_substeps: int) -> None:  # noqa: ARG002
+        self.model.lagrangian_hessians(*self.points)
+
+
 def _profile(problem: TrajectoryProblem, guess: Trajectory, options: ProntoOptions) -> str:
-    solve_pronto(problem, guess, options=options)  # warm
+    cache = ModelCache()
+    solve_pronto(problem, guess, options=options, cache=cache)  # warm
     profiler = cProfile.Profile()
     profiler.enable()
-    solve_pronto(problem, guess, options=options)
+    solve_pronto(problem, guess, options=options, cache=cache)
     profiler.disable()
     stream = io.StringIO()
     pstats.Stats(profiler, stream=stream).sort_stats("tottime").print_stats(12)
@@ -414,7 +513,13 @@ def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="toy problems only")
     parser.add_argument("--profile", action="store_true", help="profile the MEDUSA solve")
+    parser.add_argument(
+        "--substeps", action="store_true", help="only the stage-function cost per RK4 substeps"
+    )
     args = parser.parse_args(argv)
+    if args.substeps:
+        print(substep_timings())
+        return 0
     rows = []
     for name, builder in (
         ("pendulum swing-up", pendulum_swing_up),
@@ -428,7 +533,7 @@ def main(argv: list[str]) -> int:
         problem, options, guess = medusa_crossing()
         rows.append(compare("MEDUSA 2-vehicle crossing", problem, options, guess))
         if args.profile:
-            initial, _ = project_guess(build_model(problem), guess, options)
+            initial, _ = project_guess(ModelCache().get(problem), guess, options)
             print("profile, CasADi virtual machine:")
             print(_profile(problem, initial, options))
             print("profile, compiled stage functions:")

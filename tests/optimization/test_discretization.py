@@ -55,31 +55,39 @@ def _fd_columns(fun, base: np.ndarray, size: int) -> list[np.ndarray]:
     return out
 
 
-def test_step_matches_per_stage_loop_and_rk4_formula(points: tuple[np.ndarray, ...]) -> None:
+@pytest.fixture(params=[1, 3], ids=["1 substep", "3 substeps"])
+def n_substeps(request: pytest.FixtureRequest) -> int:
+    return int(request.param)
+
+
+def test_step_matches_per_stage_loop_and_rk4_formula(
+    points: tuple[np.ndarray, ...], n_substeps: int
+) -> None:
     f, cost, _ = _model_functions()
     dt = 0.2
-    model = discretize_rk4(f, cost, dt)
+    model = discretize_rk4(f, cost, dt, n_substeps=n_substeps)
+    assert model.n_substeps == n_substeps
     X, U, P, _ = points
     batched = model.step(X, U, P)
-    for k in range(N_STAGES):  # loop oracle: hand-written RK4 with the continuous f
+    h = dt / n_substeps
+    for k in range(N_STAGES):  # loop oracle: hand-written RK4 substeps with the continuous f
 
         def rate(state: np.ndarray, k: int = k) -> np.ndarray:
             return np.asarray(f(state, U[k], P[k])).ravel()
 
-        k1 = rate(X[k])
-        k2 = rate(X[k] + dt / 2 * k1)
-        k3 = rate(X[k] + dt / 2 * k2)
-        k4 = rate(X[k] + dt * k3)
-        np.testing.assert_allclose(
-            batched[k], X[k] + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4), rtol=1e-13
-        )
-        q = [
-            float(cost(s, U[k], P[k]))
-            for s in (X[k], X[k] + dt / 2 * k1, X[k] + dt / 2 * k2, X[k] + dt * k3)
-        ]
-        assert model.cost(X, U, P)[k] == pytest.approx(
-            dt / 6 * (q[0] + 2 * q[1] + 2 * q[2] + q[3]), rel=1e-13
-        )
+        x, stage_cost = X[k], 0.0
+        for _ in range(n_substeps):
+            k1 = rate(x)
+            k2 = rate(x + h / 2 * k1)
+            k3 = rate(x + h / 2 * k2)
+            k4 = rate(x + h * k3)
+            q = [
+                float(cost(s, U[k], P[k])) for s in (x, x + h / 2 * k1, x + h / 2 * k2, x + h * k3)
+            ]
+            stage_cost += h / 6 * (q[0] + 2 * q[1] + 2 * q[2] + q[3])
+            x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        np.testing.assert_allclose(batched[k], x, rtol=1e-13)
+        assert model.cost(X, U, P)[k] == pytest.approx(stage_cost, rel=1e-13)
 
 
 def test_linear_system_step_is_fourth_order_taylor() -> None:
@@ -98,10 +106,10 @@ def test_linear_system_step_is_fourth_order_taylor() -> None:
 
 
 def test_jacobians_and_weighted_hessians_vs_central_differences(
-    points: tuple[np.ndarray, ...],
+    points: tuple[np.ndarray, ...], n_substeps: int
 ) -> None:
     f, cost, _ = _model_functions()
-    model = discretize_rk4(f, cost, 0.3)
+    model = discretize_rk4(f, cost, 0.3, n_substeps=n_substeps)
     X, U, P, lam = points
     f_x, f_u = model.jacobians(X, U, P)
     fd_x = _fd_columns(lambda Z: model.step(Z, U, P), X, 3)
@@ -127,9 +135,11 @@ def test_jacobians_and_weighted_hessians_vs_central_differences(
     )
 
 
-def test_cost_derivatives_vs_central_differences(points: tuple[np.ndarray, ...]) -> None:
+def test_cost_derivatives_vs_central_differences(
+    points: tuple[np.ndarray, ...], n_substeps: int
+) -> None:
     f, cost, _ = _model_functions()
-    model = discretize_rk4(f, cost, 0.3)
+    model = discretize_rk4(f, cost, 0.3, n_substeps=n_substeps)
     X, U, P, lam = points
     l_x, l_u = model.cost_gradients(X, U, P)
     np.testing.assert_allclose(
@@ -205,10 +215,10 @@ def test_constraint_and_terminal_derivatives(points: tuple[np.ndarray, ...]) -> 
 
 
 def test_rollout_is_closed_loop_simulation(
-    points: tuple[np.ndarray, ...], rng: np.random.Generator
+    points: tuple[np.ndarray, ...], rng: np.random.Generator, n_substeps: int
 ) -> None:
     f, cost, _ = _model_functions()
-    model = discretize_rk4(f, cost, 0.1)
+    model = discretize_rk4(f, cost, 0.1, n_substeps=n_substeps)
     X, U, P, _ = points
     gains = 0.2 * rng.normal(size=(N_STAGES, 2, 3))
     states, inputs = model.rollout(X[0], X, U, gains, P)
@@ -220,7 +230,7 @@ def test_rollout_is_closed_loop_simulation(
         np.testing.assert_allclose(states[k + 1], x, rtol=1e-12)
 
 
-def test_mx_models_fall_back_and_agree(points: tuple[np.ndarray, ...]) -> None:
+def test_mx_models_fall_back_and_agree(points: tuple[np.ndarray, ...], n_substeps: int) -> None:
     """An MX model that cannot be expanded to SX (uses a lookup table) still works."""
     table = ca.interpolant(
         "table", "linear", [np.linspace(-10, 10, 5)], np.linspace(-10, 10, 5) ** 1
@@ -228,7 +238,7 @@ def test_mx_models_fall_back_and_agree(points: tuple[np.ndarray, ...]) -> None:
     x, u, p = ca.MX.sym("x", 3), ca.MX.sym("u", 2), ca.MX.sym("p", 2)
     f = ca.Function("f", [x, u, p], [ca.vertcat(table(x[0]) * 0 + u[0], x[2], u[1] + p[0])])
     cost = ca.Function("l", [x, u, p], [ca.sumsqr(u)])
-    model = discretize_rk4(f, cost, 0.1)
+    model = discretize_rk4(f, cost, 0.1, n_substeps=n_substeps)
     X, U, P, _ = points
     expected = X + 0.1 * np.stack(
         [U[:, 0], X[:, 2] + 0.05 * (U[:, 1] + P[:, 0]), U[:, 1] + P[:, 0]], 1
@@ -243,17 +253,22 @@ def test_rejects_bad_inputs() -> None:
     x = ca.SX.sym("x", 3)
     with pytest.raises(InputError, match="inputs"):
         discretize_rk4(ca.Function("g", [x], [x]), cost, 0.1)
+    with pytest.raises(InputError, match="n_substeps"):
+        discretize_rk4(f, cost, 0.1, n_substeps=0)
     model = discretize_rk4(f, cost, 0.1)
     with pytest.raises(InputError, match="U"):
         model.step(np.zeros((3, 3)), np.zeros((2, 2)), np.zeros((3, 2)))
 
 
+@pytest.mark.parametrize("n_substeps", [1, 2])
 def test_compiled_functions_match_the_virtual_machine(
-    points: tuple[np.ndarray, ...], tmp_path, rng: np.random.Generator
+    points: tuple[np.ndarray, ...], tmp_path, rng: np.random.Generator, n_substeps: int
 ) -> None:
     f, cost, _ = _model_functions()
-    vm = discretize_rk4(f, cost, 0.2)
-    compiled = discretize_rk4(f, cost, 0.2, compile_c=True, cache_dir=tmp_path)
+    vm = discretize_rk4(f, cost, 0.2, n_substeps=n_substeps)
+    compiled = discretize_rk4(
+        f, cost, 0.2, n_substeps=n_substeps, compile_c=True, cache_dir=tmp_path
+    )
     libraries = sorted(tmp_path.glob("*.so"))
     if not libraries:
         pytest.skip("no working C compiler")
@@ -276,6 +291,6 @@ def test_compiled_functions_match_the_virtual_machine(
     ):
         np.testing.assert_allclose(got, expected, rtol=1e-12)
     # a second model with the same expressions reuses the cached library
-    again = discretize_rk4(f, cost, 0.2, compile_c=True, cache_dir=tmp_path)
+    again = discretize_rk4(f, cost, 0.2, n_substeps=n_substeps, compile_c=True, cache_dir=tmp_path)
     assert sorted(tmp_path.glob("*.so")) == libraries
     np.testing.assert_allclose(again.step(X, U, P), vm.step(X, U, P), rtol=1e-13)

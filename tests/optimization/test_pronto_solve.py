@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -51,9 +53,10 @@ def _constraint_slacks(
     return model.constraints.values(states[:-1], inputs, problem.parameters) / model.slack_scales
 
 
+@pytest.mark.parametrize("n_substeps", [1, 2])
 @pytest.mark.parametrize("make_problem", [unicycle_problem, pendulum_problem])
-def test_unconstrained_cost_equals_ipopt(make_problem) -> None:
-    problem = make_problem()
+def test_unconstrained_cost_equals_ipopt(make_problem, n_substeps: int) -> None:
+    problem = dataclasses.replace(make_problem(), n_substeps=n_substeps)
     guess = zero_guess(problem)
     result = solve_pronto(problem, guess, options=ProntoOptions(tol=1e-10))
     assert result.status is ProntoStatus.CONVERGED, result.message

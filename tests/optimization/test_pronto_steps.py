@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 
 import casadi as ca
@@ -122,8 +123,23 @@ def test_projection_is_idempotent(make_problem, rng: np.random.Generator) -> Non
     np.testing.assert_array_equal(projected.states[0], problem.initial_state)
 
 
+def _three_substeps(make_problem):
+    def make() -> TrajectoryProblem:
+        return dataclasses.replace(make_problem(), n_substeps=3)
+
+    return make
+
+
 @pytest.mark.parametrize(
-    "make_problem", [unicycle_problem, pendulum_problem, obstacle_problem, crossing_problem]
+    "make_problem",
+    [
+        unicycle_problem,
+        pendulum_problem,
+        obstacle_problem,
+        crossing_problem,
+        _three_substeps(pendulum_problem),
+        _three_substeps(obstacle_problem),
+    ],
 )
 @pytest.mark.parametrize("use_search_direction", [True, False])
 def test_derivative_check_passes_at_random_trajectories(

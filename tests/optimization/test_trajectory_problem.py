@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import casadi as ca
 import numpy as np
 import pytest
@@ -35,6 +37,8 @@ def test_problem_defaults_and_validation() -> None:
         TrajectoryProblem(
             problem.dynamics, problem.running_cost, problem.terminal_cost, np.zeros(4), 0.0, 5
         )
+    with pytest.raises(InputError, match="n_substeps"):
+        dataclasses.replace(problem, n_substeps=0)
     with pytest.raises(InputError, match="stage_parameters"):
         TrajectoryProblem(
             problem.dynamics,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,7 +21,7 @@ from auvplan.mission.preplan import PreplanStage
 from auvplan.mission.timing import DeconflictStage
 from auvplan.optimization import PathConstraint, Trajectory, TrajectoryProblem
 from auvplan.planning import CircleObstacle
-from auvplan.vehicle import headings, reference_states
+from auvplan.vehicle import headings, reference_states, regulator_floor, stable_rk4_step
 
 
 @dataclass(frozen=True)
@@ -30,6 +31,17 @@ class AssembledProblem:
     functions: FleetProblemFunctions
     problem: TrajectoryProblem
     guess: Trajectory
+
+
+def integration_substeps(layout: FleetLayout, dt: float) -> int:
+    """RK4 substeps per control interval: each substep within every vehicle's stable step.
+
+    ``dt`` is the control and output interval; the integrator step ``dt / m`` is derived from
+    the vehicles' fastest modes (:func:`auvplan.vehicle.stable_rk4_step`), so the discrete
+    model damps what the vehicle damps, whatever ``dt`` the user chose.
+    """
+    stable = min(stable_rk4_step(model) for model in layout.models)
+    return max(1, math.ceil(dt / stable - 1e-9))
 
 
 def start_states(layout: FleetLayout, preplan: PreplanStage) -> FloatArray:
@@ -123,6 +135,13 @@ def assemble_problem(
         ),
         regulator_Q=np.diag(layout.state_weights(REGULATOR_WEIGHTS, 1.0)),
         regulator_R=np.eye(layout.n_u),
+        n_substeps=integration_substeps(layout, deconfliction.dt),
+        regulator_floor=np.concatenate(
+            [
+                [regulator_floor(model).get(name, 0.0) for name in model.state_names]
+                for model in layout.models
+            ]
+        ),
     )
     guess = Trajectory(
         states=stacked_desired, inputs=np.zeros((deconfliction.time.size - 1, layout.n_u))

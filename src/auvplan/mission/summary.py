@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from auvplan import __version__
+from auvplan.mission.assembly import integration_substeps
 from auvplan.mission.evaluation import OptimizedPlan
 from auvplan.mission.pipeline import MissionResult
 from auvplan.planning import path_length
@@ -104,6 +105,10 @@ def mission_summary(result: MissionResult) -> dict[str, Any]:
         coordination = stage2.coordination
         summary["deconfliction"] = {
             "horizon_s": stage2.horizon,
+            "integration": {
+                "n_substeps": integration_substeps(stage2.layout, stage2.dt),
+                "substep_s": stage2.dt / integration_substeps(stage2.layout, stage2.dt),
+            },
             "status": coordination.status.name,
             "message": coordination.message,
             "objective": coordination.objective,

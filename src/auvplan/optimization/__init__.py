@@ -4,63 +4,76 @@ Build a :class:`TrajectoryProblem` from CasADi Functions (continuous dynamics, r
 rate, terminal cost, path constraints ``c >= 0``) and call :func:`solve_pronto`;
 :func:`solve_ipopt` solves the identical discretised problem with CasADi + IPOPT.
 The algorithm is documented in ``reference/pronto.md`` (§6, §7, §11).
+
+Modules, in the order of the data flow:
+
+- ``problem``: the problem and trajectory types; ``options``: solver options;
+- ``integration``, ``discretization``, ``constraints``, ``terminal``: batched CasADi evaluators
+  of the discrete map, the stage cost, the path constraints and the terminal cost;
+- ``model``: :func:`build_model` and the explicit :class:`ModelCache`;
+- ``stages``: cost, linearisation, costate and Newton weights along a trajectory;
+- ``projection``: regulator design and the projection operator;
+- ``lq``: the LQ direction and its fallback ladder; ``steps``: :func:`compute_direction`;
+- ``linesearch``: :func:`try_step`, :func:`armijo_step`, :func:`converged`;
+- ``pronto``: :func:`solve_pronto`; ``result``: its records; ``numdiff``: derivative check;
+- ``ipopt``: the CasADi + IPOPT reference.
 """
 
 from __future__ import annotations
 
 from auvplan.optimization.barrier import (
+    BarrierKind,
     barrier_expression,
     composed_barrier,
     hockey_stick,
     log_barrier,
 )
-from auvplan.optimization.discretization import (
-    ConstraintModel,
-    DiscreteModel,
-    TerminalCost,
-    discretize_constraints,
-    discretize_rk4,
-    make_terminal_cost,
-)
+from auvplan.optimization.constraints import ConstraintModel, discretize_constraints
+from auvplan.optimization.discretization import DiscreteModel, discretize_rk4
+from auvplan.optimization.integration import choose_substeps
 from auvplan.optimization.ipopt import IpoptResult, IpoptStatus, solve_ipopt
-from auvplan.optimization.linesearch import ArmijoResult, armijo_step, converged
-from auvplan.optimization.lq import DirectionType, LqDirection, convexify, solve_lq_direction
-from auvplan.optimization.problem import PathConstraint, Trajectory, TrajectoryProblem
-from auvplan.optimization.pronto import (
-    DerivativeCheck,
-    ProntoIteration,
-    ProntoOptions,
-    ProntoResult,
-    ProntoStatus,
-    derivative_check,
-    project_guess,
-    solve_pronto,
+from auvplan.optimization.linesearch import (
+    ArmijoResult,
+    StepTrial,
+    armijo_step,
+    converged,
+    try_step,
 )
+from auvplan.optimization.lq import DirectionType, LqDirection, convexify, solve_lq_direction
+from auvplan.optimization.model import ModelCache, ProntoModel, build_model
+from auvplan.optimization.numdiff import DerivativeCheck, derivative_check
+from auvplan.optimization.options import FallbackModel, ProntoOptions, TerminalRegulator
+from auvplan.optimization.problem import PathConstraint, Trajectory, TrajectoryProblem
+from auvplan.optimization.projection import design_regulator, project, project_guess
+from auvplan.optimization.pronto import solve_pronto
+from auvplan.optimization.result import ProntoIteration, ProntoResult, ProntoStatus
 from auvplan.optimization.stages import (
     CostParts,
     Linearization,
-    ProntoModel,
     StageWeights,
-    build_model,
     compute_costate,
-    design_regulator,
     evaluate_cost,
     linearize,
-    project,
     second_order_weights,
 )
+from auvplan.optimization.steps import LocalModel, compute_direction
+from auvplan.optimization.terminal import TerminalCost, make_terminal_cost
 
 __all__ = [
     "ArmijoResult",
+    "BarrierKind",
     "ConstraintModel",
     "CostParts",
     "DerivativeCheck",
     "DirectionType",
     "DiscreteModel",
+    "FallbackModel",
     "IpoptResult",
     "IpoptStatus",
     "Linearization",
+    "LocalModel",
     "LqDirection",
+    "ModelCache",
     "PathConstraint",
     "ProntoIteration",
     "ProntoModel",
@@ -68,14 +81,18 @@ __all__ = [
     "ProntoResult",
     "ProntoStatus",
     "StageWeights",
+    "StepTrial",
     "TerminalCost",
+    "TerminalRegulator",
     "Trajectory",
     "TrajectoryProblem",
     "armijo_step",
     "barrier_expression",
     "build_model",
+    "choose_substeps",
     "composed_barrier",
     "compute_costate",
+    "compute_direction",
     "converged",
     "convexify",
     "derivative_check",
@@ -93,4 +110,5 @@ __all__ = [
     "solve_ipopt",
     "solve_lq_direction",
     "solve_pronto",
+    "try_step",
 ]

@@ -25,6 +25,7 @@ functionals with constraints", IEEE CDC 2006. See also ``reference/pronto.md`` �
 
 from __future__ import annotations
 
+import enum
 from typing import Any
 
 import casadi as ca
@@ -34,11 +35,21 @@ from auvplan._typing import FloatArray
 from auvplan.errors import InputError
 
 __all__ = [
+    "BarrierKind",
     "barrier_expression",
     "composed_barrier",
     "hockey_stick",
     "log_barrier",
 ]
+
+
+class BarrierKind(enum.StrEnum):
+    """How a path constraint's scaled slack ``s`` enters the barrier."""
+
+    PLAIN = "plain"
+    """``β_δ(s)``: convex constraints such as input bounds."""
+    HOCKEY = "hockey"
+    """``β_δ(σ(s))``: non-convex constraints (separations); vanishes far from the boundary."""
 
 
 def _check_delta(delta: float) -> None:

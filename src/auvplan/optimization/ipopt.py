@@ -1,8 +1,8 @@
 """CasADi + IPOPT bridge: the identical discretised problem by direct multiple shooting.
 
-The decision variables are all states ``x_0..x_N`` and inputs ``u_0..u_{N-1}`` on the same RK4
-grid; the defects ``F(x_k, u_k, p_k) − x_{k+1} = 0`` use the very same RK4 step Function as
-PRONTO, the objective the same stage cost ``Σ L_k + m(x_N)`` (see
+The decision variables are all states ``x_0..x_N`` and inputs ``u_0..u_{N-1}`` on the same
+grid; the defects ``F(x_k, u_k, p_k) − x_{k+1} = 0`` use the very same (substepped) RK4 step
+Function as PRONTO, the objective the same stage cost ``Σ L_k + m(x_N)`` (see
 :mod:`auvplan.optimization.problem`). Path constraints are hard inequalities
 ``c(x_k, u_k, p_k) / scale ≥ 0``; with ``barrier=(ε, δ)`` the objective also carries the
 identical approximate-barrier term ``ε dt Σ b(c / scale)`` so that costs are comparable with
@@ -21,7 +21,7 @@ import casadi as ca
 import numpy as np
 
 from auvplan.errors import InputError
-from auvplan.optimization.barrier import barrier_expression
+from auvplan.optimization.barrier import BarrierKind, barrier_expression
 from auvplan.optimization.discretization import discretize_rk4
 from auvplan.optimization.problem import Trajectory, TrajectoryProblem
 
@@ -128,7 +128,9 @@ def solve_ipopt(
         )
     if barrier is not None and not (barrier[0] > 0 and barrier[1] > 0):
         raise InputError(f"barrier must be (epsilon > 0, delta > 0), got {barrier!r}")
-    model = discretize_rk4(problem.dynamics, problem.running_cost, problem.dt)
+    model = discretize_rk4(
+        problem.dynamics, problem.running_cost, problem.dt, n_substeps=problem.n_substeps
+    )
     params = problem.parameters.T
     states = ca.MX.sym("X", n_x, n_steps + 1)
     inputs = ca.MX.sym("U", n_u, n_steps)
@@ -144,7 +146,8 @@ def solve_ipopt(
             inequalities.append(ca.vec(slack))
         if barrier is not None:
             epsilon, delta = barrier
-            values = barrier_expression(slack, delta, is_hockey=constraint.kind == "hockey")
+            is_hockey = constraint.kind is BarrierKind.HOCKEY
+            values = barrier_expression(slack, delta, is_hockey=is_hockey)
             barrier_term = barrier_term + epsilon * problem.dt * ca.sum1(ca.sum2(values))
     variables = ca.vertcat(ca.vec(states), ca.vec(inputs))
     n_ineq = sum(int(g.numel()) for g in inequalities)

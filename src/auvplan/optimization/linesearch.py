@@ -1,4 +1,4 @@
-"""Armijo backtracking on ``h(P(ξ + γζ))`` and the stopping test (``reference/pronto.md`` §5)."""
+"""Trying a step, Armijo backtracking on ``h(P(ξ + γζ))`` and the stopping test (§5)."""
 
 from __future__ import annotations
 
@@ -8,10 +8,70 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.optimization.lq import LqDirection
+from auvplan.optimization.model import ProntoModel
 from auvplan.optimization.problem import Trajectory
-from auvplan.optimization.stages import CostParts, ProntoModel, evaluate_cost, project
+from auvplan.optimization.projection import project
+from auvplan.optimization.stages import CostParts, evaluate_cost
 
-__all__ = ["ArmijoResult", "armijo_step", "converged"]
+__all__ = ["ArmijoResult", "StepTrial", "armijo_step", "converged", "try_step"]
+
+
+@dataclass(frozen=True)
+class StepTrial:
+    """One trial point ``P(ξ + γζ)`` of the line search (Crocoddyl's ``tryStep``).
+
+    Attributes
+    ----------
+    trajectory : Trajectory
+        The projected candidate (non-finite if the closed loop diverged).
+    cost : CostParts
+        Its objective parts (``inf`` when non-finite).
+    min_slack : float
+        Its smallest scaled constraint slack.
+    """
+
+    trajectory: Trajectory
+    cost: CostParts
+    min_slack: float
+
+
+def try_step(
+    model: ProntoModel,
+    trajectory: Trajectory,
+    direction: tuple[FloatArray, FloatArray],
+    gains: FloatArray,
+    step: float,
+    *,
+    epsilon: float,
+    delta: float,
+) -> StepTrial:
+    """Project ``ξ + γζ`` with the fixed regulator and evaluate the objective there.
+
+    Parameters
+    ----------
+    model : ProntoModel
+        Evaluators.
+    trajectory : Trajectory
+        ``ξ``.
+    direction : tuple of ndarray
+        ``(z (N + 1, n_x), v (N, n_u))``.
+    gains : ndarray of shape (N, n_u, n_x)
+        The regulator of the iteration.
+    step : float
+        ``γ``.
+    epsilon, delta : float
+        Barrier weight and switching point.
+
+    Returns
+    -------
+    StepTrial
+        ``P(ξ + γζ)``, ``h`` there and its smallest slack.
+    """
+    z, v = direction
+    reference = Trajectory(trajectory.states + step * z, trajectory.inputs + step * v)
+    candidate = project(model, reference, gains)
+    cost, min_slack = evaluate_cost(model, candidate, epsilon, delta)
+    return StepTrial(candidate, cost, min_slack)
 
 
 @dataclass(frozen=True)
@@ -66,23 +126,22 @@ def armijo_step(
     """
     step = 1.0
     for n_backtracks in range(max_backtracks + 1):
-        reference = Trajectory(
-            trajectory.states + step * direction.z, trajectory.inputs + step * direction.v
+        trial = try_step(
+            model, trajectory, (direction.z, direction.v), gains, step, epsilon=epsilon, delta=delta
         )
-        candidate = project(model, reference, gains)
-        cost, min_slack = evaluate_cost(model, candidate, epsilon, delta)
-        feasible_ok = not require_feasible or min_slack > 0.0
+        total = trial.cost.total
+        feasible_ok = not require_feasible or trial.min_slack > 0.0
         if (
-            np.isfinite(cost.total)
+            np.isfinite(total)
             and feasible_ok
-            and cost.total <= current_cost + alpha * step * direction.slope
+            and total <= current_cost + alpha * step * direction.slope
         ):
             return ArmijoResult(
                 True,
-                candidate,
-                cost,
-                min_slack,
-                _min_argument(model, min_slack),
+                trial.trajectory,
+                trial.cost,
+                trial.min_slack,
+                _min_argument(model, trial.min_slack),
                 step,
                 n_backtracks,
             )

@@ -18,7 +18,14 @@ from auvplan.errors import SolverError
 from auvplan.optimization import _kernels
 from auvplan.optimization.stages import Linearization, StageWeights
 
-__all__ = ["DirectionType", "LqDirection", "convexify", "solve_lq_direction"]
+__all__ = [
+    "DirectionType",
+    "LqDirection",
+    "convexify",
+    "directional_derivative",
+    "quadratic_form",
+    "solve_lq_direction",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -81,7 +88,8 @@ class LqDirection:
     direction: DirectionType
 
 
-def _quadratic_form(weights: StageWeights, z: FloatArray, v: FloatArray) -> float:
+def quadratic_form(weights: StageWeights, z: FloatArray, v: FloatArray) -> float:
+    """``Σ_k (z_kᵀ Q_k z_k + 2 z_kᵀ S_k v_k + v_kᵀ R_k v_k) + z_Nᵀ P_N z_N`` (``D²`` of a model)."""
     zs, zn = z[:-1], z[-1]
     return float(
         np.einsum("ki,kij,kj->", zs, weights.Q, zs)
@@ -91,7 +99,8 @@ def _quadratic_form(weights: StageWeights, z: FloatArray, v: FloatArray) -> floa
     )
 
 
-def _slope(linearization: Linearization, z: FloatArray, v: FloatArray) -> float:
+def directional_derivative(linearization: Linearization, z: FloatArray, v: FloatArray) -> float:
+    """``Dh·ζ = Σ_k (a_kᵀ z_k + b_kᵀ v_k) + m_xᵀ z_N`` for ``ζ = (z, v)`` (§3.1)."""
     lin = linearization
     return float(np.sum(lin.a * z[:-1]) + np.sum(lin.b * v) + lin.m_x @ z[-1])
 
@@ -115,10 +124,10 @@ def _try_direction(
         logger.debug("%s LQ model not positive definite at stage %d", direction.value, failed)
         return None
     z, v = _kernels.lq_forward(lin.A, lin.B, feedback, feedforward)
-    slope = _slope(lin, z, v)
+    slope = directional_derivative(lin, z, v)
     if not (np.isfinite(slope) and np.all(np.isfinite(z))):
         return None
-    curvature = _quadratic_form(weights, z, v)
+    curvature = quadratic_form(weights, z, v)
     if slope > 0.0:
         logger.debug("%s direction is not a descent direction (Dh·ζ = %g)", direction.value, slope)
         return None

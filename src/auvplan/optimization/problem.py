@@ -9,11 +9,12 @@ IPOPT bridge is
         + ε\, dt \sum_j b_j\big(c_j(x_k, u_k, p_k) / \text{scale}_j\big) \Big] + m(x_N)
     \quad \text{s.t.}\quad x_{k+1} = F(x_k, u_k, p_k),\; x_0 = x0,
 
-with ``F`` one RK4 step and ``L`` the RK4 quadrature of the running-cost rate (see
-:mod:`auvplan.optimization.discretization`), ``b_j`` the approximate log barrier composed with
-the hockey stick (``kind="hockey"``) or not (``kind="plain"``), see
-:mod:`auvplan.optimization.barrier`. Path constraints are imposed at the nodes
-``k = 0..N-1`` (where an input exists); ``x_N`` is steered by the terminal cost.
+with ``F`` the flow of the dynamics over the control interval ``dt``, approximated by
+``n_substeps`` RK4 substeps (``u_k``, ``p_k`` held), and ``L`` the RK4 quadrature of the
+running-cost rate along the same substeps (see :mod:`auvplan.optimization.integration`),
+``b_j`` the approximate log barrier composed with the hockey stick (``kind="hockey"``) or not
+(``kind="plain"``), see :mod:`auvplan.optimization.barrier`. Path constraints are imposed at
+the nodes ``k = 0..N-1`` (where an input exists); ``x_N`` is steered by the terminal cost.
 """
 
 from __future__ import annotations
@@ -26,6 +27,9 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
+from auvplan.optimization.barrier import BarrierKind
+from auvplan.optimization.integration import check_substeps
+from auvplan.optimization.options import named_choice
 
 __all__ = ["PathConstraint", "Trajectory", "TrajectoryProblem"]
 
@@ -38,10 +42,11 @@ class PathConstraint:
     ----------
     function : casadi.Function
         ``c(x[n_x], u[n_u], p[n_p]) -> (n_c,)``; feasible when every component is ``>= 0``.
-    kind : {"plain", "hockey"}
+    kind : BarrierKind or {"plain", "hockey"}
         ``"hockey"`` composes the barrier with the hockey stick ``σ`` so it vanishes far
         from the constraint (use for non-convex constraints such as separations);
         ``"plain"`` uses ``β_δ(s)`` directly (convex constraints such as input bounds).
+        Strings are converted to :class:`BarrierKind`.
     scale : float
         Slack scale: the barrier sees ``s = c / scale``; choose it so that ``s ≈ 1`` is a
         meaningful margin (unit of ``c``).
@@ -50,7 +55,7 @@ class PathConstraint:
     """
 
     function: ca.Function
-    kind: Literal["plain", "hockey"] = "hockey"
+    kind: BarrierKind | Literal["plain", "hockey"] = BarrierKind.HOCKEY
     scale: float = 1.0
     name: str = "constraint"
 
@@ -59,8 +64,9 @@ class PathConstraint:
             raise InputError(
                 f"PathConstraint.function must be a casadi.Function, got {self.function!r}"
             )
-        if self.kind not in ("plain", "hockey"):
-            raise InputError(f"PathConstraint.kind must be 'plain' or 'hockey', got {self.kind!r}")
+        object.__setattr__(
+            self, "kind", named_choice(BarrierKind, self.kind, "PathConstraint.kind")
+        )
         if not (np.isfinite(self.scale) and self.scale > 0.0):
             raise InputError(f"PathConstraint.scale must be positive, got {self.scale!r}")
 
@@ -84,7 +90,7 @@ def _as_matrix(value: FloatArray, size: int, name: str) -> FloatArray:
 
 @dataclass(frozen=True)
 class TrajectoryProblem:
-    """Fixed-horizon optimal-control problem on a uniform RK4 grid.
+    """Fixed-horizon optimal-control problem on a uniform grid of control intervals.
 
     Attributes
     ----------
@@ -97,7 +103,8 @@ class TrajectoryProblem:
     initial_state : ndarray of shape (n_x,)
         ``x0``.
     dt : float
-        Step length [s].
+        Control interval [s]: inputs and stage parameters are held over it, and the states
+        and inputs of a :class:`Trajectory` are sampled at this interval.
     n_steps : int
         Number of stages ``N`` (horizon ``T = N dt``).
     stage_parameters : ndarray of shape (n_steps, n_p)
@@ -108,6 +115,15 @@ class TrajectoryProblem:
         State weight of the projection regulator (diagonal when 1-D); default identity.
     regulator_R : ndarray of shape (n_u, n_u) or (n_u,)
         Input weight of the projection regulator; default identity.
+    n_substeps : int
+        RK4 substeps of length ``dt / n_substeps`` per control interval (default 1); see
+        :func:`~auvplan.optimization.integration.choose_substeps`.
+    regulator_floor : ndarray of shape (n_x,), optional
+        The projection regulator is designed on the linearisation at states whose magnitudes
+        are raised to at least these values, ``x̃_i = sign(x_i) max(|x_i|, floor_i)``
+        (0: unchanged). A model whose input authority vanishes at rest (thrust ∝ n|n| has
+        ``∂T/∂n = 0`` at ``n = 0``) stays controllable in the design; the Newton model keeps the
+        exact linearisation. Default: the exact linearisation.
     """
 
     dynamics: ca.Function
@@ -120,6 +136,8 @@ class TrajectoryProblem:
     constraints: tuple[PathConstraint, ...] = ()
     regulator_Q: FloatArray | None = field(default=None)
     regulator_R: FloatArray | None = field(default=None)
+    n_substeps: int = 1
+    regulator_floor: FloatArray | None = None
 
     def __post_init__(self) -> None:
         for name in ("dynamics", "running_cost", "terminal_cost"):
@@ -134,6 +152,7 @@ class TrajectoryProblem:
             raise InputError(f"n_steps must be a positive integer, got {self.n_steps!r}")
         if not (np.isfinite(self.dt) and self.dt > 0.0):
             raise InputError(f"dt must be a positive number of seconds, got {self.dt!r}")
+        check_substeps(self.n_substeps)
         x0 = np.asarray(self.initial_state, dtype=np.float64).reshape(-1)
         if x0.shape != (n_x,) or not np.all(np.isfinite(x0)):
             raise InputError(f"initial_state must be finite with shape ({n_x},), got {x0.shape}")
@@ -152,6 +171,11 @@ class TrajectoryProblem:
         r_r = np.ones(n_u) if self.regulator_R is None else self.regulator_R
         object.__setattr__(self, "regulator_Q", _as_matrix(q_r, n_x, "regulator_Q"))
         object.__setattr__(self, "regulator_R", _as_matrix(r_r, n_u, "regulator_R"))
+        if self.regulator_floor is not None:
+            floor = np.asarray(self.regulator_floor, dtype=np.float64).reshape(-1)
+            if floor.shape != (n_x,) or not np.all(np.isfinite(floor)) or np.any(floor < 0):
+                raise InputError(f"regulator_floor must be finite, >= 0, with shape ({n_x},)")
+            object.__setattr__(self, "regulator_floor", floor)
         object.__setattr__(self, "constraints", tuple(self.constraints))
         for constraint in self.constraints:
             if not isinstance(constraint, PathConstraint):

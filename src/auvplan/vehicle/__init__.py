@@ -31,7 +31,11 @@ from auvplan.vehicle.dynamics import (
     energy,
     vessel_dynamics,
 )
-from auvplan.vehicle.limits import max_surge_acceleration, minimum_useful_speed
+from auvplan.vehicle.limits import (
+    max_surge_acceleration,
+    minimum_useful_speed,
+    regulator_floor,
+)
 from auvplan.vehicle.params import HullParams, MotorParams, PropellerParams, VehicleParams
 from auvplan.vehicle.propulsion import (
     open_water_thrust_torque,
@@ -106,6 +110,7 @@ __all__ = [
     "optimal_cruise_speed",
     "positions",
     "reference_states",
+    "regulator_floor",
     "rk4_simulate",
     "rk4_step_function",
     "simulate_adaptive",

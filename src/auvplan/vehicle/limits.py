@@ -20,7 +20,7 @@ from typing import Final
 from scipy.optimize import brentq
 
 from auvplan.vehicle.dynamics import VehicleModel
-from auvplan.vehicle.trim import bollard, energy_per_metre, optimal_cruise_speed
+from auvplan.vehicle.trim import bollard, energy_per_metre, optimal_cruise_speed, trim_surge
 
 #: Energy per metre, relative to the optimum cruise, still counted as useful motion.
 USEFUL_ENERGY_FACTOR: Final = 2.0
@@ -51,6 +51,24 @@ def minimum_useful_speed(model: VehicleModel) -> float:
     return float(brentq(excess, lowest, cruise.speed, xtol=1e-6))
 
 
+def regulator_floor(model: VehicleModel) -> dict[str, float]:
+    """Smallest state magnitudes the tracking regulator is designed at, by state name.
+
+    The propeller speeds are floored at the steady-surge trim of the minimum useful speed:
+    at rest ``∂T/∂n = 0`` and a regulator designed there would invert a vanishing coupling.
+
+    Examples
+    --------
+    >>> from auvplan.io.vehicles import load_vehicle
+    >>> from auvplan.vehicle.dynamics import build_vehicle_model
+    >>> floor = regulator_floor(build_vehicle_model(load_vehicle("medusa")))
+    >>> sorted(floor), 5.0 < floor["n_ps"] < 20.0
+    (['n_ps', 'n_sb'], True)
+    """
+    propeller = trim_surge(model, minimum_useful_speed(model)).n
+    return {name: propeller for name, _ in model.state_limits}
+
+
 @cache
 def max_surge_acceleration(model: VehicleModel) -> float:
     """``ACCELERATION_SHARE`` × bollard thrust of both propellers / ``(m − X_u̇)`` [m/s²].
@@ -71,4 +89,5 @@ __all__ = [
     "USEFUL_ENERGY_FACTOR",
     "max_surge_acceleration",
     "minimum_useful_speed",
+    "regulator_floor",
 ]

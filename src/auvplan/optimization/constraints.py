@@ -1,0 +1,142 @@
+"""Path constraints ``c(x_k, u_k, p_k) >= 0`` with exact derivatives, batched over stages."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import casadi as ca
+
+from auvplan._typing import FloatArray
+from auvplan.errors import InputError
+from auvplan.optimization._casadi import (
+    StageEvaluator,
+    Symbol,
+    dense_function,
+    hessian_blocks,
+    hessian_shapes,
+    row_major,
+    signature_sizes,
+    symbols,
+    with_symbol_fallback,
+)
+
+__all__ = ["ConstraintModel", "discretize_constraints"]
+
+_ARGS = ["x", "u", "p"]
+
+
+@dataclass(frozen=True, eq=False)
+class ConstraintModel:
+    """Path constraints ``c(x_k, u_k, p_k) >= 0`` evaluated in batch over the stages.
+
+    Build with :func:`discretize_constraints`. ``n_c`` is the total number of constraint
+    components (all constraint functions stacked).
+    """
+
+    n_x: int
+    n_u: int
+    n_p: int
+    n_c: int
+    function: ca.Function
+    _jacobians: ca.Function = field(repr=False)
+    _hessian: ca.Function = field(repr=False)
+    _stages: StageEvaluator = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "_stages", StageEvaluator(self.n_x, self.n_u, self.n_p))
+
+    def values(self, states: FloatArray, inputs: FloatArray, parameters: FloatArray) -> FloatArray:
+        """Constraint values, shape ``(N, n_c)`` (``>= 0`` feasible)."""
+        (out,) = self._stages(self.function, states, inputs, parameters, [(self.n_c,)])
+        return out
+
+    def jacobians(
+        self, states: FloatArray, inputs: FloatArray, parameters: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Values ``(N, n_c)`` and Jacobians ``c_x (N, n_c, n_x)``, ``c_u (N, n_c, n_u)``."""
+        c, c_x, c_u = self._stages(
+            self._jacobians,
+            states,
+            inputs,
+            parameters,
+            [(self.n_c,), (self.n_c, self.n_x), (self.n_c, self.n_u)],
+        )
+        return c, c_x, c_u
+
+    def weighted_hessians(
+        self,
+        states: FloatArray,
+        inputs: FloatArray,
+        parameters: FloatArray,
+        weights: FloatArray,
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Blocks of ``Σ_j w_{k,j} ∇²c_j(x_k, u_k, p_k)``; ``weights`` has shape ``(N, n_c)``."""
+        h_xx, h_xu, h_uu = self._stages(
+            self._hessian,
+            states,
+            inputs,
+            parameters,
+            hessian_shapes(self.n_x, self.n_u),
+            ("weights", weights, self.n_c),
+        )
+        return h_xx, h_xu, h_uu
+
+
+def discretize_constraints(
+    functions: tuple[ca.Function, ...], n_x: int, n_u: int, n_p: int
+) -> ConstraintModel:
+    """Stack path-constraint functions ``c_i(x, u, p) -> (n_ci,)`` into one batched model.
+
+    Parameters
+    ----------
+    functions : tuple of casadi.Function
+        Each ``c(x[n_x], u[n_u], p[n_p]) -> column of n_c values``, feasible when ``>= 0``.
+    n_x, n_u, n_p : int
+        Dimensions the functions must accept.
+
+    Returns
+    -------
+    ConstraintModel
+        Values, exact Jacobians and weighted Hessians, batched over stages.
+
+    Raises
+    ------
+    InputError
+        If a function has the wrong arity or input sizes.
+    """
+    for i, function in enumerate(functions):
+        sizes = signature_sizes(function, f"constraint {i}", 3, 1)
+        if sizes != [n_x, n_u, n_p]:
+            raise InputError(f"constraint {i} input sizes {sizes} differ from {[n_x, n_u, n_p]}")
+
+    def build(use_sx: bool) -> ConstraintModel:
+        x, u, p = symbols([n_x, n_u, n_p], _ARGS, use_sx)
+        kind: Symbol = ca.SX if use_sx else ca.MX
+        parts = [ca.reshape(function(x, u, p), -1, 1) for function in functions]
+        c: Symbol = ca.vertcat(*parts) if parts else kind(0, 1)
+        n_c = int(c.numel())
+        weights = kind.sym("w", n_c)
+        args = [x, u, p]
+        return ConstraintModel(
+            n_x,
+            n_u,
+            n_p,
+            n_c,
+            dense_function("constraints", args, [c], _ARGS, ["c"]),
+            dense_function(
+                "constraint_jac",
+                args,
+                [c, row_major(ca.jacobian(c, x)), row_major(ca.jacobian(c, u))],
+                _ARGS,
+                ["c", "c_x", "c_u"],
+            ),
+            dense_function(
+                "constraint_hess",
+                [*args, weights],
+                hessian_blocks(ca.dot(weights, c), x, u),
+                [*_ARGS, "w"],
+                ["h_xx", "h_xu", "h_uu"],
+            ),
+        )
+
+    return with_symbol_fallback(build)

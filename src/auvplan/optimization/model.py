@@ -1,0 +1,145 @@
+"""Model building: a :class:`TrajectoryProblem` turned into batched evaluators.
+
+:func:`build_model` discretises the problem (RK4 map and stage cost, constraints, terminal
+cost). Building costs CasADi graph construction and common-subexpression elimination (up to
+seconds for vehicle fleets), so a caller that solves the same problem repeatedly keeps the
+models in an explicit :class:`ModelCache` and passes it to the solver.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from auvplan._typing import BoolArray, FloatArray
+from auvplan.optimization.barrier import BarrierKind
+from auvplan.optimization.constraints import ConstraintModel, discretize_constraints
+from auvplan.optimization.discretization import DiscreteModel, discretize_rk4
+from auvplan.optimization.problem import TrajectoryProblem
+from auvplan.optimization.terminal import TerminalCost, make_terminal_cost
+
+__all__ = ["ModelCache", "ProntoModel", "build_model"]
+
+
+@dataclass(frozen=True, eq=False)
+class ProntoModel:
+    """Compiled, batched evaluators of a :class:`TrajectoryProblem` (see :func:`build_model`).
+
+    Attributes
+    ----------
+    problem : TrajectoryProblem
+        The problem.
+    discrete : DiscreteModel
+        Step ``F`` and stage cost ``L`` with their derivatives.
+    terminal : TerminalCost
+        ``m(x_N)`` with its derivatives.
+    constraints : ConstraintModel or None
+        All path constraints stacked (``None`` without constraints).
+    slack_scales : ndarray of shape (n_c,)
+        Scale of every constraint component (the barrier sees ``c / scale``).
+    is_hockey : ndarray of shape (n_c,)
+        Whether each component's barrier is composed with the hockey stick.
+    """
+
+    problem: TrajectoryProblem
+    discrete: DiscreteModel
+    terminal: TerminalCost
+    constraints: ConstraintModel | None
+    slack_scales: FloatArray
+    is_hockey: BoolArray
+
+    @property
+    def has_constraints(self) -> bool:
+        """True when there is at least one constraint component."""
+        return self.constraints is not None and self.constraints.n_c > 0
+
+
+def build_model(
+    problem: TrajectoryProblem, *, n_threads: int = 1, compile_c: bool = False
+) -> ProntoModel:
+    """Discretise a problem (RK4 map, stage cost, constraints, terminal cost).
+
+    Parameters
+    ----------
+    problem : TrajectoryProblem
+        The problem.
+    n_threads : int, optional
+        Threads for the batched stage evaluations (1 = serial).
+    compile_c : bool, optional
+        Compile the stage functions to C (cached on disk; see :func:`discretize_rk4`).
+
+    Returns
+    -------
+    ProntoModel
+        Batched evaluators (built anew; see :class:`ModelCache` to reuse them).
+    """
+    discrete = discretize_rk4(
+        problem.dynamics,
+        problem.running_cost,
+        problem.dt,
+        n_substeps=problem.n_substeps,
+        parallelization="thread" if n_threads > 1 else "serial",
+        n_threads=n_threads,
+        compile_c=compile_c,
+    )
+    terminal = make_terminal_cost(problem.terminal_cost, problem.n_states)
+    constraints = None
+    scales: list[float] = []
+    hockey: list[bool] = []
+    if problem.constraints:
+        constraints = discretize_constraints(
+            tuple(c.function for c in problem.constraints),
+            problem.n_states,
+            problem.n_inputs,
+            problem.n_parameters,
+        )
+        for constraint in problem.constraints:
+            scales += [constraint.scale] * constraint.n_components
+            hockey += [constraint.kind is BarrierKind.HOCKEY] * constraint.n_components
+    return ProntoModel(
+        problem=problem,
+        discrete=discrete,
+        terminal=terminal,
+        constraints=constraints,
+        slack_scales=np.asarray(scales, dtype=np.float64),
+        is_hockey=np.asarray(hockey, dtype=np.bool_),
+    )
+
+
+@dataclass(eq=False)
+class ModelCache:
+    """Models built for given problems, reused while the cache object lives.
+
+    Entries are matched by the identity of the problem object (problems are immutable) and
+    the build options; the cache holds a reference to each problem, so an identity is never
+    reused while its entry exists. At most ``max_entries`` models are kept (oldest evicted).
+
+    Examples
+    --------
+    >>> import casadi as ca, numpy as np
+    >>> x, u, p = ca.SX.sym("x"), ca.SX.sym("u"), ca.SX.sym("p", 0)
+    >>> problem = TrajectoryProblem(
+    ...     ca.Function("f", [x, u, p], [u]), ca.Function("l", [x, u, p], [u**2]),
+    ...     ca.Function("m", [x], [x**2]), np.zeros(1), 0.1, 10)
+    >>> cache = ModelCache()
+    >>> cache.get(problem) is cache.get(problem)
+    True
+    """
+
+    max_entries: int = 16
+    _entries: list[tuple[TrajectoryProblem, int, bool, ProntoModel]] = field(
+        default_factory=list, repr=False
+    )
+
+    def get(
+        self, problem: TrajectoryProblem, *, n_threads: int = 1, compile_c: bool = False
+    ) -> ProntoModel:
+        """The model of ``problem`` for these options, built by :func:`build_model` if new."""
+        for cached, threads, compiled, model in self._entries:
+            if cached is problem and threads == n_threads and compiled == compile_c:
+                return model
+        model = build_model(problem, n_threads=n_threads, compile_c=compile_c)
+        self._entries.append((problem, n_threads, compile_c, model))
+        del self._entries[: -self.max_entries]
+        return model

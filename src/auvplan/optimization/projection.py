@@ -1,0 +1,151 @@
+"""The projection operator ``P``: time-varying LQR along a curve and the closed-loop rollout.
+
+``reference/pronto.md`` §6.1: ``u_k = μ_k + K_k (α_k − x_k)``, ``x_{k+1} = F(x_k, u_k, p_k)``
+from ``x_0``, with ``K_k`` the discrete LQR designed along the current trajectory.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+import scipy.linalg
+
+from auvplan._typing import FloatArray
+from auvplan.errors import SolverError
+from auvplan.optimization import _kernels
+from auvplan.optimization.model import ProntoModel
+from auvplan.optimization.options import ProntoOptions, TerminalRegulator, named_choice
+from auvplan.optimization.problem import Trajectory
+
+__all__ = ["design_regulator", "project", "project_guess", "regulator_gains"]
+
+
+def design_regulator(
+    A: FloatArray,
+    B: FloatArray,
+    Q_r: FloatArray,
+    R_r: FloatArray,
+    *,
+    terminal: TerminalRegulator | Literal["dare", "weight"] = TerminalRegulator.DARE,
+) -> FloatArray:
+    """Time-varying discrete LQR along a trajectory (the projection regulator, §6.1).
+
+    Parameters
+    ----------
+    A, B : ndarray of shape (N, n_x, n_x), (N, n_x, n_u)
+        Linearisation along the trajectory.
+    Q_r, R_r : ndarray of shape (n_x, n_x), (n_u, n_u)
+        Regulator weights (``R_r ≻ 0``).
+    terminal : TerminalRegulator or {"dare", "weight"}
+        ``P_N`` from :func:`scipy.linalg.solve_discrete_are` at the last stage (falls back
+        to ``Q_r`` when the ARE fails) or ``Q_r``.
+
+    Returns
+    -------
+    ndarray of shape (N, n_u, n_x)
+        Gains ``K_k`` for ``u_k = μ_k + K_k (α_k − x_k)``.
+
+    Raises
+    ------
+    InputError
+        If ``terminal`` is not a known choice.
+    SolverError
+        If the Riccati recursion breaks down (non-finite linearisation).
+    """
+    p_final = Q_r
+    if named_choice(TerminalRegulator, terminal, "terminal") is TerminalRegulator.DARE:
+        try:
+            with np.errstate(all="ignore"):
+                candidate = scipy.linalg.solve_discrete_are(A[-1], B[-1], Q_r, R_r)
+            if np.all(np.isfinite(candidate)) and np.min(np.linalg.eigvalsh(candidate)) > -1e-9:
+                p_final = 0.5 * (candidate + candidate.T)
+        except (np.linalg.LinAlgError, ValueError):
+            p_final = Q_r
+    gains, ok = _kernels.regulator_riccati(
+        np.ascontiguousarray(A), np.ascontiguousarray(B), Q_r, R_r, np.ascontiguousarray(p_final)
+    )
+    if not ok or not np.all(np.isfinite(gains)):
+        raise SolverError(
+            "the projection-regulator Riccati recursion broke down (non-finite A, B?)"
+        )
+    return gains
+
+
+def regulator_gains(
+    model: ProntoModel,
+    trajectory: Trajectory,
+    A: FloatArray,
+    B: FloatArray,
+    options: ProntoOptions,
+) -> FloatArray:
+    """The projection regulator along ``trajectory`` (given its exact ``A``, ``B``).
+
+    With :attr:`TrajectoryProblem.regulator_floor` the regulator is designed on the
+    linearisation at the floored states instead (one more batched Jacobian evaluation).
+    """
+    problem = model.problem
+    if problem.regulator_floor is not None:
+        states = trajectory.states[:-1]
+        design = np.where(states < 0.0, -1.0, 1.0) * np.maximum(
+            np.abs(states), problem.regulator_floor
+        )
+        A, B = model.discrete.jacobians(design, trajectory.inputs, problem.parameters)
+    return design_regulator(
+        A, B, problem.state_weight, problem.input_weight, terminal=options.terminal_regulator
+    )
+
+
+def project(model: ProntoModel, reference: Trajectory, gains: FloatArray) -> Trajectory:
+    """Projection operator ``P``: closed loop ``u_k = μ_k + K_k (α_k − x_k)`` from ``x0``.
+
+    Parameters
+    ----------
+    model : ProntoModel
+        Evaluators.
+    reference : Trajectory
+        The curve ``η = (α, μ)`` (need not satisfy the dynamics).
+    gains : ndarray of shape (N, n_u, n_x)
+        Regulator gains.
+
+    Returns
+    -------
+    Trajectory
+        ``P(η)``; may contain non-finite values if the simulation diverged.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        states, inputs = model.discrete.rollout(
+            model.problem.initial_state,
+            reference.states,
+            reference.inputs,
+            gains,
+            model.problem.parameters,
+        )
+    return Trajectory(states, inputs)
+
+
+def project_guess(
+    model: ProntoModel, guess: Trajectory, options: ProntoOptions
+) -> tuple[Trajectory, FloatArray]:
+    """Project a curve onto the trajectory manifold with a regulator designed along it.
+
+    Returns
+    -------
+    trajectory : Trajectory
+        ``P(guess)``, a trajectory of the discrete dynamics from ``x0``.
+    gains : ndarray of shape (N, n_u, n_x)
+        The regulator used.
+
+    Raises
+    ------
+    SolverError
+        If the closed-loop simulation diverges.
+    """
+    f_x, f_u = model.discrete.jacobians(guess.states[:-1], guess.inputs, model.problem.parameters)
+    gains = regulator_gains(model, guess, f_x, f_u, options)
+    trajectory = project(model, guess, gains)
+    if not (np.all(np.isfinite(trajectory.states)) and np.all(np.isfinite(trajectory.inputs))):
+        raise SolverError(
+            "the projection of the initial guess diverged; use a better guess or regulator"
+        )
+    return trajectory, gains
