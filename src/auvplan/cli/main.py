@@ -19,7 +19,7 @@ from auvplan import __version__
 from auvplan.errors import AuvplanError
 
 #: Modules of :mod:`auvplan.cli` that provide a verb, in help order.
-COMMAND_MODULES = ("maps", "plan", "vehicle")
+COMMAND_MODULES = ("maps", "plan", "vehicle", "scenarios")
 
 EXIT_USER_ERROR = 2
 
