@@ -96,14 +96,14 @@ def _block_for(spacing: float) -> tuple[int, int]:
     return (1, 1) if spacing > COARSE_CELL_M else (2, 2)
 
 
-def feasible_kinds(data_dir: Path | None, min_distance: float, max_distance: float) -> list[str]:
+def feasible_kinds(data_dir: Path, min_distance: float, max_distance: float) -> list[str]:
     """Kinds whose extent and resolution suit start-goal distances in ``[min, max]`` [m]."""
     kinds = ["synthetic"]
     if max_distance <= BANK_MAX_DISTANCE_M:
         kinds.insert(0, "bank")
     for kind, name in REAL_GRIDS.items():
-        path = None if data_dir is None else data_dir / name
-        if path is None or not path.is_file():
+        path = data_dir / name
+        if not path.is_file():
             continue
         geometry = _full_grid(path.resolve()).geometry
         spacing = max(geometry.spacing_north, geometry.spacing_east)
@@ -131,7 +131,7 @@ def draw_terrain(
     *,
     max_distance: float,
     safety_radius: float,
-    data_dir: Path | None,
+    data_dir: Path,
 ) -> DrawnTerrain | None:
     """A terrain of ``kind`` large enough for ``max_distance`` [m]; None if no window has water.
 
@@ -144,7 +144,6 @@ def draw_terrain(
         return _with_maps(kind, {"synthetic": True, "seed": seed}, grid, None, f"bank {seed}")
     if kind == "synthetic":
         return _synthetic(rng, max_distance, safety_radius)
-    assert data_dir is not None
     path = (data_dir / REAL_GRIDS[kind]).resolve()
     full = _full_grid(path)
     assert full.projection is not None
