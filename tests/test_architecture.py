@@ -18,7 +18,8 @@ FORBIDDEN = {
     "vehicle": {"terrain", "planning", "deconfliction", "optimization", "mission", "cli", "viz"},
     "optimization": {"terrain", "planning", "deconfliction", "mission", "cli", "viz"},
     "io": {"mission", "cli", "viz", "optimization"},
-    "mission": {"cli", "viz"},
+    "mission": {"cli", "viz", "scenarios"},
+    "scenarios": {"optimization", "mission", "cli", "viz"},
     "viz": {"cli"},
 }
 

@@ -1,0 +1,55 @@
+"""``auvplan scenarios SEED... -o DIR``: write missions of the public seeded scenario family."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"seed must be a non-negative integer, got {text!r}")
+    return value
+
+
+def register(subparsers: argparse._SubParsersAction[Any]) -> None:
+    """Add the ``scenarios`` verb to the command line."""
+    parser = subparsers.add_parser(
+        "scenarios",
+        help="write missions of the seeded scenario family (to reproduce a benchmark run)",
+        description="Write one folder DIR/seed_NNNN per seed with mission.toml (and terrain.nc "
+        "for a generated terrain). Real grids are read from --data-dir when present; the "
+        "family depends on whether they are.",
+    )
+    parser.add_argument("seeds", metavar="SEED", type=_seed, nargs="+", help="scenario seeds")
+    parser.add_argument("-o", "--output", type=Path, required=True, help="output directory")
+    parser.add_argument(
+        "--data-dir",
+        type=Path,
+        default=None,
+        help="folder of the real bathymetry grids (default: $AUVPLAN_SHARED_DATA/bathymetry, "
+        "else ../shared/data/bathymetry)",
+    )
+    parser.set_defaults(run=run)
+
+
+def scenario_folder(output: Path, seed: int) -> Path:
+    """The folder of ``seed``'s scenario under ``output``."""
+    return output / f"seed_{seed:04d}"
+
+
+def run(args: argparse.Namespace) -> int:
+    """Generate every scenario first, then write them; returns the exit code."""
+    from auvplan.scenarios import generate
+
+    scenarios = [generate(seed, data_dir=args.data_dir) for seed in args.seeds]
+    for scenario in scenarios:
+        path = scenario.write(scenario_folder(args.output, scenario.seed))
+        if not args.quiet:
+            print(f"{path}: {scenario.description}")
+    return 0

@@ -1,0 +1,13 @@
+"""Seeded scenario family and independent checks of plans (reliability benchmarking).
+
+:func:`generate` draws a valid mission from a seed (:class:`Scenario`, written with
+:meth:`Scenario.write`); :func:`check` verifies a ``plan`` output folder with its own
+interpolation and its own plain-numpy vehicle model, independently of the solver's report.
+"""
+
+from __future__ import annotations
+
+from auvplan.scenarios.check import CheckFailure, CheckReport, check
+from auvplan.scenarios.family import Scenario, generate
+
+__all__ = ["CheckFailure", "CheckReport", "Scenario", "check", "generate"]

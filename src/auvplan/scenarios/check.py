@@ -1,0 +1,274 @@
+"""Independent checks of a ``plan`` output folder, not trusting the solver's own report.
+
+:func:`check` reads only ``trajectories.csv``, ``summary.json`` (goals resolved to the local
+frame, safety radius, solver settings, status) and the mission file (obstacles, communication
+pairs; ``maps.nc`` only for the projection when an obstacle centre is in lat/lon), and checks:
+
+(a) **constraints between samples**: positions interpolated by a cubic spline per coordinate
+    on a grid ``refinement`` times finer than the plan's; every pair keeps ``>= 2 r_c``, every
+    vehicle keeps ``>= r_c`` from every obstacle's edge, every communication pair stays within
+    its range;
+(b) **dynamics**: the per-step defect of the samples against an independent plain-numpy
+    MEDUSA model integrated with the input held (:mod:`auvplan.scenarios._model`);
+(c) **arrival**: the distance of each vehicle's last sample from its goal.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import tomllib
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any, Final
+
+import numpy as np
+import shapely
+from scipy.interpolate import CubicSpline
+
+from auvplan._typing import FloatArray
+from auvplan.errors import DataFormatError, InputError
+from auvplan.scenarios._model import read_medusa_model, step_defects
+
+STATE_COLUMNS: Final = ("north", "east", "psi", "u", "v", "r", "n_ps", "n_sb")
+INPUT_COLUMNS: Final = ("c_ps", "c_sb")
+#: Largest per-step position defect [m] accepted (issue 11: 10 mm).
+DEFECT_TOLERANCE_M: Final = 0.01
+#: Largest distance [m] of the last sample from the goal accepted.
+ARRIVAL_TOLERANCE_M: Final = 1.0
+#: Slack [m] on geometric constraints, for rounding in the CSV only.
+GEOMETRY_SLACK_M: Final = 1e-6
+FAILURE_KINDS: Final = ("separation", "obstacle", "comm", "defect", "arrival")
+
+
+@dataclass(frozen=True)
+class CheckFailure:
+    """One violated check: ``kind`` (one of :data:`FAILURE_KINDS`) and a one-line message."""
+
+    kind: str
+    message: str
+
+
+@dataclass(frozen=True)
+class CheckReport:
+    """Result of :func:`check`; distances in metres, pair labels ``"a / b"``.
+
+    ``min_obstacle_clearance_m`` is the smallest distance to each obstacle's edge
+    (``"a / obstacle k"``); ``max_state_defect`` the largest absolute defect per state (units
+    of ``trajectories.csv``); ``status`` the optimiser's status in ``summary.json``.
+    """
+
+    status: str
+    separation_limit_m: float
+    min_separation_m: dict[str, float]
+    min_obstacle_clearance_m: dict[str, float]
+    max_comm_distance_m: dict[str, float]
+    max_position_defect_m: dict[str, float]
+    max_state_defect: dict[str, dict[str, float]]
+    arrival_error_m: dict[str, float]
+    failures: tuple[CheckFailure, ...]
+
+    @property
+    def passed(self) -> bool:
+        """True when every check holds (whatever the optimiser's status)."""
+        return not self.failures
+
+    @property
+    def success(self) -> bool:
+        """A converged plan that passes every check."""
+        return self.passed and self.status == "CONVERGED"
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON-able values."""
+        return {**asdict(self), "passed": self.passed, "success": self.success}
+
+
+def read_trajectories(path: Path) -> dict[str, tuple[FloatArray, FloatArray, FloatArray]]:
+    """``trajectories.csv`` as ``{vehicle: (time (n_t,), states (n_t, 8), inputs (n_t-1, 2))}``."""
+    try:
+        with path.open(newline="", encoding="utf-8") as handle:
+            rows = list(csv.DictReader(handle))
+    except FileNotFoundError:
+        raise DataFormatError(f"{path} not found (did the plan reach the optimiser?)") from None
+    by_vehicle: dict[str, list[dict[str, str]]] = {}
+    for row in rows:
+        by_vehicle.setdefault(row["vehicle"], []).append(row)
+    result = {}
+    for name, records in by_vehicle.items():
+        table = np.array(
+            [[float(r[c]) for c in ("t", *STATE_COLUMNS, *INPUT_COLUMNS)] for r in records]
+        )
+        result[name] = (table[:, 0], table[:, 1:9], table[:-1, 9:11])
+    return result
+
+
+def check(
+    output_dir: Path | str,
+    *,
+    mission: Path | str | None = None,
+    refinement: int = 10,
+    defect_tolerance_m: float = DEFECT_TOLERANCE_M,
+    arrival_tolerance_m: float = ARRIVAL_TOLERANCE_M,
+) -> CheckReport:
+    """Check a ``plan`` output folder independently of the solver (module docstring).
+
+    Parameters
+    ----------
+    output_dir : Path or str
+        Folder written by ``auvplan plan`` (``summary.json``, ``trajectories.csv``).
+    mission : Path or str, optional
+        The mission file; default: the one recorded in ``summary.json``.
+    refinement : int
+        Interpolation points per plan step for the constraint checks.
+    defect_tolerance_m, arrival_tolerance_m : float
+        Largest per-step position defect and arrival error [m] accepted.
+
+    Returns
+    -------
+    CheckReport
+
+    Raises
+    ------
+    DataFormatError
+        A file is missing or malformed.
+    InputError
+        No mission file is known.
+    """
+    output_dir = Path(output_dir)
+    summary = json.loads((output_dir / "summary.json").read_text(encoding="utf-8"))
+    if "optimization" not in summary:
+        raise DataFormatError(f"{output_dir}/summary.json has no optimisation result")
+    mission_path = Path(mission) if mission is not None else _recorded_mission(summary)
+    document = tomllib.loads(mission_path.read_text(encoding="utf-8"))
+    tracks = read_trajectories(output_dir / "trajectories.csv")
+    names = list(tracks)
+    failures: list[CheckFailure] = []
+
+    time = tracks[names[0]][0]
+    fine_time = np.linspace(time[0], time[-1], refinement * (time.size - 1) + 1)
+    fine = {
+        name: CubicSpline(t, states[:, :2], axis=0)(fine_time)
+        for name, (t, states, _) in tracks.items()
+    }
+    radius = float(summary["fleet"]["safety_radius_m"])
+    separations = _pair_distances(fine, names)
+    min_separation = {pair: float(d.min()) for pair, d in separations.items()}
+    for pair, distance in min_separation.items():
+        if distance < 2.0 * radius - GEOMETRY_SLACK_M:
+            failures.append(
+                CheckFailure(
+                    "separation", f"{pair} {distance:.3f} m apart < 2 r_c = {2 * radius:g} m"
+                )
+            )
+    clearances = _obstacle_clearances(fine, document, output_dir)
+    for label, clearance in clearances.items():
+        if clearance < radius - GEOMETRY_SLACK_M:
+            failures.append(
+                CheckFailure(
+                    "obstacle", f"{label}: {clearance:.3f} m from its edge < r_c = {radius:g} m"
+                )
+            )
+    comm_distances = {}
+    for comm in document.get("comm", []):
+        pair = f"{comm['pair'][0]} / {comm['pair'][1]}"
+        farthest = float(np.max(np.hypot(*(fine[comm["pair"][0]] - fine[comm["pair"][1]]).T)))
+        comm_distances[pair] = farthest
+        if farthest > float(comm["max_range_m"]) + GEOMETRY_SLACK_M:
+            failures.append(
+                CheckFailure(
+                    "comm",
+                    f"{pair} {farthest:.1f} m apart > max_range_m = {comm['max_range_m']:g} m",
+                )
+            )
+
+    vehicles = {vehicle["name"]: vehicle for vehicle in summary["vehicles"]}
+    order = summary["solver"].get("propeller_order")
+    position_defects, state_defects, arrival = {}, {}, {}
+    for name, (t, states, inputs) in tracks.items():
+        model = read_medusa_model(
+            vehicles[name]["type"],
+            propeller_order=order,
+            base_dirs=(mission_path.parent, Path()),
+        )
+        defects = step_defects(model, t, states, inputs)
+        position_defects[name] = float(np.max(np.hypot(defects[:, 0], defects[:, 1]), initial=0.0))
+        state_defects[name] = dict(
+            zip(STATE_COLUMNS, np.max(np.abs(defects), axis=0, initial=0.0).tolist(), strict=True)
+        )
+        if position_defects[name] > defect_tolerance_m:
+            step = int(np.argmax(np.hypot(defects[:, 0], defects[:, 1])))
+            failures.append(
+                CheckFailure(
+                    "defect",
+                    f"{name}: position defect {position_defects[name]:.4g} m at t = {t[step]:g} s "
+                    f"> {defect_tolerance_m:g} m",
+                )
+            )
+        goal = vehicles[name]["goal"]
+        arrival[name] = float(np.hypot(states[-1, 0] - goal["north"], states[-1, 1] - goal["east"]))
+        if arrival[name] > arrival_tolerance_m:
+            failures.append(
+                CheckFailure(
+                    "arrival",
+                    f"{name}: {arrival[name]:.3f} m from its goal > {arrival_tolerance_m:g} m",
+                )
+            )
+    return CheckReport(
+        status=str(summary["optimization"]["status"]),
+        separation_limit_m=2.0 * radius,
+        min_separation_m=min_separation,
+        min_obstacle_clearance_m=clearances,
+        max_comm_distance_m=comm_distances,
+        max_position_defect_m=position_defects,
+        max_state_defect=state_defects,
+        arrival_error_m=arrival,
+        failures=tuple(failures),
+    )
+
+
+def _recorded_mission(summary: Mapping[str, Any]) -> Path:
+    recorded = summary.get("mission")
+    if not recorded or not Path(recorded).is_file():
+        raise InputError(f"mission file {recorded!r} recorded in summary.json not found; pass it")
+    return Path(recorded)
+
+
+def _pair_distances(fine: Mapping[str, FloatArray], names: list[str]) -> dict[str, FloatArray]:
+    return {
+        f"{a} / {b}": np.hypot(*(fine[a] - fine[b]).T)
+        for i, a in enumerate(names)
+        for b in names[i + 1 :]
+    }
+
+
+def _obstacle_clearances(
+    fine: Mapping[str, FloatArray], document: Mapping[str, Any], output_dir: Path
+) -> dict[str, float]:
+    """Smallest signed distance [m] of each vehicle to each obstacle's edge (< 0 inside)."""
+    clearances = {}
+    for k, obstacle in enumerate(document.get("obstacle", [])):
+        for name, track in fine.items():
+            if "polygon" in obstacle:
+                shape = shapely.Polygon(np.asarray(obstacle["polygon"], dtype=np.float64))
+                points = shapely.points(track)
+                distance = shapely.distance(shape.boundary, points)
+                signed = np.where(shapely.contains(shape, points), -distance, distance)
+            else:
+                centre = _local(obstacle["center"], output_dir)
+                signed = np.hypot(*(track - centre).T) - float(obstacle["radius_m"])
+            clearances[f"{name} / obstacle {k}"] = float(np.min(signed))
+    return clearances
+
+
+def _local(position: Mapping[str, float], output_dir: Path) -> tuple[float, float]:
+    """``(north, east)`` [m] of a mission position; lat/lon via the projection in ``maps.nc``."""
+    if "north" in position:
+        return float(position["north"]), float(position["east"])
+    from auvplan.io.bathymetry import read_bathymetry
+
+    projection = read_bathymetry(output_dir / "maps.nc").projection
+    if projection is None:
+        raise DataFormatError(f"{output_dir}/maps.nc has no projection for a lat/lon obstacle")
+    north, east = projection.to_local(np.array([position["lat"]]), np.array([position["lon"]]))
+    return float(north[0]), float(east[0])
