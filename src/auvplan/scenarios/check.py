@@ -56,7 +56,8 @@ class CheckReport:
 
     ``min_obstacle_clearance_m`` is the smallest distance to each obstacle's edge
     (``"a / obstacle k"``); ``max_state_defect`` the largest absolute defect per state (units
-    of ``trajectories.csv``); ``status`` the optimiser's status in ``summary.json``.
+    of ``trajectories.csv``); ``status`` the plan's status in ``summary.json``
+    (``plan_status``: CONVERGED only when the planner's own between-sample checks pass too).
     """
 
     status: str
@@ -215,7 +216,7 @@ def check(
                 )
             )
     return CheckReport(
-        status=str(summary["optimization"]["status"]),
+        status=str(summary["optimization"].get("plan_status", summary["optimization"]["status"])),
         separation_limit_m=2.0 * radius,
         min_separation_m=min_separation,
         min_obstacle_clearance_m=clearances,
