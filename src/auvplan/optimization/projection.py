@@ -82,15 +82,21 @@ def regulator_gains(
     """The projection regulator along ``trajectory`` (given its exact ``A``, ``B``).
 
     With :attr:`TrajectoryProblem.regulator_floor` the regulator is designed on the
-    linearisation at the floored states instead (one more batched Jacobian evaluation).
+    linearisation at the floored states instead (the Jacobians are evaluated again at the
+    stages where a state lies below its floor).
     """
     problem = model.problem
     if problem.regulator_floor is not None:
         states = trajectory.states[:-1]
-        design = np.where(states < 0.0, -1.0, 1.0) * np.maximum(
-            np.abs(states), problem.regulator_floor
-        )
-        A, B = model.discrete.jacobians(design, trajectory.inputs, problem.parameters)
+        below = np.abs(states) < problem.regulator_floor
+        stages = np.flatnonzero(np.any(below, axis=1))
+        if stages.size:
+            sign = np.where(states[stages] < 0.0, -1.0, 1.0)
+            design = np.where(below[stages], sign * problem.regulator_floor, states[stages])
+            A, B = A.copy(), B.copy()
+            A[stages], B[stages] = model.discrete.jacobians(
+                design, trajectory.inputs[stages], problem.parameters[stages]
+            )
     return design_regulator(
         A, B, problem.state_weight, problem.input_weight, terminal=options.terminal_regulator
     )
