@@ -64,11 +64,15 @@ def evaluate_plan(
     config: MissionConfig,
     preplan: PreplanStage,
     time: FloatArray,
+    dt: float,
     functions: FleetProblemFunctions,
     result: ProntoResult,
     terrain_weight: float,
 ) -> OptimizedPlan:
-    """Energy, information, arrival error and sampled-and-between separations of a result."""
+    """Energy, information, arrival error and sampled-and-between separations of a result.
+
+    ``time`` is the solver grid of control interval ``dt`` [s].
+    """
     layout = functions.layout
     models = layout.models
     flat_states, flat_inputs = result.trajectory.states, result.trajectory.inputs
@@ -82,7 +86,6 @@ def evaluate_plan(
     arrival = np.hypot(*(planned[:, -1] - preplan.goals[:, :2]).T)
     information = information_along(preplan.maps, planned)
 
-    dt = float(time[1] - time[0])
     flown = [
         replay_closed_loop(
             model,

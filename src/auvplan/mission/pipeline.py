@@ -188,5 +188,11 @@ def run_optimization(
         result.cost,
     )
     return evaluate_plan(
-        config, preplan, deconfliction.time, assembled.functions, result, terrain_weight
+        config,
+        preplan,
+        deconfliction.time,
+        deconfliction.dt,
+        assembled.functions,
+        result,
+        terrain_weight,
     )
