@@ -133,15 +133,10 @@ def assemble_problem(
             PathConstraint(block.function, kind=block.kind, name=block.name)
             for block in functions.constraints
         ),
-        regulator_Q=np.diag(layout.state_weights(REGULATOR_WEIGHTS, 1.0)),
+        regulator_Q=np.diag(layout.per_state(REGULATOR_WEIGHTS, 1.0)),
         regulator_R=np.eye(layout.n_u),
         n_substeps=integration_substeps(layout, deconfliction.dt),
-        regulator_floor=np.concatenate(
-            [
-                [regulator_floor(model).get(name, 0.0) for name in model.state_names]
-                for model in layout.models
-            ]
-        ),
+        regulator_floor=layout.per_state(regulator_floor, 0.0),
     )
     guess = Trajectory(
         states=stacked_desired, inputs=np.zeros((deconfliction.time.size - 1, layout.n_u))

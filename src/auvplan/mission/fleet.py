@@ -23,7 +23,7 @@ follow SPEC §5 (feasible when ``c >= 0``): inter-vehicle collision
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Final, Literal
 
@@ -99,11 +99,19 @@ class FleetLayout:
         """Vehicle ``i``'s own block ``(N, n_u_i, n_x_i)`` of stacked gains ``(N, n_u, n_x)``."""
         return gains[:, self.input_slice(i), self.state_slice(i)]
 
-    def state_weights(self, weights: dict[str, float], default: float) -> FloatArray:
-        """A stacked weight vector from per-name weights (``default`` for unnamed states)."""
+    def per_state(
+        self,
+        values: Mapping[str, float] | Callable[[VehicleModel], Mapping[str, float]],
+        default: float,
+    ) -> FloatArray:
+        """A stacked vector from values by state name (or a model's own), ``default`` elsewhere."""
         return np.concatenate(
-            [[weights.get(name, default) for name in model.state_names] for model in self.models]
-        )
+            [
+                [(values(model) if callable(values) else values).get(name, default)
+                 for name in model.state_names]
+                for model in self.models
+            ]
+        )  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -183,7 +191,7 @@ def build_fleet_functions(
 
     xdot = ca.vertcat(*[model.dynamics(xs[i], cs[i]) for i, model in enumerate(models)])
     powers = ca.vertcat(*[model.power(xs[i], cs[i]) for i, model in enumerate(models)])
-    q = ca.DM(layout.state_weights(TRACKING_WEIGHTS, 0.0))
+    q = ca.DM(layout.per_state(TRACKING_WEIGHTS, 0.0))
     error = x - p
     rate = weights.energy * ca.sum1(powers)
     rate += 0.5 * weights.terrain * ca.dot(q * error, error)
