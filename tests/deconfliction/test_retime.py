@@ -123,3 +123,23 @@ def test_retimed_law_between_samples_is_the_integrated_speed() -> None:
     for i in range(2):
         expected = [law_at(result, i, float(t)) for t in middle]
         np.testing.assert_allclose(progress_at(result, i, middle), expected, atol=1e-12)
+
+
+def test_coarse_resampling_falls_back_to_the_certified_replay(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from auvplan.deconfliction import retime
+
+    problem = CoordinationProblem(
+        (np.array([[-30.0, 0.0], [30.0, 0.0]]), np.array([[0.0, -30.0], [0.0, 30.0]])),
+        safety_radius=2.0,
+        cruise_speeds=np.ones(2),
+        time_step=0.5,
+    )
+    schedule = deconflict(problem)
+    monkeypatch.setattr(retime, "MAX_SAMPLES", 5)  # a grid too coarse to certify the crossing
+    result = retime_for_arrival(schedule, problem, 80.0)
+    assert result.certificate.holds
+    assert result.min_separation >= 2 * problem.safety_radius
+    np.testing.assert_allclose(result.time, schedule.time * 80.0 / schedule.time[-1])
+    assert max(result.arrival_times) == pytest.approx(80.0)

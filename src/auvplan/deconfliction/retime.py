@@ -137,6 +137,20 @@ def retime_for_arrival(
         progress[i], speeds[i], within[i] = law
     certificate = certify_separation(problem, time, progress)
     if not certificate.holds:
+        # the resampled corridor missed a close pass: replay the schedule itself on its own
+        # grid at the common pace, which keeps its configurations and hence its certificate
+        i, j = certificate.pair
+        logger.warning(
+            "retime: %s and %s not certified on the resampled grid (%.3g m); replaying the "
+            "schedule at a common pace", problem.label(i), problem.label(j),
+            certificate.min_separation,
+        )  # fmt: skip
+        time = result.time * (final_time / makespan)
+        progress = np.array(result.progress, dtype=np.float64)
+        speeds = np.full_like(progress, np.nan)
+        within = [False] * problem.n_vehicles
+        certificate = certify_separation(problem, time, progress)
+    if not certificate.holds:
         i, j = certificate.pair
         raise InfeasibleError(
             f"retiming vehicles {problem.label(i)} and {problem.label(j)} to arrive at "
