@@ -342,6 +342,11 @@ def optimal_cruise_speed(model: VehicleModel) -> CruiseOptimum:
     True
     """
     upper = top_speed(model)
+    if upper <= _MIN_CRUISE_SPEED:
+        raise InputError(
+            f"vehicle {model.params.name!r} tops out at {upper:.3g} m/s, below the "
+            f"{_MIN_CRUISE_SPEED:g} m/s a cruise speed is searched from; check its thrust and drag"
+        )
     result = minimize_scalar(
         lambda u: energy_per_metre(model, float(u)),
         bounds=(_MIN_CRUISE_SPEED, upper),
