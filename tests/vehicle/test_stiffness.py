@@ -46,14 +46,3 @@ def test_step_bound_keeps_every_damped_mode_stable(order: int | None) -> None:
     assert largest <= fastest_mode(model) * (1 + 1e-6)
     # the bound is not loose: twice the step leaves RK4's stability region somewhere
     assert largest * 2 * h > 2.785
-
-
-def test_too_weak_vehicle_has_no_cruise_speed_but_a_clear_error() -> None:
-    import dataclasses
-
-    from auvplan.errors import InputError
-    from auvplan.vehicle import optimal_cruise_speed
-
-    weak = dataclasses.replace(load_vehicle("medusa"), n_max=0.5)
-    with pytest.raises(InputError, match="tops out at"):
-        optimal_cruise_speed(build_vehicle_model(weak, propeller_order=3))
