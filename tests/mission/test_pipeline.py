@@ -52,3 +52,14 @@ def test_optimiser_failure_writes_earlier_stages_and_exits_3(
     assert summary["optimization"]["plan_status"] == "FAILED"
     assert (out / "desired.csv").is_file()
     assert not (out / "trajectories.csv").exists()
+
+
+def test_summary_keeps_the_keys_users_read(tmp_path: Path) -> None:
+    mission = tmp_path / "mission.toml"
+    mission.write_text(MISSION + 'propeller_order = "full"\n')
+    out = tmp_path / "out"
+    assert main(["-q", "plan", str(mission), "-o", str(out), "--stage", "deconflict"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["fleet"]["deconfliction_method"] == summary["deconfliction"]["method"]
+    assert summary["solver"]["dt"] == 1.0
+    assert summary["solver"]["propeller_order"] is None  # "full", as before

@@ -79,8 +79,10 @@ def mission_summary(result: MissionResult) -> dict[str, Any]:
         "fleet": {
             "safety_radius_m": config.fleet.safety_radius,
             "edge_model": config.planner.edge_model,
+            "deconfliction_method": str(config.deconfliction.method),
         },
-        "solver": config.solver.model_dump(by_alias=True),
+        # the settings by field name, "full" propeller order as null (keys users already read)
+        "solver": {**config.solver.model_dump(), "propeller_order": config.solver.harmonics},
         "vehicles": [],
         "wall_time_s": dict(result.timings),
     }
@@ -103,12 +105,11 @@ def mission_summary(result: MissionResult) -> dict[str, Any]:
     stage2 = result.deconfliction
     if stage2 is not None:
         coordination = stage2.coordination
+        n_substeps = integration_substeps(stage2.layout, stage2.dt)
+        summary["fleet"]["deconfliction_method"] = str(coordination.method)
         summary["deconfliction"] = {
             "horizon_s": stage2.horizon,
-            "integration": {
-                "n_substeps": integration_substeps(stage2.layout, stage2.dt),
-                "substep_s": stage2.dt / integration_substeps(stage2.layout, stage2.dt),
-            },
+            "integration": {"n_substeps": n_substeps, "substep_s": stage2.dt / n_substeps},
             "status": coordination.status.name,
             "message": coordination.message,
             "objective": coordination.objective,

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from functools import cache
 from typing import NamedTuple
 
 import casadi as ca
@@ -250,8 +251,9 @@ def trim_turn(model: VehicleModel, speed: float, yaw_rate: float) -> TurnTrim:
     return TurnTrim(n_ps, n_sb, v, _power(model, _state(speed, v, yaw_rate, n_ps, n_sb)))
 
 
+@cache
 def top_speed(model: VehicleModel) -> float:
-    """Steady straight-line speed with both propellers at ``n_max`` [m/s].
+    """Steady straight-line speed with both propellers at ``n_max`` [m/s] (cached per model).
 
     Examples
     --------
