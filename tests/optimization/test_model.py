@@ -14,6 +14,7 @@ from auvplan.optimization import (
     ModelCache,
     PathConstraint,
     ProntoOptions,
+    StageBackend,
     TerminalRegulator,
     build_model,
     solve_pronto,
@@ -27,7 +28,7 @@ def test_cache_returns_the_same_model_per_problem_and_options() -> None:
     problem = unicycle_problem()
     model = cache.get(problem)
     assert cache.get(problem) is model
-    assert cache.get(problem, n_threads=2) is not model
+    assert cache.get(problem, StageBackend(n_threads=2)) is not model
     # an equal but distinct problem object gets its own model (identity, never id reuse)
     twin = dataclasses.replace(problem)
     assert cache.get(twin) is not model

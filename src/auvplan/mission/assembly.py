@@ -137,6 +137,7 @@ def assemble_problem(
         regulator_R=np.eye(layout.n_u),
         n_substeps=integration_substeps(layout, deconfliction.dt),
         regulator_floor=layout.per_state(regulator_floor, 0.0),
+        blocks=functions.blocks,
     )
     guess = Trajectory(
         states=stacked_desired, inputs=np.zeros((deconfliction.time.size - 1, layout.n_u))

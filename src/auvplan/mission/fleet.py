@@ -31,6 +31,7 @@ import casadi as ca
 import numpy as np
 
 from auvplan._typing import FloatArray
+from auvplan.optimization import StageBlock, stack_blocks
 from auvplan.vehicle import VehicleModel
 
 #: Desired-state weights Q of the tracking term per unit of ``terrain`` weight, by state name:
@@ -49,6 +50,23 @@ INPUT_WEIGHT: Final = 1e-2
 #: Terminal stiffness per unit of ``terminal`` weight: position [J/m²], heading [J/rad²].
 TERMINAL_POSITION_WEIGHT: Final = 2e3
 TERMINAL_HEADING_WEIGHT: Final = 2e3
+
+
+def vehicle_stage_functions(model: VehicleModel) -> tuple[ca.Function, ca.Function]:
+    r"""One vehicle's block of the fleet problem: ``f(x, c, p)`` and cost rate ``l(x, c, p, w)``.
+
+    ``p`` is the vehicle's desired state and ``w = (w_E, w_T, r, q_1, …, q_{n_x})`` the
+    runtime weights: ``l = w_E P(x, c) + ½ w_T Σ_s q_s (x_s − p_s)² + ½ r ‖c‖²`` [W].
+    """
+    x, c = ca.SX.sym("x", model.n_x), ca.SX.sym("c", model.n_u)
+    p, w = ca.SX.sym("p", model.n_x), ca.SX.sym("w", 3 + model.n_x)
+    error = x - p
+    rate = w[0] * model.power(x, c) + 0.5 * w[1] * ca.dot(w[3:] * error, error)
+    rate += 0.5 * w[2] * ca.dot(c, c)
+    return (
+        ca.Function("vehicle_f", [x, c, p], [model.dynamics(x, c)]),
+        ca.Function("vehicle_l", [x, c, p, w], [rate]),
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -133,6 +151,7 @@ class FleetProblemFunctions:
     """CasADi functions of the fleet problem; see the module docstring for the equations."""
 
     layout: FleetLayout
+    blocks: tuple[StageBlock, ...]
     dynamics: ca.Function
     running_cost: ca.Function
     power: ca.Function
@@ -189,13 +208,21 @@ def build_fleet_functions(
     cs = [c[layout.input_slice(i)] for i in range(layout.n_vehicles)]
     models = layout.models
 
-    xdot = ca.vertcat(*[model.dynamics(xs[i], cs[i]) for i, model in enumerate(models)])
+    def tracking(model: VehicleModel) -> list[float]:
+        return [TRACKING_WEIGHTS.get(name, 0.0) for name in model.state_names]
+
+    blocks = tuple(
+        StageBlock(
+            *vehicle_stage_functions(model),
+            weights=np.array([weights.energy, weights.terrain, INPUT_WEIGHT, *tracking(model)]),
+            states=layout.state_slice(i),
+            inputs=layout.input_slice(i),
+            parameters=layout.state_slice(i),
+        )
+        for i, model in enumerate(models)
+    )
+    dynamics, running_cost = stack_blocks(blocks, layout.n_x, layout.n_u, layout.n_x)
     powers = ca.vertcat(*[model.power(xs[i], cs[i]) for i, model in enumerate(models)])
-    q = ca.DM(layout.per_state(TRACKING_WEIGHTS, 0.0))
-    error = x - p
-    rate = weights.energy * ca.sum1(powers)
-    rate += 0.5 * weights.terrain * ca.dot(q * error, error)
-    rate += 0.5 * INPUT_WEIGHT * ca.dot(c, c)
 
     terminal = 0.0
     for i, model in enumerate(models):
@@ -211,8 +238,9 @@ def build_fleet_functions(
         )
     return FleetProblemFunctions(
         layout=layout,
-        dynamics=ca.Function("fleet_f", [x, c, p], [xdot]),
-        running_cost=ca.Function("fleet_l", [x, c, p], [rate]),
+        blocks=blocks,
+        dynamics=dynamics,
+        running_cost=running_cost,
         power=ca.Function("fleet_power", [x, c], [powers]),
         terminal_cost=ca.Function("fleet_m", [x], [terminal]),
         constraints=_constraints(layout, (x, c, p), xs, limits),

@@ -307,7 +307,9 @@ class SolverConfig(TableModel):
 
     ``dt`` is the control and output interval. ``propeller_order`` is the number of Fourier
     harmonics of the four-quadrant propeller model inside the optimiser (the paper's low-order
-    approximation) or ``"full"``. ``compile`` C-compiles the stage functions (cached on disk).
+    approximation) or ``"full"``. ``kernels`` evaluates each vehicle's stage derivatives with
+    compiled kernels (numba, built once per vehicle model and cached on disk); without them
+    ``compile`` C-compiles the stacked CasADi functions (cached on disk, needs a C compiler).
     """
 
     dt: Number = Field(
@@ -337,7 +339,12 @@ class SolverConfig(TableModel):
         _SOLVER_DEFAULTS.eigenvalue_floor, gt=0.0, le=1e6,
         description="smallest curvature kept by the convexified fallback",
     )  # fmt: skip
-    compile: Flag = Field(_SOLVER_DEFAULTS.compile_c, description="C-compile stage functions")
+    kernels: Flag = Field(
+        _SOLVER_DEFAULTS.stage_kernels, description="compiled per-vehicle stage kernels"
+    )
+    compile: Flag = Field(
+        _SOLVER_DEFAULTS.compile_c, description="C-compile the CasADi stage functions"
+    )
 
     @model_validator(mode="after")
     def _schedule(self) -> SolverConfig:
@@ -357,6 +364,7 @@ class SolverConfig(TableModel):
             eps_factor=self.eps_factor,
             delta_initial=self.delta_initial,
             eigenvalue_floor=self.eigenvalue_floor,
+            stage_kernels=self.kernels,
             compile_c=self.compile,
         )
 

@@ -11,7 +11,8 @@ digital controller sampled at the solver's rate,
 
     c(t) = \mu_k + K_k (\alpha_k - x(t_k)), \qquad t \in [t_k, t_{k+1}),
 
-with the plant integrated by RK4 on a grid ``refinement`` times finer than the solver's.
+with the plant integrated by RK4 on a grid ``refinement`` times finer than the solver's (the
+vehicle's compiled model kernels, :mod:`auvplan.optimization.block_kernels`).
 Because the plan is a trajectory of the solver's discrete dynamics, the replay differs from
 it only by the integration error of the coarse grid, kept small by the feedback.
 """
@@ -22,8 +23,9 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
+from auvplan.mission.fleet import vehicle_stage_functions
+from auvplan.optimization import block_kernels
 from auvplan.vehicle import VehicleModel
-from auvplan.vehicle.simulate import rk4_step_function
 
 
 def replay_closed_loop(
@@ -63,13 +65,16 @@ def replay_closed_loop(
             f"inconsistent plan shapes: states {states.shape}, inputs {inputs.shape}, "
             f"gains {gains.shape}"
         )
-    step = rk4_step_function(model, dt / refinement)
-    flown = np.empty((n_steps * refinement + 1, model.n_x))
-    x = states[0].copy()
-    flown[0] = x
-    for k in range(n_steps):
-        control = inputs[k] + gains[k] @ (states[k] - x)
-        for j in range(refinement):
-            x = np.asarray(step(x, control)).reshape(-1)
-            flown[k * refinement + j + 1] = x
+    kernels = block_kernels(*vehicle_stage_functions(model))
+    path, _ = kernels.closed_loop(
+        states[:1],
+        states[None, :-1],
+        inputs[None],
+        gains[None],
+        np.zeros((1, n_steps, model.n_x)),
+        np.zeros((1, kernels.n_w)),
+        dt / refinement,
+        refinement,
+    )
+    flown: FloatArray = path[0]
     return flown

@@ -10,6 +10,8 @@ Modules, in the order of the data flow:
 - ``problem``: the problem and trajectory types; ``options``: solver options;
 - ``integration``, ``discretization``, ``constraints``, ``terminal``: batched CasADi evaluators
   of the discrete map, the stage cost, the path constraints and the terminal cost;
+- ``separable``, ``block_kernels``: separable problems (one block per vehicle) evaluated with
+  compiled model kernels stepped by RK4, built once per model and cached on disk;
 - ``model``: :func:`build_model` and the explicit :class:`ModelCache`;
 - ``stages``: cost, linearisation, costate and Newton weights along a trajectory;
 - ``projection``: regulator design and the projection operator;
@@ -28,6 +30,7 @@ from auvplan.optimization.barrier import (
     hockey_stick,
     log_barrier,
 )
+from auvplan.optimization.block_kernels import BlockKernels, block_kernels
 from auvplan.optimization.constraints import ConstraintModel, discretize_constraints
 from auvplan.optimization.discretization import DiscreteModel, discretize_rk4
 from auvplan.optimization.integration import choose_substeps
@@ -42,11 +45,17 @@ from auvplan.optimization.linesearch import (
 from auvplan.optimization.lq import DirectionType, LqDirection, convexify, solve_lq_direction
 from auvplan.optimization.model import ModelCache, ProntoModel, build_model
 from auvplan.optimization.numdiff import DerivativeCheck, derivative_check
-from auvplan.optimization.options import FallbackModel, ProntoOptions, TerminalRegulator
+from auvplan.optimization.options import (
+    FallbackModel,
+    ProntoOptions,
+    StageBackend,
+    TerminalRegulator,
+)
 from auvplan.optimization.problem import PathConstraint, Trajectory, TrajectoryProblem
 from auvplan.optimization.projection import design_regulator, project, project_guess
 from auvplan.optimization.pronto import solve_pronto
 from auvplan.optimization.result import ProntoIteration, ProntoResult, ProntoStatus
+from auvplan.optimization.separable import BlockDiscreteModel, StageBlock, stack_blocks
 from auvplan.optimization.stages import (
     CostParts,
     Linearization,
@@ -62,6 +71,8 @@ from auvplan.optimization.terminal import TerminalCost, make_terminal_cost
 __all__ = [
     "ArmijoResult",
     "BarrierKind",
+    "BlockDiscreteModel",
+    "BlockKernels",
     "ConstraintModel",
     "CostParts",
     "DerivativeCheck",
@@ -80,6 +91,8 @@ __all__ = [
     "ProntoOptions",
     "ProntoResult",
     "ProntoStatus",
+    "StageBackend",
+    "StageBlock",
     "StageWeights",
     "StepTrial",
     "TerminalCost",
@@ -88,6 +101,7 @@ __all__ = [
     "TrajectoryProblem",
     "armijo_step",
     "barrier_expression",
+    "block_kernels",
     "build_model",
     "choose_substeps",
     "composed_barrier",
@@ -110,5 +124,6 @@ __all__ = [
     "solve_ipopt",
     "solve_lq_direction",
     "solve_pronto",
+    "stack_blocks",
     "try_step",
 ]

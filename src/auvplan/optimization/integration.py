@@ -20,6 +20,8 @@ calls of one substep Function, evaluate the Hessians about 2.2 times slower).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import casadi as ca
 import numpy as np
 
@@ -33,7 +35,7 @@ from auvplan.optimization._casadi import (
     with_symbol_fallback,
 )
 
-__all__ = ["check_substeps", "choose_substeps", "rk4_step"]
+__all__ = ["check_substeps", "choose_substeps", "rk4_step", "rk4_substep"]
 
 
 def check_substeps(n_substeps: int) -> None:
@@ -48,15 +50,19 @@ def check_substeps(n_substeps: int) -> None:
         raise InputError(f"n_substeps must be a positive integer, got {n_substeps!r}")
 
 
-def _substep(
+def rk4_substep(
     dynamics: ca.Function,
-    running_cost: ca.Function | None,
+    running_cost: ca.Function | Callable[[Symbol, Symbol, Symbol], Symbol] | None,
     x: Symbol,
     u: Symbol,
     p: Symbol,
     h: Symbol | float,
 ) -> tuple[Symbol, Symbol]:
-    """One RK4 substep of length ``h`` and its cost quadrature (0 without a cost)."""
+    """One RK4 substep of length ``h`` from ``x`` and its cost quadrature (0 without a cost).
+
+    ``dynamics`` and ``running_cost`` are called as ``g(x, u, p)`` on symbols (a CasADi
+    Function or any callable building an expression).
+    """
 
     def rate(state: Symbol) -> tuple[Symbol, Symbol]:
         cost = 0 if running_cost is None else running_cost(state, u, p)
@@ -97,9 +103,9 @@ def rk4_step(
         ``F`` and ``L``.
     """
     h = dt / n_substeps
-    x_next, stage_cost = _substep(dynamics, running_cost, x, u, p, h)
+    x_next, stage_cost = rk4_substep(dynamics, running_cost, x, u, p, h)
     for _ in range(n_substeps - 1):
-        x_next, cost = _substep(dynamics, running_cost, x_next, u, p, h)
+        x_next, cost = rk4_substep(dynamics, running_cost, x_next, u, p, h)
         stage_cost = stage_cost + cost
     return x_next, stage_cost
 
@@ -172,7 +178,7 @@ def choose_substeps(
 
     def build(use_sx: bool) -> ca.Function:
         x, u, p, h = symbols([n_x, n_u, n_p, 1], ["x", "u", "p", "h"], use_sx)
-        x_next, _ = _substep(dynamics, None, x, u, p, h)
+        x_next, _ = rk4_substep(dynamics, None, x, u, p, h)
         return ca.Function("rk4_substep", [x, u, p, h], [x_next])
 
     substep = with_symbol_fallback(build)

@@ -8,18 +8,24 @@ models in an explicit :class:`ModelCache` and passes it to the solver.
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from auvplan._typing import BoolArray, FloatArray
+from auvplan.optimization._numba_codegen import UnsupportedOperation
 from auvplan.optimization.barrier import BarrierKind
 from auvplan.optimization.constraints import ConstraintModel, discretize_constraints
 from auvplan.optimization.discretization import DiscreteModel, discretize_rk4
+from auvplan.optimization.options import StageBackend
 from auvplan.optimization.problem import TrajectoryProblem
+from auvplan.optimization.separable import BlockDiscreteModel
 from auvplan.optimization.terminal import TerminalCost, make_terminal_cost
 
 __all__ = ["ModelCache", "ProntoModel", "build_model"]
+
+logger = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True, eq=False)
@@ -30,8 +36,8 @@ class ProntoModel:
     ----------
     problem : TrajectoryProblem
         The problem.
-    discrete : DiscreteModel
-        Step ``F`` and stage cost ``L`` with their derivatives.
+    discrete : DiscreteModel or BlockDiscreteModel
+        Step ``F`` and stage cost ``L`` with their derivatives (CasADi or block kernels).
     terminal : TerminalCost
         ``m(x_N)`` with its derivatives.
     constraints : ConstraintModel or None
@@ -43,7 +49,7 @@ class ProntoModel:
     """
 
     problem: TrajectoryProblem
-    discrete: DiscreteModel
+    discrete: DiscreteModel | BlockDiscreteModel
     terminal: TerminalCost
     constraints: ConstraintModel | None
     slack_scales: FloatArray
@@ -55,34 +61,43 @@ class ProntoModel:
         return self.constraints is not None and self.constraints.n_c > 0
 
 
-def build_model(
-    problem: TrajectoryProblem, *, n_threads: int = 1, compile_c: bool = False
-) -> ProntoModel:
+def _discrete_model(
+    problem: TrajectoryProblem, backend: StageBackend
+) -> DiscreteModel | BlockDiscreteModel:
+    """The step's evaluator: block kernels when possible, else the stacked CasADi functions."""
+    if problem.blocks and backend.stage_kernels:
+        sizes = (problem.n_states, problem.n_inputs, problem.n_parameters)
+        try:
+            return BlockDiscreteModel.build(problem.blocks, sizes, problem.dt, problem.n_substeps)
+        except UnsupportedOperation as error:
+            logger.warning("stage kernels unavailable (%s): evaluating with CasADi", error)
+    return discretize_rk4(
+        problem.dynamics,
+        problem.running_cost,
+        problem.dt,
+        n_substeps=problem.n_substeps,
+        parallelization="thread" if backend.n_threads > 1 else "serial",
+        n_threads=backend.n_threads,
+        compile_c=backend.compile_c,
+    )
+
+
+def build_model(problem: TrajectoryProblem, backend: StageBackend | None = None) -> ProntoModel:
     """Discretise a problem (RK4 map, stage cost, constraints, terminal cost).
 
     Parameters
     ----------
     problem : TrajectoryProblem
         The problem.
-    n_threads : int, optional
-        Threads for the batched stage evaluations (1 = serial).
-    compile_c : bool, optional
-        Compile the stage functions to C (cached on disk; see :func:`discretize_rk4`).
+    backend : StageBackend, optional
+        How to evaluate the step (default: kernels for separable problems, else CasADi).
 
     Returns
     -------
     ProntoModel
         Batched evaluators (built anew; see :class:`ModelCache` to reuse them).
     """
-    discrete = discretize_rk4(
-        problem.dynamics,
-        problem.running_cost,
-        problem.dt,
-        n_substeps=problem.n_substeps,
-        parallelization="thread" if n_threads > 1 else "serial",
-        n_threads=n_threads,
-        compile_c=compile_c,
-    )
+    discrete = _discrete_model(problem, StageBackend() if backend is None else backend)
     terminal = make_terminal_cost(problem.terminal_cost, problem.n_states)
     constraints = None
     scales: list[float] = []
@@ -128,18 +143,17 @@ class ModelCache:
     """
 
     max_entries: int = 16
-    _entries: list[tuple[TrajectoryProblem, int, bool, ProntoModel]] = field(
+    _entries: list[tuple[TrajectoryProblem, StageBackend, ProntoModel]] = field(
         default_factory=list, repr=False
     )
 
-    def get(
-        self, problem: TrajectoryProblem, *, n_threads: int = 1, compile_c: bool = False
-    ) -> ProntoModel:
-        """The model of ``problem`` for these options, built by :func:`build_model` if new."""
-        for cached, threads, compiled, model in self._entries:
-            if cached is problem and threads == n_threads and compiled == compile_c:
+    def get(self, problem: TrajectoryProblem, backend: StageBackend | None = None) -> ProntoModel:
+        """The model of ``problem`` for this backend, built by :func:`build_model` if new."""
+        backend = StageBackend() if backend is None else backend
+        for cached, cached_backend, model in self._entries:
+            if cached is problem and cached_backend == backend:
                 return model
-        model = build_model(problem, n_threads=n_threads, compile_c=compile_c)
-        self._entries.append((problem, n_threads, compile_c, model))
+        model = build_model(problem, backend)
+        self._entries.append((problem, backend, model))
         del self._entries[: -self.max_entries]
         return model

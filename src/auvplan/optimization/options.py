@@ -8,7 +8,7 @@ from typing import Literal, TypeVar
 
 from auvplan.errors import InputError
 
-__all__ = ["FallbackModel", "ProntoOptions", "TerminalRegulator", "named_choice"]
+__all__ = ["FallbackModel", "ProntoOptions", "StageBackend", "TerminalRegulator", "named_choice"]
 
 _Choice = TypeVar("_Choice", bound=enum.StrEnum)
 
@@ -47,6 +47,19 @@ def named_choice(choice_type: type[_Choice], value: str, name: str) -> _Choice:
 
 
 @dataclass(frozen=True)
+class StageBackend:
+    """How the stage model is evaluated (see :class:`~auvplan.optimization.ProntoOptions`).
+
+    ``stage_kernels``: compiled per-block kernels when the problem is separable;
+    ``compile_c``: C-compiled CasADi functions otherwise; ``n_threads``: CasADi map threads.
+    """
+
+    stage_kernels: bool = True
+    compile_c: bool = False
+    n_threads: int = 1
+
+
+@dataclass(frozen=True)
 class ProntoOptions:
     """Options of :func:`~auvplan.optimization.pronto.solve_pronto`.
 
@@ -82,9 +95,13 @@ class ProntoOptions:
         back to ``Q_r`` when it fails), or ``Q_r``. Strings are converted to the enum.
     n_threads : int
         Threads for the batched stage evaluations (CasADi ``map(N, "thread", n)``); 1 = serial.
+    stage_kernels : bool
+        Evaluate a separable problem (``TrajectoryProblem.blocks``) with compiled per-block
+        kernels (numba; compiled once per vehicle model and cached on disk, 10–25x faster
+        than CasADi's virtual machine); False evaluates the stacked CasADi functions.
     compile_c : bool
-        Evaluate C-compiled stage functions (compiled once per model and cached on disk;
-        about 10x faster Hessians; needs a C compiler, else the CasADi VM is used).
+        Without stage kernels: evaluate C-compiled CasADi stage functions (compiled once per
+        model and cached on disk; needs a C compiler, else the CasADi VM is used).
     fallback_model : FallbackModel or {"newton", "cost"}
         Which weights the convexified fallback clips: the exact Newton weights (default; no
         extra evaluation) or the cost Hessians only (quasi-Newton, one more Hessian pass).
@@ -106,6 +123,7 @@ class ProntoOptions:
     eigenvalue_floor: float = 1e-2
     terminal_regulator: TerminalRegulator | Literal["dare", "weight"] = TerminalRegulator.DARE
     n_threads: int = 1
+    stage_kernels: bool = True
     compile_c: bool = False
     fallback_model: FallbackModel | Literal["newton", "cost"] = FallbackModel.NEWTON
 
@@ -135,6 +153,11 @@ class ProntoOptions:
         fallback = named_choice(FallbackModel, self.fallback_model, "ProntoOptions.fallback_model")
         object.__setattr__(self, "terminal_regulator", terminal)
         object.__setattr__(self, "fallback_model", fallback)
+
+    @property
+    def backend(self) -> StageBackend:
+        """How the stage model is evaluated (``stage_kernels``, ``compile_c``, ``n_threads``)."""
+        return StageBackend(self.stage_kernels, self.compile_c, self.n_threads)
 
     def epsilon_levels(self) -> tuple[float, ...]:
         """The barrier weights visited by the continuation, largest first."""

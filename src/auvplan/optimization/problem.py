@@ -30,6 +30,7 @@ from auvplan.errors import InputError
 from auvplan.optimization.barrier import BarrierKind
 from auvplan.optimization.integration import check_substeps
 from auvplan.optimization.options import named_choice
+from auvplan.optimization.separable import StageBlock, check_tiling
 
 __all__ = ["PathConstraint", "Trajectory", "TrajectoryProblem"]
 
@@ -124,6 +125,11 @@ class TrajectoryProblem:
         (0: unchanged). A model whose input authority vanishes at rest (thrust ∝ n|n| has
         ``∂T/∂n = 0`` at ``n = 0``) stays controllable in the design; the Newton model keeps the
         exact linearisation. Default: the exact linearisation.
+    blocks : tuple of StageBlock
+        The separable structure of ``dynamics`` and ``running_cost`` when they were stacked
+        from independent subsystems by :func:`~auvplan.optimization.separable.stack_blocks`:
+        the solver then evaluates the step with compiled per-block kernels. Default: none
+        (the stacked functions are evaluated by CasADi).
     """
 
     dynamics: ca.Function
@@ -138,6 +144,7 @@ class TrajectoryProblem:
     regulator_R: FloatArray | None = field(default=None)
     n_substeps: int = 1
     regulator_floor: FloatArray | None = None
+    blocks: tuple[StageBlock, ...] = ()
 
     def __post_init__(self) -> None:
         for name in ("dynamics", "running_cost", "terminal_cost"):
@@ -176,6 +183,9 @@ class TrajectoryProblem:
             if floor.shape != (n_x,) or not np.all(np.isfinite(floor)) or np.any(floor < 0):
                 raise InputError(f"regulator_floor must be finite, >= 0, with shape ({n_x},)")
             object.__setattr__(self, "regulator_floor", floor)
+        object.__setattr__(self, "blocks", tuple(self.blocks))
+        if self.blocks:
+            check_tiling(self.blocks, (n_x, n_u, n_p))
         object.__setattr__(self, "constraints", tuple(self.constraints))
         for constraint in self.constraints:
             if not isinstance(constraint, PathConstraint):

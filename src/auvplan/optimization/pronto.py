@@ -244,7 +244,7 @@ def solve_pronto(
     check_guess(problem, guess)
     start = time.perf_counter()
     cache = cache if cache is not None else ModelCache(max_entries=1)
-    model = cache.get(problem, n_threads=options.n_threads, compile_c=options.compile_c)
+    model = cache.get(problem, options.backend)
     trajectory, gains = project_guess(model, guess, options)
     state = _State(trajectory, gains, options.delta_initial)
     status, message, epsilon = _continuation(model, state, options, start, callback)

@@ -1,0 +1,380 @@
+r"""Compiled kernels of one block's continuous model, stepped by RK4; built once per model.
+
+For a block ``ẋ = f(x, u, p)`` with running-cost rate ``l(x, u, p, w)`` (``w``: runtime
+weights) three kernels are generated, with no mission quantity baked in:
+
+- ``value(y, u, p, w) -> (f, l)``;
+- ``first(y, u, p, w) -> (f, l, J, g)`` with ``J = ∂f/∂(y, u)`` (row-major) and
+  ``g = ∇_{(y,u)} l``;
+- ``hessian(y, u, p, w, λ, ν) -> ∇²_{(y,u)} (ν l + λᵀ f)`` (row-major).
+
+They are translated to numba (:mod:`~auvplan.optimization._numba_codegen`) and cached on
+disk (:mod:`~auvplan.optimization._kernel_cache`) under a key made of the serialised ``f``
+and ``l``: the first mission with a model pays the compilation (seconds, logged), every
+later one, in any process, loads it. :class:`BlockKernels` integrates whole control
+intervals of ``m`` RK4 substeps of length ``h`` (zero-order hold, the cost as a quadrature
+state; :mod:`~auvplan.optimization.integration`) and differentiates them exactly to second
+order through the ``4m`` model evaluations (:mod:`~auvplan.optimization._chain`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+from typing import Final
+
+import casadi as ca
+import numpy as np
+
+from auvplan._typing import FloatArray
+from auvplan.optimization import _chain
+from auvplan.optimization._casadi import row_major
+from auvplan.optimization._kernel_cache import load_kernel_module, mark_compiled
+from auvplan.optimization._numba_codegen import (
+    GENERATOR_VERSION,
+    UnsupportedOperation,
+    numba_source,
+)
+
+__all__ = ["BlockKernels", "block_kernels"]
+
+logger = logging.getLogger(__name__)
+
+#: RK4 node offsets ``a_i`` (``Y_i = y + h a_i K_{i-1}``) and quadrature weights ``b_i``.
+RK4_OFFSETS: Final = (0.0, 0.5, 0.5, 1.0)
+RK4_WEIGHTS: Final = (1.0 / 6.0, 2.0 / 6.0, 2.0 / 6.0, 1.0 / 6.0)
+#: Largest Hessian kernel translated (SX instructions); larger models stay in CasADi, whose
+#: virtual machine starts at once, because numba's compile time grows with the code size.
+MAX_KERNEL_INSTRUCTIONS: Final = 12_000
+#: Points evaluated per chunk (bounds the memory of the stored node derivatives).
+CHUNK: Final = 8192
+
+#: Closed-loop RK4 simulation appended to every kernel module: it calls the ``value`` kernel
+#: in a sequential loop, and numba caches a function only together with the kernels it calls
+#: as globals of its own module.
+_CLOSED_LOOP_SOURCE: Final = """
+@numba.njit(cache=True, error_model='numpy')
+def closed_loop_batch(x0, alpha, mu, gains, p, w, h, n_sub, path, inputs):
+    n_points, n_stages, n_x = alpha.shape
+    n_u = mu.shape[2]
+    z = np.empty(n_x)
+    y = np.empty(n_x)
+    rates = np.empty((4, n_x))
+    q = np.empty(1)
+    for b in range(n_points):
+        z[:] = x0[b]
+        path[b, 0] = z
+        for k in range(n_stages):
+            for i in range(n_u):
+                s = mu[b, k, i]
+                for j in range(n_x):
+                    s += gains[b, k, i, j] * (alpha[b, k, j] - z[j])
+                inputs[b, k, i] = s
+            for j in range(n_sub):
+                value(z, inputs[b, k], p[b, k], w[b], rates[0], q)
+                for t in range(n_x):
+                    y[t] = z[t] + 0.5 * h * rates[0, t]
+                value(y, inputs[b, k], p[b, k], w[b], rates[1], q)
+                for t in range(n_x):
+                    y[t] = z[t] + 0.5 * h * rates[1, t]
+                value(y, inputs[b, k], p[b, k], w[b], rates[2], q)
+                for t in range(n_x):
+                    y[t] = z[t] + h * rates[2, t]
+                value(y, inputs[b, k], p[b, k], w[b], rates[3], q)
+                for t in range(n_x):
+                    s = rates[0, t] + 2.0 * (rates[1, t] + rates[2, t]) + rates[3, t]
+                    z[t] += h / 6.0 * s
+                path[b, k * n_sub + j + 1] = z
+"""
+_BUILT: dict[tuple[str, Path | None], BlockKernels] = {}
+
+
+def _symbolic_kernels(dynamics: ca.Function, running_cost: ca.Function) -> dict[str, ca.Function]:
+    """The three kernel Functions (module docstring) on SX symbols."""
+    n_x, n_u, n_p = (int(dynamics.numel_in(i)) for i in range(3))
+    y, u, p = ca.SX.sym("y", n_x), ca.SX.sym("u", n_u), ca.SX.sym("p", n_p)
+    w, lam, nu = (
+        ca.SX.sym("w", int(running_cost.numel_in(3))),
+        ca.SX.sym("lam", n_x),
+        ca.SX.sym("nu"),
+    )
+    rate, cost = dynamics(y, u, p), running_cost(y, u, p, w)
+    yu = ca.vertcat(y, u)
+    hessian, _ = ca.hessian(nu * cost + ca.dot(lam, rate), yu)
+
+    def dense(name: str, args: list[ca.SX], outputs: list[ca.SX]) -> ca.Function:
+        return ca.Function(name, args, ca.cse([ca.densify(out) for out in outputs]))
+
+    return {
+        "value": dense("model_value", [y, u, p, w], [rate, cost]),
+        "first": dense(
+            "model_first",
+            [y, u, p, w],
+            [rate, cost, row_major(ca.jacobian(rate, yu)), ca.gradient(cost, yu)],
+        ),
+        "hessian": dense("model_hessian", [y, u, p, w, lam, nu], [row_major(hessian)]),
+    }
+
+
+def _chunks(n_points: int) -> Iterator[slice]:
+    for start in range(0, n_points, CHUNK):
+        yield slice(start, min(start + CHUNK, n_points))
+
+
+@dataclass(frozen=True)
+class _Forward:
+    """Node data of a forward sweep: points ``Y_n``, their derivatives ``D_n``, ``J_n``, ``g_n``."""
+
+    points: list[FloatArray]
+    carried: list[FloatArray]
+    jac: list[FloatArray]
+    grad: list[FloatArray]
+    step_jac: FloatArray
+    cost: FloatArray
+    cost_grad: FloatArray
+
+
+@dataclass(frozen=True, eq=False)
+class BlockKernels:
+    """The compiled kernels of one block model and its RK4 steps.
+
+    Every method takes points on axis 0: ``x (B, n_x)``, ``u (B, n_u)``, ``p (B, n_p)``,
+    weights ``w (B, n_w)``; ``h`` is the substep length [s] and ``n_substeps`` the substeps
+    per step.
+    """
+
+    module: ModuleType
+    n_x: int
+    n_u: int
+    n_p: int
+    n_w: int
+
+    def step(
+        self, x: FloatArray, u: FloatArray, p: FloatArray, w: FloatArray, h: float, n_substeps: int
+    ) -> tuple[FloatArray, FloatArray]:
+        """``F (B, n_x)`` and ``L (B,)`` of one control interval."""
+        n_points = x.shape[0]
+        cost = np.zeros(n_points)
+        rate, increment = np.empty((n_points, self.n_x)), np.empty((n_points, 1))
+        for _ in range(n_substeps):
+            y, advanced = x, x.copy()
+            for i in range(4):
+                self.module.value_batch(np.ascontiguousarray(y), u, p, w, rate, increment)
+                advanced += h * RK4_WEIGHTS[i] * rate
+                cost += h * RK4_WEIGHTS[i] * increment[:, 0]
+                if i < 3:
+                    y = x + h * RK4_OFFSETS[i + 1] * rate
+            x = advanced
+        return x, cost
+
+    def _forward(
+        self, x: FloatArray, u: FloatArray, p: FloatArray, w: FloatArray, h: float, n_substeps: int
+    ) -> _Forward:
+        """Forward sweep through the ``4m`` nodes with first-order derivatives."""
+        n_points, n_x, n_z = x.shape[0], self.n_x, self.n_x + self.n_u
+        nodes: tuple[list[FloatArray], list[FloatArray], list[FloatArray], list[FloatArray]] = (
+            [],
+            [],
+            [],
+            [],
+        )
+        cost, cost_grad = np.zeros(n_points), np.zeros((n_points, n_z))
+        y = np.ascontiguousarray(x)
+        dy = np.zeros((n_points, n_x, n_z))
+        dy[:, np.arange(n_x), np.arange(n_x)] = 1.0
+        rate, increment = np.empty((n_points, n_x)), np.empty((n_points, 1))
+        for _ in range(n_substeps):
+            point, carried = y, dy
+            advanced, advanced_d = y.copy(), dy.copy()
+            for i in range(4):
+                jac, grad = np.empty((n_points, n_x, n_z)), np.empty((n_points, n_z))
+                self.module.first_batch(
+                    point, u, p, w, rate, increment, jac.reshape(n_points, -1), grad
+                )
+                for store, value in zip(nodes, (point, carried, jac, grad), strict=True):
+                    store.append(value)
+                factor = h * RK4_WEIGHTS[i]
+                offset = h * RK4_OFFSETS[i + 1] if i < 3 else 0.0
+                cost += factor * increment[:, 0]
+                advanced += factor * rate
+                carried = np.empty_like(dy)
+                _chain.advance_node(
+                    jac, grad, nodes[1][-1], dy, advanced_d, cost_grad, factor, offset, carried
+                )
+                point = y + offset * rate
+            y, dy = advanced, advanced_d
+        return _Forward(*nodes, dy, cost, cost_grad)
+
+    def first_order(
+        self, x: FloatArray, u: FloatArray, p: FloatArray, w: FloatArray, h: float, n_substeps: int
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``∂F/∂(x, u) (B, n_x, n_z)``, ``L (B,)`` and ``∇_{(x,u)} L (B, n_z)``."""
+        n_z = self.n_x + self.n_u
+        step_jac = np.empty((x.shape[0], self.n_x, n_z))
+        cost, cost_grad = np.empty(x.shape[0]), np.empty((x.shape[0], n_z))
+        for rows in _chunks(x.shape[0]):
+            forward = self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps)
+            step_jac[rows], cost[rows], cost_grad[rows] = (
+                forward.step_jac, forward.cost, forward.cost_grad,
+            )  # fmt: skip
+        return step_jac, cost, cost_grad
+
+    def hessian(
+        self,
+        x: FloatArray,
+        u: FloatArray,
+        p: FloatArray,
+        w: FloatArray,
+        h: float,
+        n_substeps: int,
+        costate: FloatArray,
+        cost_weight: float = 1.0,
+    ) -> FloatArray:
+        """``∇²_{(x,u)} (ν L + λᵀ F)`` of shape ``(B, n_z, n_z)`` (``λ = costate``, ``ν``)."""
+        n_z = self.n_x + self.n_u
+        total = np.zeros((x.shape[0], n_z, n_z))
+        for rows in _chunks(x.shape[0]):
+            forward = self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps)
+            self._reverse(forward, u[rows], p[rows], w[rows], h, costate[rows], cost_weight,
+                          total[rows])  # fmt: skip
+        return total
+
+    def _reverse(
+        self,
+        forward: _Forward,
+        u: FloatArray,
+        p: FloatArray,
+        w: FloatArray,
+        h: float,
+        costate: FloatArray,
+        cost_weight: float,
+        total: FloatArray,
+    ) -> None:
+        """Reverse sweep: node adjoints ``K̄`` and the node Hessians added into ``total``."""
+        n_points, n_z = u.shape[0], self.n_x + self.n_u
+        local = np.empty((n_points, n_z * n_z))
+        y_bar = np.ascontiguousarray(costate)
+        for j in range(len(forward.points) // 4 - 1, -1, -1):
+            start_bar = y_bar.copy()
+            point_bar = None
+            for i in range(3, -1, -1):
+                n = 4 * j + i
+                k_bar = h * RK4_WEIGHTS[i] * y_bar
+                if point_bar is not None:
+                    k_bar = k_bar + h * RK4_OFFSETS[i + 1] * point_bar
+                node_weight = cost_weight * h * RK4_WEIGHTS[i]
+                self.module.hessian_batch(
+                    forward.points[n], u, p, w, k_bar, np.full((n_points, 1), node_weight), local
+                )
+                _chain.add_hessian(total, local.reshape(n_points, n_z, n_z), forward.carried[n])
+                point_bar = _chain.node_adjoint(k_bar, forward.jac[n], forward.grad[n], node_weight)
+                start_bar += point_bar
+            y_bar = start_bar
+
+    def closed_loop(
+        self,
+        x0: FloatArray,
+        reference_states: FloatArray,
+        reference_inputs: FloatArray,
+        gains: FloatArray,
+        p: FloatArray,
+        w: FloatArray,
+        h: float,
+        n_substeps: int,
+    ) -> tuple[FloatArray, FloatArray]:
+        """Independent closed-loop simulations ``u_k = μ_k + K_k (α_k − x_k)`` (held over a step).
+
+        Parameters
+        ----------
+        x0 : ndarray of shape (B, n_x)
+            Initial states.
+        reference_states, reference_inputs : ndarray of shape (B, N, n_x), (B, N, n_u)
+            ``α_k`` and ``μ_k``.
+        gains : ndarray of shape (B, N, n_u, n_x)
+            ``K_k``.
+        p : ndarray of shape (B, N, n_p)
+            Stage parameters.
+        w : ndarray of shape (B, n_w)
+            Weights.
+        h : float
+            Substep length [s].
+        n_substeps : int
+            Substeps per stage.
+
+        Returns
+        -------
+        path : ndarray of shape (B, N · n_substeps + 1, n_x)
+            The state after every substep (every ``n_substeps``-th is a stage state).
+        inputs : ndarray of shape (B, N, n_u)
+            The inputs applied.
+        """
+        n_points, n_stages = reference_inputs.shape[:2]
+        path = np.empty((n_points, n_stages * n_substeps + 1, self.n_x))
+        inputs = np.empty((n_points, n_stages, self.n_u))
+        arrays = [np.ascontiguousarray(a) for a in (x0, reference_states, reference_inputs, gains)]
+        self.module.closed_loop_batch(
+            *arrays, np.ascontiguousarray(p), np.ascontiguousarray(w), h, n_substeps, path, inputs
+        )
+        return path, inputs
+
+
+def _warm_up(kernels: BlockKernels) -> None:
+    """Call every kernel once: compiles it (new model) or loads its machine code."""
+    z, u = np.zeros((1, kernels.n_x)), np.zeros((1, kernels.n_u))
+    p, w = np.zeros((1, kernels.n_p)), np.zeros((1, kernels.n_w))
+    kernels.step(z, u, p, w, 0.1, 1)
+    kernels.hessian(z, u, p, w, 0.1, 1, np.zeros((1, kernels.n_x)))
+    gains = np.zeros((1, 1, kernels.n_u, kernels.n_x))
+    kernels.closed_loop(z, z[:, None], u[:, None], gains, p[:, None], w, 0.1, 1)
+
+
+def block_kernels(
+    dynamics: ca.Function, running_cost: ca.Function, cache_dir: Path | None = None
+) -> BlockKernels:
+    """The compiled kernels of ``f(x, u, p)`` and ``l(x, u, p, w)`` (module notes).
+
+    Raises
+    ------
+    UnsupportedOperation
+        If the model uses an operation the translator does not know, or its Hessian kernel
+        exceeds :data:`MAX_KERNEL_INSTRUCTIONS` (evaluate it with CasADi then).
+    """
+    key = "\n".join(
+        [
+            str(GENERATOR_VERSION),
+            _CLOSED_LOOP_SOURCE,
+            dynamics.serialize(),
+            running_cost.serialize(),
+        ]
+    )
+    memo = (hashlib.sha256(key.encode("utf-8")).hexdigest(), cache_dir)
+    built = _BUILT.get(memo)
+    if built is not None:
+        return built
+
+    def source() -> str:
+        functions = _symbolic_kernels(dynamics, running_cost)
+        size = functions["hessian"].n_instructions()
+        if size > MAX_KERNEL_INSTRUCTIONS:
+            raise UnsupportedOperation(
+                f"the model's Hessian has {size} instructions (> {MAX_KERNEL_INSTRUCTIONS})"
+            )
+        return numba_source(functions, f"model kernels {memo[0][:24]}", _CLOSED_LOOP_SOURCE)
+
+    module, is_new = load_kernel_module(key, source, cache_dir)
+    n_x, n_u, n_p = (int(dynamics.numel_in(i)) for i in range(3))
+    kernels = BlockKernels(module, n_x, n_u, n_p, int(running_cost.numel_in(3)))
+    started = time.perf_counter()
+    if is_new:
+        logger.info("compiling the stage kernels of a new vehicle model (once)")
+    _warm_up(kernels)
+    mark_compiled(module)
+    if is_new:
+        logger.info("stage kernels compiled in %.0f s", time.perf_counter() - started)
+    _BUILT[memo] = kernels
+    return kernels
