@@ -55,21 +55,27 @@ def advance_node(
     rate_d = np.empty((n_x, n_z))
     for b in range(n_points):
         jb, db, gb = jac[b], carried[b], grad[b]
+        for r in range(n_x):  # rate_d = J D̃ (i-k-j order: the inner loop runs along rows)
+            for c in range(n_x):
+                rate_d[r, c] = 0.0
+            for c in range(n_x, n_z):
+                rate_d[r, c] = jb[r, c]
+            for k in range(n_x):
+                a = jb[r, k]
+                for c in range(n_z):
+                    rate_d[r, c] += a * db[k, c]
+        cg = cost_grad[b]
+        for c in range(n_x, n_z):
+            cg[c] += factor * gb[c]
+        for r in range(n_x):
+            a = factor * gb[r]
+            for c in range(n_z):
+                cg[c] += a * db[r, c]
+        sj, st, nc = step_jac[b], start[b], next_carried[b]
         for r in range(n_x):
             for c in range(n_z):
-                s = jb[r, c] if c >= n_x else 0.0
-                for k in range(n_x):
-                    s += jb[r, k] * db[k, c]
-                rate_d[r, c] = s
-        for c in range(n_z):
-            s = gb[c] if c >= n_x else 0.0
-            for r in range(n_x):
-                s += gb[r] * db[r, c]
-            cost_grad[b, c] += factor * s
-        for r in range(n_x):
-            for c in range(n_z):
-                step_jac[b, r, c] += factor * rate_d[r, c]
-                next_carried[b, r, c] = start[b, r, c] + offset * rate_d[r, c]
+                sj[r, c] += factor * rate_d[r, c]
+                nc[r, c] = st[r, c] + offset * rate_d[r, c]
 
 
 @numba.njit(cache=True, fastmath=True)
@@ -79,18 +85,23 @@ def add_hessian(total: FloatArray, local: FloatArray, carried: FloatArray) -> No
     right = np.empty((n_z, n_z))
     for b in range(n_points):
         e, h, t = carried[b], local[b], total[b]
-        for r in range(n_z):  # right = local D̃
+        for r in range(n_z):  # right = local D̃ (i-k-j order)
+            for c in range(n_x):
+                right[r, c] = 0.0
+            for c in range(n_x, n_z):
+                right[r, c] = h[r, c]
+            for k in range(n_x):
+                a = h[r, k]
+                for c in range(n_z):
+                    right[r, c] += a * e[k, c]
+        for r in range(n_x, n_z):  # total += D̃ᵀ right: the identity rows of D̃ …
             for c in range(n_z):
-                s = h[r, c] if c >= n_x else 0.0
-                for k in range(n_x):
-                    s += h[r, k] * e[k, c]
-                right[r, c] = s
-        for r in range(n_z):  # total += D̃ᵀ right
-            for c in range(n_z):
-                s = right[r, c] if r >= n_x else 0.0
-                for k in range(n_x):
-                    s += e[k, r] * right[k, c]
-                t[r, c] += s
+                t[r, c] += right[r, c]
+        for k in range(n_x):  # … and the rows of D
+            for r in range(n_z):
+                a = e[k, r]
+                for c in range(n_z):
+                    t[r, c] += a * right[k, c]
 
 
 @numba.njit(cache=True, fastmath=True)

@@ -1,0 +1,155 @@
+"""Fleet missions for the optimiser benchmarks, and one measurement per process.
+
+A case is a real mission run through the pipeline up to the stage-3 problem (pre-planning and
+deconfliction as ``auvplan plan`` does them): the ``demo`` crossing, or ``fleet-N-T-DT``, N
+MEDUSAs for T seconds at control interval DT on a synthetic bank sized to the mission, half of
+them on northbound lanes and half on eastbound lanes that cross them mid-way. Each
+measurement runs in its own process (``python benchmarks/_fleet.py CASE SOLVER``), so that
+the peak memory is its own and the kernel cache is exactly what ``AUVPLAN_CACHE_DIR`` holds.
+It prints one JSON line.
+"""
+
+from __future__ import annotations
+
+import json
+import resource
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import tomli_w
+
+from auvplan.mission import load_mission
+from auvplan.mission.assembly import AssembledProblem, assemble_problem
+from auvplan.mission.pipeline import fleet_layout
+from auvplan.mission.preplan import run_preplan
+from auvplan.mission.timing import run_deconfliction
+from auvplan.optimization import (
+    ModelCache,
+    ProntoOptions,
+    StageBackend,
+    project_guess,
+    solve_ipopt,
+    solve_pronto,
+)
+from auvplan.scenarios._terrain import write_synthetic_terrain
+from auvplan.terrain import synthetic_bank
+
+DEMO = Path(__file__).resolve().parents[1] / "src/auvplan/data/missions/demo.toml"
+#: Cruise speed of the lane missions [m/s] and the path-length allowance for detours.
+SPEED = 0.45
+DETOUR = 1.2
+#: Lane spacing [m] and terrain margin around the lanes [m].
+LANE = 60.0
+MARGIN = 120.0
+
+
+def lane_mission(n_vehicles: int, horizon: float, dt: float, folder: Path) -> Path:
+    """Write a lane-crossing mission of ``n_vehicles`` and its terrain into ``folder``."""
+    length = SPEED * horizon / DETOUR
+    extent = length + 2 * MARGIN
+    spacing = max(4.0, extent / 300.0)
+    write_synthetic_terrain(
+        synthetic_bank(seed=11, extent_north=extent, extent_east=extent, spacing=spacing),
+        folder / "terrain.nc",
+    )
+    vehicles = []
+    middle = extent / 2
+    for i in range(n_vehicles):
+        lane = middle + LANE * ((i // 2) - (n_vehicles // 2 - 1) / 2)
+        if i % 2 == 0:  # northbound
+            start, goal, heading = (MARGIN, lane), (MARGIN + length, lane), 0.0
+        else:  # eastbound
+            start, goal, heading = (lane, MARGIN), (lane, MARGIN + length), 90.0
+        vehicles.append(
+            {
+                "name": f"v{i}",
+                "type": "medusa",
+                "start": {"north": start[0], "east": start[1], "heading_deg": heading,
+                          "speed": SPEED},
+                "goal": {"north": goal[0], "east": goal[1], "heading_deg": heading},
+            }
+        )  # fmt: skip
+    mission = {
+        "terrain": {"file": "terrain.nc"},
+        "maps": {"block": [2, 2]},
+        "fleet": {"horizon_s": horizon, "safety_radius_m": 5.0},
+        "vehicle": vehicles,
+        "solver": {"dt_s": dt},
+    }
+    path = folder / "mission.toml"
+    path.write_text(tomli_w.dumps(mission), encoding="utf-8")
+    return path
+
+
+def build_case(name: str, folder: Path) -> tuple[AssembledProblem, ProntoOptions]:
+    """The stage-3 problem of a case (``demo`` energy-only, or ``fleet-N-T-DT``)."""
+    if name == "demo":
+        config, terrain_weight = load_mission(DEMO), 0.0
+    else:
+        _, n, horizon, dt = name.split("-")
+        path = lane_mission(int(n), float(horizon), float(dt), folder)
+        config = load_mission(path)
+        terrain_weight = config.weights.terrain
+    preplan = run_preplan(config)
+    layout = fleet_layout(config)
+    deconfliction = run_deconfliction(
+        layout, preplan.paths, preplan.starts[:, 2], fleet=config.fleet,
+        settings=config.deconfliction, dt=config.solver.dt,
+    )  # fmt: skip
+    assembled = assemble_problem(
+        layout, preplan, deconfliction, weights=config.weights, terrain_weight=terrain_weight,
+        safety_radius=config.fleet.safety_radius, comms=config.comms,
+    )  # fmt: skip
+    return assembled, config.solver.pronto_options()
+
+
+def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, Any]:
+    """Solve ``case`` with ``solver`` (``kernels``, ``casadi`` or ``ipopt``) and time it.
+
+    ``kernels``/``casadi``: PRONTO with/without the compiled stage kernels; the time includes
+    building the model (loading or compiling kernels). ``ipopt``: CasADi + IPOPT on the same
+    discretised problem from PRONTO's projected initial trajectory, hard constraints.
+    ``max_iter`` caps PRONTO's iterations (for per-iteration timing).
+    """
+    with tempfile.TemporaryDirectory() as scratch:
+        assembled, options = build_case(case, Path(scratch))
+    problem, guess = assembled.problem, assembled.guess
+    if max_iter is not None:
+        options = ProntoOptions(**{**options.__dict__, "max_iter": max_iter})
+    record: dict[str, Any] = {
+        "case": case, "solver": solver, "n_x": problem.n_states, "n_steps": problem.n_steps,
+        "n_substeps": problem.n_substeps,
+    }  # fmt: skip
+    started = time.perf_counter()
+    if solver == "ipopt":
+        initial, _ = project_guess(ModelCache().get(problem), guess, options)
+        started = time.perf_counter()
+        result = solve_ipopt(problem, initial)
+        record.update(status=str(result.status), iterations=result.n_iter, cost=result.cost)
+    else:
+        backend = StageBackend(stage_kernels=solver == "kernels")
+        options = ProntoOptions(**{**options.__dict__, "stage_kernels": backend.stage_kernels})
+        cache = ModelCache()
+        cache.get(problem, backend)
+        record["model_s"] = time.perf_counter() - started
+        outcome = solve_pronto(problem, guess, options=options, cache=cache)
+        stamps = np.array([0.0, *[it.wall_time for it in outcome.history]])
+        record.update(
+            status=outcome.status.name,
+            iterations=outcome.n_iter,
+            cost=outcome.cost,
+            objective=outcome.running_cost + outcome.terminal_cost,
+            iteration_s=float(np.median(np.diff(stamps))) if outcome.history else None,
+        )
+    record["wall_s"] = time.perf_counter() - started
+    record["peak_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return record
+
+
+if __name__ == "__main__":
+    cap = int(sys.argv[3]) if len(sys.argv) > 3 else None
+    print(json.dumps(measure(sys.argv[1], sys.argv[2], cap)), flush=True)
