@@ -5,8 +5,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import casadi as ca
+import numba
+import numpy as np
 
-from auvplan._typing import FloatArray
+from auvplan._typing import FloatArray, IntArray
 from auvplan.errors import InputError
 from auvplan.optimization._casadi import (
     StageEvaluator,
@@ -40,6 +42,10 @@ class ConstraintModel:
     function: ca.Function
     _jacobians: ca.Function = field(repr=False)
     _hessian: ca.Function = field(repr=False)
+    row_start: IntArray = field(repr=False)
+    """Row ``j`` of ``∂c/∂(x, u)`` has its structural nonzeros in
+    ``columns[row_start[j]:row_start[j + 1]]`` (compressed rows)."""
+    columns: IntArray = field(repr=False)
     _stages: StageEvaluator = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -81,6 +87,51 @@ class ConstraintModel:
         )
         return h_xx, h_xu, h_uu
 
+    def add_outer_products(
+        self,
+        weights: FloatArray,
+        c_x: FloatArray,
+        c_u: FloatArray,
+        blocks: tuple[FloatArray, FloatArray, FloatArray],
+    ) -> None:
+        """Add ``Σ_j w_{k,j} ∇c_j ∇c_jᵀ`` to the blocks ``(H_xx, H_xu, H_uu)`` in place.
+
+        Only the structural nonzeros of each gradient are visited (a separation touches four
+        states of a fleet), so the cost does not grow with ``n_x²``.
+        """
+        _add_outer_products(weights, c_x, c_u, self.row_start, self.columns, *blocks)
+
+
+@numba.njit(cache=True)
+def _add_outer_products(
+    weights: FloatArray,
+    c_x: FloatArray,
+    c_u: FloatArray,
+    row_start: IntArray,
+    columns: IntArray,
+    h_xx: FloatArray,
+    h_xu: FloatArray,
+    h_uu: FloatArray,
+) -> None:
+    n_stages, n_c, n_x = c_x.shape
+    for k in range(n_stages):
+        for j in range(n_c):
+            w = weights[k, j]
+            if w == 0.0:
+                continue
+            for a in range(row_start[j], row_start[j + 1]):
+                col_a = columns[a]
+                g_a = w * (c_x[k, j, col_a] if col_a < n_x else c_u[k, j, col_a - n_x])
+                for b in range(row_start[j], row_start[j + 1]):
+                    col_b = columns[b]
+                    g_b = c_x[k, j, col_b] if col_b < n_x else c_u[k, j, col_b - n_x]
+                    if col_a < n_x and col_b < n_x:
+                        h_xx[k, col_a, col_b] += g_a * g_b
+                    elif col_a < n_x:
+                        h_xu[k, col_a, col_b - n_x] += g_a * g_b
+                    elif col_b >= n_x:
+                        h_uu[k, col_a - n_x, col_b - n_x] += g_a * g_b
+
 
 def discretize_constraints(
     functions: tuple[ca.Function, ...], n_x: int, n_u: int, n_p: int
@@ -117,6 +168,7 @@ def discretize_constraints(
         n_c = int(c.numel())
         weights = kind.sym("w", n_c)
         args = [x, u, p]
+        row_start, columns = ca.jacobian(c, ca.vertcat(x, u)).sparsity().get_crs()
         return ConstraintModel(
             n_x,
             n_u,
@@ -137,6 +189,8 @@ def discretize_constraints(
                 [*_ARGS, "w"],
                 ["h_xx", "h_xu", "h_uu"],
             ),
+            np.asarray(row_start, dtype=np.int64),
+            np.asarray(columns, dtype=np.int64),
         )
 
     return with_symbol_fallback(build)

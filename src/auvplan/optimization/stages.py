@@ -245,11 +245,8 @@ def _with_barrier_hessians(
         h_xx, h_xu, h_uu = model.constraints.weighted_hessians(
             trajectory.states[:-1], trajectory.inputs, model.problem.parameters, lin.barrier_weight
         )
-        outer = lin.barrier_outer
-        h_xx = h_xx + np.einsum("kj,kja,kjb->kab", outer, lin.c_x, lin.c_x)
-        h_xu = h_xu + np.einsum("kj,kja,kjb->kab", outer, lin.c_x, lin.c_u)
-        h_uu = h_uu + np.einsum("kj,kja,kjb->kab", outer, lin.c_u, lin.c_u)
         q, s, r = q + h_xx, s + h_xu, r + h_uu
+        model.constraints.add_outer_products(lin.barrier_outer, lin.c_x, lin.c_u, (q, s, r))
     return StageWeights(q, s, r, lin.m_xx)
 
 
