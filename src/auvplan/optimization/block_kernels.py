@@ -23,7 +23,7 @@ import hashlib
 import logging
 import time
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
 from typing import Final
@@ -153,6 +153,27 @@ class BlockKernels:
     n_u: int
     n_p: int
     n_w: int
+    _last: dict[bytes, list[_Forward]] = field(default_factory=dict, repr=False)
+    """The forward sweeps of the last :meth:`first_order` call, by a digest of its arguments:
+    a Newton step asks for the Hessians at the trajectory it just linearised."""
+
+    def _sweeps(
+        self, x: FloatArray, u: FloatArray, p: FloatArray, w: FloatArray, h: float, n_substeps: int
+    ) -> list[_Forward]:
+        """The forward sweeps of every chunk (reused when the arguments repeat)."""
+        digest = hashlib.blake2b(np.float64(h).tobytes() + bytes([n_substeps % 256]))
+        for array in (x, u, p, w):
+            digest.update(np.ascontiguousarray(array).tobytes())
+        key = digest.digest()
+        sweeps = self._last.get(key)
+        if sweeps is None:
+            sweeps = [
+                self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps)
+                for rows in _chunks(x.shape[0])
+            ]
+            self._last.clear()
+            self._last[key] = sweeps
+        return sweeps
 
     def step(
         self, x: FloatArray, u: FloatArray, p: FloatArray, w: FloatArray, h: float, n_substeps: int
@@ -217,8 +238,8 @@ class BlockKernels:
         n_z = self.n_x + self.n_u
         step_jac = np.empty((x.shape[0], self.n_x, n_z))
         cost, cost_grad = np.empty(x.shape[0]), np.empty((x.shape[0], n_z))
-        for rows in _chunks(x.shape[0]):
-            forward = self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps)
+        sweeps = self._sweeps(x, u, p, w, h, n_substeps)
+        for rows, forward in zip(_chunks(x.shape[0]), sweeps, strict=True):
             step_jac[rows], cost[rows], cost_grad[rows] = (
                 forward.step_jac, forward.cost, forward.cost_grad,
             )  # fmt: skip
@@ -238,8 +259,8 @@ class BlockKernels:
         """``∇²_{(x,u)} (ν L + λᵀ F)`` of shape ``(B, n_z, n_z)`` (``λ = costate``, ``ν``)."""
         n_z = self.n_x + self.n_u
         total = np.zeros((x.shape[0], n_z, n_z))
-        for rows in _chunks(x.shape[0]):
-            forward = self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps)
+        sweeps = self._sweeps(x, u, p, w, h, n_substeps)
+        for rows, forward in zip(_chunks(x.shape[0]), sweeps, strict=True):
             self._reverse(forward, u[rows], p[rows], w[rows], h, costate[rows], cost_weight,
                           total[rows])  # fmt: skip
         return total
