@@ -38,6 +38,7 @@ def kml_document(plan: ExportPlan, fleet: Sequence[Waypoints]) -> str:
     """The KML text of the fleet's timed tracks and the obstacles."""
     import simplekml
 
+    simplekml.Kml.resetidcounter()  # element ids from 0: the same plan gives the same file
     document = simplekml.Kml(name=f"auvplan {__version__} plan, {utc_text(plan.start_time)}")
     for waypoints in fleet:
         track = document.newgxtrack(name=waypoints.name)

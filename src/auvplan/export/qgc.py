@@ -5,12 +5,13 @@ geofence version 2). The mission is for ArduPilot (``firmwareType`` 3 = MAV_AUTO
 on a submarine (``vehicleType`` 12 = MAV_TYPE_SUBMARINE):
 
 * a ``MAV_CMD_NAV_WAYPOINT`` (16) per waypoint, frame 3 (MAV_FRAME_GLOBAL_RELATIVE_ALT), params
-  ``[hold 0 s, acceptance radius, pass radius 0, yaw unchanged (null), lat, lon, altitude]``;
+  ``[hold, acceptance radius, pass radius 0, yaw unchanged (null), lat, lon, altitude]``;
   the altitude is the depth as a negative number, since ArduSub refuses a waypoint above home
   ("Alt above home must be negative");
 * a ``MAV_CMD_DO_CHANGE_SPEED`` (178, frame 2 = MAV_FRAME_MISSION, params
   ``[1 = ground speed, speed, -1 = throttle unchanged, 0, 0, 0, 0]``) before each leg whose
-  speed differs from the previous one, so that the legs keep their durations;
+  speed differs from the previous one, so that the legs keep their durations; a leg slower
+  than :data:`STOP_SPEED` (a wait) is a hold [s] at its first waypoint instead;
 * every obstacle as an exclusion geofence (``inclusion: false``): circles as circles, polygons
   with their vertices in clockwise order, as the format asks.
 """
@@ -34,6 +35,8 @@ FIRMWARE_ARDUPILOT: Final = 3
 VEHICLE_SUBMARINE: Final = 12
 #: Speeds that differ by less than this [m/s] are not repeated as a speed change.
 SPEED_RESOLUTION: Final = 1e-3
+#: Legs slower than this [m/s] are flown as a hold at their first waypoint.
+STOP_SPEED: Final = 0.01
 
 
 def _geofence(plan: ExportPlan) -> dict[str, Any]:
@@ -58,17 +61,20 @@ def _geofence(plan: ExportPlan) -> dict[str, Any]:
 
 
 def mission_items(plan: ExportPlan, waypoints: Waypoints) -> list[dict[str, Any]]:
-    """The mission's simple items: waypoints with speed changes before the legs."""
+    """The mission's simple items: waypoints (holding through waits), speed changes before legs."""
+    speeds = waypoints.leg_speeds
+    is_wait = speeds < STOP_SPEED
+    holds = np.append(np.where(is_wait, waypoints.leg_durations, 0.0), 0.0)
     commands: list[tuple[int, int, list[float | None]]] = []
     speed = None
     for k in range(waypoints.time.size):
-        if k > 0:
-            leg_speed = float(waypoints.leg_speeds[k - 1])
+        if k > 0 and not is_wait[k - 1]:
+            leg_speed = float(speeds[k - 1])
             if speed is None or abs(leg_speed - speed) >= SPEED_RESOLUTION:
                 commands.append((DO_CHANGE_SPEED, FRAME_MISSION, [1, leg_speed, -1, 0, 0, 0, 0]))
                 speed = leg_speed
         position = [float(waypoints.lat[k]), float(waypoints.lon[k]), 0.0 - plan.depth]
-        parameters: list[float | None] = [0, plan.capture_radius, 0, None, *position]
+        parameters: list[float | None] = [float(holds[k]), plan.capture_radius, 0, None, *position]
         commands.append((NAV_WAYPOINT, FRAME_GLOBAL_RELATIVE_ALT, parameters))
     return [
         {
