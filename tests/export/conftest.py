@@ -2,20 +2,26 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
 
 from auvplan.cli.main import main
+from auvplan.export import FORMATS
 from auvplan.export.plan import ExportPlan
+from auvplan.mission.folder import load_export_plan
 
 from ._plans import MISSION, synthetic_plan, write_geographic_grid
 
 
-@pytest.fixture
-def export_plan() -> ExportPlan:
-    """Two vehicles (one with characters XML must escape), a circle and a polygon obstacle."""
-    return synthetic_plan()
+@pytest.fixture(params=["synthetic", pytest.param("monterey", marks=pytest.mark.slow)])
+def export_plan(request: pytest.FixtureRequest) -> ExportPlan:
+    """The synthetic plan (two vehicles, one named with characters XML escapes, a circle and
+    a polygon obstacle) and, in the slow suite, the Monterey example's plan read back."""
+    if request.param == "synthetic":
+        return synthetic_plan()
+    return load_export_plan(request.getfixturevalue("monterey_folder"))
 
 
 @pytest.fixture(scope="session")
@@ -38,4 +44,18 @@ def planned_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
         ]
     )
     assert code == 0
+    return out
+
+
+@pytest.fixture(scope="session")
+def monterey_folder(tmp_path_factory: pytest.TempPathFactory, bathymetry_dir: Path) -> Path:
+    """examples/missions/monterey.toml planned with every export (slow; needs shared data)."""
+    example = Path(__file__).parents[2] / "examples" / "missions" / "monterey.toml"
+    grid = bathymetry_dir / "monterey_canyon_head_ncei_13arcsec.nc"
+    text = re.sub(r'(?m)^file = ".*"$', f"file = {str(grid)!r}", example.read_text())
+    root = tmp_path_factory.mktemp("monterey")
+    (root / "monterey.toml").write_text(text)
+    out = root / "out"
+    arguments = ["-q", "plan", str(root / "monterey.toml"), "-o", str(out), "--no-figures"]
+    assert main([*arguments, "--export", ",".join(FORMATS)]) == 0
     return out

@@ -205,3 +205,15 @@ def test_plan_export_refuses_before_planning(
         capsys,
     )
     assert "--stage preplan" in message
+
+
+@pytest.mark.slow
+def test_monterey_example_exports_everything(monterey_folder: Path, tmp_path: Path) -> None:
+    """The issue's acceptance: the Monterey example's trajectories.nc is CF and every export is
+    written (each is read back by its reader in test_formats' slow variant)."""
+    findings = cf_findings(monterey_folder / "trajectories.nc", tmp_path / "cf.json")
+    assert findings["high"] == [], findings
+    names = {path.name for path in (monterey_folder / "export").iterdir()}
+    for vehicle in ("blue", "green"):
+        assert {f"{vehicle}.bhv", f"{vehicle}.plan", f"{vehicle}.imc.json"} <= names
+    assert {"origin.moos", "trajectories.gpx", "trajectories.kml", "trajectories.geojson"} <= names

@@ -78,13 +78,16 @@ def test_kml_timed_tracks_and_obstacle_outlines(export_plan: ExportPlan) -> None
         for p in root.iter(f"{KML}Placemark")
         if p.find(f".//{KML}Polygon") is not None
     }
-    circle = next(zone for zone in export_plan.zones if isinstance(zone, CircleZone))
-    ring = outlines[circle.name]
-    radius = _distance_m(
-        np.full(len(ring), circle.lat), np.full(len(ring), circle.lon), ring[:, 1], ring[:, 0]
-    )
-    np.testing.assert_allclose(radius, circle.radius, atol=1e-3)
-    assert len(outlines) == len(export_plan.zones)
+    assert sorted(outlines) == sorted(zone.name for zone in export_plan.zones)
+    for zone in export_plan.zones:
+        ring = outlines[zone.name]
+        if isinstance(zone, CircleZone):
+            centre = (np.full(len(ring), zone.lat), np.full(len(ring), zone.lon))
+            radius = _distance_m(*centre, ring[:, 1], ring[:, 0])
+            np.testing.assert_allclose(radius, zone.radius, atol=1e-3)
+        else:
+            np.testing.assert_allclose(ring[:-1, 1], zone.lat)
+            np.testing.assert_allclose(ring[:-1, 0], zone.lon)
 
 
 def test_qgc_plans_for_ardusub(export_plan: ExportPlan) -> None:
@@ -119,14 +122,17 @@ def test_qgc_plans_for_ardusub(export_plan: ExportPlan) -> None:
         np.testing.assert_allclose(arrivals, waypoints.time - waypoints.time[0], atol=0.01)
         fence = document["geoFence"]
         assert not any(zone["inclusion"] for zone in fence["circles"] + fence["polygons"])
-        (circle,) = fence["circles"]
-        assert circle["circle"]["radius"] == 10.0
-        (polygon,) = fence["polygons"]
-        vertices = np.array(polygon["polygon"])  # [lat, lon], clockwise on the map
-        lat, lon = vertices[:, 0], vertices[:, 1]
-        assert np.dot(lon, np.roll(lat, -1)) - np.dot(lat, np.roll(lon, -1)) < 0.0
-        zone = next(z for z in export_plan.zones if isinstance(z, PolygonZone))
-        assert sorted(map(tuple, vertices)) == sorted(zip(zone.lat, zone.lon, strict=True))
+        circles = [zone for zone in export_plan.zones if isinstance(zone, CircleZone)]
+        assert [(c["circle"]["center"], c["circle"]["radius"]) for c in fence["circles"]] == [
+            ([zone.lat, zone.lon], zone.radius) for zone in circles
+        ]
+        polygons = [zone for zone in export_plan.zones if isinstance(zone, PolygonZone)]
+        assert len(fence["polygons"]) == len(polygons)
+        for polygon, zone in zip(fence["polygons"], polygons, strict=True):
+            vertices = np.array(polygon["polygon"])  # [lat, lon], clockwise on the map
+            lat, lon = vertices[:, 0], vertices[:, 1]
+            assert np.dot(lon, np.roll(lat, -1)) - np.dot(lat, np.roll(lon, -1)) < 0.0
+            assert sorted(map(tuple, vertices)) == sorted(zip(zone.lat, zone.lon, strict=True))
 
 
 def test_imc_follow_trajectory_plans(export_plan: ExportPlan) -> None:
@@ -190,11 +196,17 @@ def test_geojson_trajectories(export_plan: ExportPlan) -> None:
 
 
 def test_every_format_renders_its_files(export_plan: ExportPlan) -> None:
-    files = render_exports(export_plan, FORMATS)
-    assert {"origin.moos", "trajectories.gpx", "trajectories.kml", "trajectories.geojson"} <= set(
-        files
-    )
-    assert {"blue.bhv", "blue.plan", "blue.imc.json", "r_d__2_.bhv"} <= set(files)
+    files = set(render_exports(export_plan, FORMATS))
+    stems = file_stems([track.name for track in export_plan.tracks])
+    per_vehicle = {f"{stem}.{suffix}" for stem in stems for suffix in ("bhv", "plan", "imc.json")}
+    shared = {"origin.moos", "trajectories.gpx", "trajectories.kml", "trajectories.geojson"}
+    assert files == per_vehicle | shared
+
+
+def test_file_stems_are_safe_and_unique() -> None:
+    assert file_stems(["blue", "r&d <2>", "r&d_<2>", ".hidden"]) == (
+        "blue", "r_d__2_", "r_d__2_-2", "hidden",
+    )  # fmt: skip
 
 
 @pytest.mark.parametrize("text", ["gpx,shp", "", " , "])
