@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from datetime import datetime, timedelta
 from xml.etree import ElementTree
 
@@ -144,7 +145,7 @@ def test_imc_follow_trajectory_plans(export_plan: ExportPlan) -> None:
         (maneuver,) = document["maneuvers"]
         assert maneuver["maneuver_id"] == document["start_man_id"]
         data = maneuver["data"]
-        lat_0, lon_0 = np.degrees(data["lat"]), np.degrees(data["lon"])
+        lat_0, lon_0 = math.degrees(data["lat"]), math.degrees(data["lon"])
         assert (data["z"], data["z_units"], data["speed_units"]) == (export_plan.depth, 1, 0)
         points = data["points"]
         np.testing.assert_allclose(np.cumsum([p["t"] for p in points]), waypoints.time)

@@ -18,8 +18,8 @@ from typing import Any, Final
 
 import numpy as np
 
-from auvplan.export.plan import ExportPlan, file_stems
-from auvplan.export.waypoints import Waypoints
+from auvplan.export.plan import ExportPlan
+from auvplan.export.waypoints import Waypoints, by_file_stem
 from auvplan.terrain.projection import LocalProjection
 
 Z_UNITS_DEPTH: Final = 1
@@ -80,7 +80,7 @@ def render(plan: ExportPlan, fleet: Sequence[Waypoints]) -> dict[str, str]:
     """``NAME.imc.json`` per vehicle."""
     return {
         f"{stem}.imc.json": json.dumps(plan_specification(plan, waypoints), indent=2) + "\n"
-        for stem, waypoints in zip(file_stems([w.name for w in fleet]), fleet, strict=True)
+        for stem, waypoints in by_file_stem(fleet)
     }
 
 

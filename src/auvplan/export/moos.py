@@ -19,8 +19,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from auvplan import __version__
-from auvplan.export.plan import ExportPlan, file_stems, utc_text
-from auvplan.export.waypoints import Waypoints
+from auvplan.export.plan import ExportPlan, utc_text
+from auvplan.export.waypoints import Waypoints, by_file_stem
 from auvplan.terrain.projection import LocalProjection
 
 #: Slip radius as a multiple of the capture radius.
@@ -35,8 +35,8 @@ def local_xy(plan: ExportPlan, waypoints: Waypoints) -> tuple[np.ndarray, np.nda
     return east, north
 
 
-def behavior_block(plan: ExportPlan, waypoints: Waypoints) -> str:
-    """The ``Behavior = BHV_Waypoint { ... }`` block of one vehicle, with its leg timetable."""
+def behavior_block(plan: ExportPlan, waypoints: Waypoints, *, name: str) -> str:
+    """The ``Behavior = BHV_Waypoint { ... }`` block ``name`` of one vehicle, with its legs."""
     x, y = local_xy(plan, waypoints)
     legs = [
         f"//   leg {k + 1}: {length:.2f} m in {duration:.2f} s at {speed:.3f} m/s "
@@ -61,7 +61,7 @@ def behavior_block(plan: ExportPlan, waypoints: Waypoints) -> str:
             *legs,
             "Behavior = BHV_Waypoint",
             "{",
-            f"  name           = {file_stems([waypoints.name])[0]}_plan",
+            f"  name           = {name}",
             "  pwt            = 100",
             "  condition      = DEPLOY = true",
             f"  speed          = {waypoints.mean_speed:.3f}",
@@ -77,8 +77,8 @@ def behavior_block(plan: ExportPlan, waypoints: Waypoints) -> str:
 def render(plan: ExportPlan, fleet: Sequence[Waypoints]) -> dict[str, str]:
     """``NAME.bhv`` per vehicle and ``origin.moos``."""
     files = {
-        f"{stem}.bhv": behavior_block(plan, waypoints)
-        for stem, waypoints in zip(file_stems([w.name for w in fleet]), fleet, strict=True)
+        f"{stem}.bhv": behavior_block(plan, waypoints, name=f"{stem}_plan")
+        for stem, waypoints in by_file_stem(fleet)
     }
     files["origin.moos"] = (
         f"// auvplan {__version__}: origin of the x (east) / y (north) frame of the .bhv files\n"

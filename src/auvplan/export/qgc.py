@@ -9,8 +9,8 @@ on a submarine (``vehicleType`` 12 = MAV_TYPE_SUBMARINE):
   the altitude is the depth as a negative number, since ArduSub refuses a waypoint above home
   ("Alt above home must be negative");
 * a ``MAV_CMD_DO_CHANGE_SPEED`` (178, frame 2 = MAV_FRAME_MISSION, params
-  ``[1 = ground speed, speed, -1 = throttle unchanged, 0, 0, 0, 0]``) before each leg whose
-  speed differs from the previous one, so that the legs keep their durations; a leg slower
+  ``[1 = ground speed, speed, -1 = throttle unchanged, 0, 0, 0, 0]``) before each leg, so
+  that the legs keep their durations; a leg slower
   than :data:`STOP_SPEED` (a wait) is a hold [s] at its first waypoint instead;
 * every obstacle as an exclusion geofence (``inclusion: false``): circles as circles, polygons
   with their vertices in clockwise order, as the format asks.
@@ -24,8 +24,8 @@ from typing import Any, Final
 
 import numpy as np
 
-from auvplan.export.plan import CircleZone, ExportPlan, PolygonZone, file_stems
-from auvplan.export.waypoints import Waypoints
+from auvplan.export.plan import CircleZone, ExportPlan, PolygonZone
+from auvplan.export.waypoints import Waypoints, by_file_stem
 
 NAV_WAYPOINT: Final = 16
 DO_CHANGE_SPEED: Final = 178
@@ -33,8 +33,6 @@ FRAME_GLOBAL_RELATIVE_ALT: Final = 3
 FRAME_MISSION: Final = 2
 FIRMWARE_ARDUPILOT: Final = 3
 VEHICLE_SUBMARINE: Final = 12
-#: Speeds that differ by less than this [m/s] are not repeated as a speed change.
-SPEED_RESOLUTION: Final = 1e-3
 #: Legs slower than this [m/s] are flown as a hold at their first waypoint.
 STOP_SPEED: Final = 0.01
 
@@ -70,7 +68,7 @@ def mission_items(plan: ExportPlan, waypoints: Waypoints) -> list[dict[str, Any]
     for k in range(waypoints.time.size):
         if k > 0 and not is_wait[k - 1]:
             leg_speed = float(speeds[k - 1])
-            if speed is None or abs(leg_speed - speed) >= SPEED_RESOLUTION:
+            if leg_speed != speed:
                 commands.append((DO_CHANGE_SPEED, FRAME_MISSION, [1, leg_speed, -1, 0, 0, 0, 0]))
                 speed = leg_speed
         position = [float(waypoints.lat[k]), float(waypoints.lon[k]), 0.0 - plan.depth]
@@ -113,7 +111,7 @@ def render(plan: ExportPlan, fleet: Sequence[Waypoints]) -> dict[str, str]:
     """``NAME.plan`` per vehicle."""
     return {
         f"{stem}.plan": json.dumps(plan_document(plan, waypoints), indent=2, allow_nan=False) + "\n"
-        for stem, waypoints in zip(file_stems([w.name for w in fleet]), fleet, strict=True)
+        for stem, waypoints in by_file_stem(fleet)
     }
 
 

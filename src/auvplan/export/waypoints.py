@@ -29,13 +29,14 @@ EDBT 2004 (the synchronised Euclidean distance).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from auvplan._typing import FloatArray, IntArray
 from auvplan.errors import InputError
-from auvplan.export.plan import VehicleTrack
+from auvplan.export.plan import VehicleTrack, file_stems
 
 
 @dataclass(frozen=True)
@@ -162,6 +163,11 @@ def thin_track(track: VehicleTrack, tolerance: float) -> Waypoints:
     )
 
 
+def by_file_stem(fleet: Sequence[Waypoints]) -> list[tuple[str, Waypoints]]:
+    """Each vehicle's waypoints with the stem of its file names (:func:`.file_stems`)."""
+    return list(zip(file_stems([waypoints.name for waypoints in fleet]), fleet, strict=True))
+
+
 def _sample_indices(samples: FloatArray, vertices: FloatArray) -> IntArray:
     """Indices of the simplified line's vertices among the samples (a subsequence of them)."""
     indices = [0]
@@ -174,4 +180,4 @@ def _sample_indices(samples: FloatArray, vertices: FloatArray) -> IntArray:
     return np.unique(np.asarray(indices, dtype=np.intp))
 
 
-__all__ = ["Waypoints", "synchronized_distances", "thin_track"]
+__all__ = ["Waypoints", "by_file_stem", "synchronized_distances", "thin_track"]
