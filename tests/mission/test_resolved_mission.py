@@ -59,6 +59,7 @@ def test_start_time_is_kept_in_utc(text: str, expected: datetime) -> None:
         ('"first of May"', "not an ISO 8601 time"),
         ("1777622400", "ISO 8601"),  # no Unix seconds
         ("2026-05-01", "ISO 8601"),  # a date alone
+        ("9999-12-31T23:59:59-05:00", "outside 1900-2200"),
     ],
 )
 def test_bad_start_times_name_the_key(text: str, fragment: str) -> None:

@@ -29,6 +29,8 @@ BlockSize = Annotated[int, Strict(), Field(ge=1, le=256)]
 FORBIDDEN_NAME_CHARACTERS: Final = ",\n\"'"
 
 _SOLVER_DEFAULTS: Final = ProntoOptions()
+#: Years a start time may fall in (timestamps stay within numpy's datetime64[ns] range).
+START_YEARS: Final = (1900, 2200)
 
 
 def _unit(unit: str) -> dict[str, Any]:
@@ -405,6 +407,8 @@ class ExecutionConfig(TableModel):
             raise ValueError(
                 f"give a time zone, e.g. {value.isoformat()}Z for UTC, got {value.isoformat()}"
             )
+        if not START_YEARS[0] <= value.year <= START_YEARS[1]:
+            raise ValueError(f"year {value.year} is outside {START_YEARS[0]}-{START_YEARS[1]}")
         return value.astimezone(UTC)
 
 
