@@ -111,3 +111,12 @@ def test_vehicle_files_are_made_absolute(tmp_path: Path) -> None:
     mission.write_text(MINIMAL.replace("[[vehicle]]", '[[vehicle]]\ntype = "boats/mine.toml"'))
     document = resolved_document(load_mission(mission))
     assert document["vehicle"][0]["type"] == str(boat.resolve())
+
+
+def test_keys_reference_lists_the_mission_table() -> None:
+    from auvplan.mission.keys import key_reference
+
+    rows = {row.key: row for row in key_reference()}
+    assert rows["mission.start_time"].type == "datetime"
+    assert "ISO 8601" in rows["mission.start_time"].description
+    assert (rows["mission.depth_m"].unit, rows["mission.depth_m"].default) == ("m", "0.0")

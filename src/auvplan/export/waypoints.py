@@ -105,7 +105,7 @@ def synchronized_distances(
 
 
 def thin_track(track: VehicleTrack, tolerance: float) -> Waypoints:
-    """The fewest-needed samples of ``track`` that keep its path and time law within tolerance.
+    """Few samples of ``track`` that keep its path and its time law within ``tolerance``.
 
     Parameters
     ----------
@@ -169,7 +169,11 @@ def by_file_stem(fleet: Sequence[Waypoints]) -> list[tuple[str, Waypoints]]:
 
 
 def _sample_indices(samples: FloatArray, vertices: FloatArray) -> IntArray:
-    """Indices of the simplified line's vertices among the samples (a subsequence of them)."""
+    """Indices of the simplified line's vertices among the samples (a subsequence of them).
+
+    GEOS returns input vertices unchanged; one not found would only leave its leg to the
+    time-law refinement, which restores the tolerance.
+    """
     indices = [0]
     for vertex in vertices[1:-1]:
         start = indices[-1] + 1
