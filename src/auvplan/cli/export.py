@@ -30,7 +30,8 @@ def add_export_options(parser: argparse.ArgumentParser, *, required: bool) -> No
         dest="formats",
         required=required,
         metavar="FORMAT,...",
-        help=f"export formats, comma-separated: {', '.join(FORMATS)}",
+        help=f"export formats, comma-separated: {', '.join(FORMATS)}"
+        + ("" if required else " (written into OUTPUT/export)"),
     )
     parser.add_argument(
         "--tolerance-m",
