@@ -89,6 +89,8 @@ OPTIONAL: dict[Path_, Any] = {
     ("solver", "propeller_order"): 5,
     ("obstacle",): [{"center": {"north": 200.0, "east": 410.0}, "radius_m": 20.0}],
     ("comm",): [{"pair": ["blue", "green"], "max_range_m": 400.0}],
+    ("mission", "start_time"): "2026-05-01T08:00:00Z",
+    ("mission", "depth_m"): 3.0,
 }
 #: Factors a number is scaled by (a slip of units or of the decimal point, or worse).
 SCALES = (1e-6, 1e-3, 0.1, 10.0, 1e3, 1e6)

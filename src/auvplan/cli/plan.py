@@ -7,6 +7,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from auvplan.cli.export import add_export_options
+
 STAGES = ("preplan", "deconflict", "full")
 #: Exit code when the plan did not converge or breaks a constraint (user errors exit with 2).
 EXIT_NOT_CONVERGED = 3
@@ -21,6 +23,7 @@ def register(subparsers: Any) -> None:
     )
     plan.add_argument("mission", type=Path, help="mission file (TOML)")
     _add_common(plan, default_output=None)
+    add_export_options(plan, required=False)
     plan.set_defaults(run=run_plan)
 
     demo = subparsers.add_parser(
@@ -68,22 +71,49 @@ def run_demo(args: argparse.Namespace) -> int:
         return _run(load_mission(path), args)
 
 
+def _export_formats(config: Any, args: argparse.Namespace) -> tuple[str, ...]:
+    """The ``--export`` formats, checked before any planning (fail fast)."""
+    from auvplan.errors import InputError
+    from auvplan.export import parse_formats
+
+    if getattr(args, "formats", None) is None:
+        return ()
+    formats = parse_formats(args.formats)
+    if args.stage != "full":
+        raise InputError(f"--export needs the optimised plan: drop --stage {args.stage}")
+    if config.terrain.synthetic:
+        raise InputError(
+            "--export needs lat/lon, but the synthetic bank has no geographic reference: "
+            "plan on a georeferenced bathymetry file"
+        )
+    return formats
+
+
 def _run(config: Any, args: argparse.Namespace) -> int:
     from auvplan.io.output import staged_output_dir
     from auvplan.mission.outputs import write_mission_files
     from auvplan.mission.pipeline import Stage, run_mission
 
+    formats = _export_formats(config, args)
     result = run_mission(
         config, stage=Stage(args.stage), compare_energy_only=args.compare_energy_only
     )
     with staged_output_dir(args.output) as staging:
         written = write_mission_files(result, staging)
+        if formats and result.plan is not None:  # from the folder, as `auvplan export` does
+            from auvplan.export import write_exports
+            from auvplan.mission.folder import load_export_plan
+
+            written += write_exports(
+                load_export_plan(staging), staging / "export", formats, tolerance=args.tolerance_m
+            )
         if not args.no_figures:
             from auvplan.viz.report import save_mission_figures
 
             written += save_mission_figures(result, staging)
+        shown = [args.output / path.relative_to(staging) for path in written]
     if not args.quiet:
-        _print_report(result, [args.output / path.name for path in written])
+        _print_report(result, shown)
     return _exit_code(result)
 
 

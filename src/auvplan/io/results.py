@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from auvplan._typing import FloatArray
-from auvplan.errors import InputError
+from auvplan.errors import DataFormatError, InputError
 from auvplan.terrain.projection import LocalProjection
 
 TRAJECTORY_COLUMNS = (
@@ -47,6 +47,17 @@ def _plain(value: Any) -> Any:
     if isinstance(value, float) and not math.isfinite(value):
         return None
     return value
+
+
+def write_text_files(directory: Path, files: Mapping[str, str]) -> list[Path]:
+    """Write each ``name: text`` of ``files`` as a UTF-8 file in ``directory`` (created)."""
+    directory.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, text in files.items():
+        path = directory / name
+        path.write_text(text, encoding="utf-8")
+        written.append(path)
+    return written
 
 
 def write_trajectories_csv(
@@ -87,6 +98,33 @@ def write_trajectories_csv(
         for index, name in enumerate(names):
             block = np.column_stack([time, states[index], held[index], power[index]])
             writer.writerows([name, *(repr(float(value)) for value in row)] for row in block)
+
+
+def read_trajectories_csv(path: Path) -> dict[str, dict[str, FloatArray]]:
+    """Read ``trajectories.csv``: per vehicle (file order), each numeric column by name.
+
+    Raises
+    ------
+    DataFormatError
+        If the file cannot be read or its header is not :data:`TRAJECTORY_COLUMNS`.
+    """
+    import pandas as pd
+
+    try:
+        table = pd.read_csv(path, dtype={"vehicle": str}, keep_default_na=False)
+    except (OSError, ValueError) as error:
+        raise DataFormatError(f"{path}: unreadable CSV ({error})") from None
+    if tuple(table.columns) != TRAJECTORY_COLUMNS:
+        raise DataFormatError(f"{path}: header is not {','.join(TRAJECTORY_COLUMNS)}")
+    try:
+        return {
+            str(name): {
+                column: rows[column].to_numpy(dtype=np.float64) for column in TRAJECTORY_COLUMNS[1:]
+            }
+            for name, rows in table.groupby("vehicle", sort=False)
+        }
+    except ValueError as error:
+        raise DataFormatError(f"{path}: a value is not a number ({error})") from None
 
 
 def write_desired_csv(

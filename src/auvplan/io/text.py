@@ -9,7 +9,10 @@ be and where it is, e.g. ``vehicle file boat.toml: not UTF-8 text (byte 0xff at 
 
 from __future__ import annotations
 
+import hashlib
+import json
 import tomllib
+from collections.abc import Mapping
 from importlib.resources.abc import Traversable
 from pathlib import Path
 from typing import Any
@@ -95,4 +98,46 @@ def read_toml(path: Path | Traversable, *, what: str) -> dict[str, Any]:
         raise DataFormatError(f"{what} {path}: not valid TOML ({error})") from None
 
 
-__all__ = ["read_text", "read_toml"]
+def read_json(path: Path, *, what: str) -> Any:
+    """The document of a JSON file, read with :func:`read_text`.
+
+    Raises
+    ------
+    DataFormatError
+        If the file cannot be read as text or is not valid JSON (names ``what`` and the file).
+    """
+    text = read_text(path, what=what)
+    try:
+        return json.loads(text)
+    except (ValueError, RecursionError) as error:
+        raise DataFormatError(f"{what} {path}: not valid JSON ({error})") from None
+
+
+def write_toml(document: Mapping[str, Any], path: Path, *, header: str = "") -> None:
+    """Write ``document`` (plain TOML values: no ``None``) as a UTF-8 TOML file (tomli-w).
+
+    ``header`` lines are written first, as ``#`` comments.
+    """
+    import tomli_w
+
+    comments = "".join(f"# {line}\n" for line in header.splitlines())
+    path.write_text(comments + tomli_w.dumps(document), encoding="utf-8")
+
+
+def file_sha256(path: Path | Traversable) -> str:
+    """The SHA-256 digest of a file's bytes, as 64 hexadecimal digits.
+
+    Examples
+    --------
+    >>> from importlib import resources
+    >>> len(file_sha256(resources.files("auvplan") / "data/vehicles/medusa.toml"))
+    64
+    """
+    digest = hashlib.sha256()
+    with path.open("rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+__all__ = ["file_sha256", "read_json", "read_text", "read_toml", "write_toml"]

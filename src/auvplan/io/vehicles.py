@@ -78,6 +78,19 @@ def packaged_vehicle_types() -> tuple[str, ...]:
     )
 
 
+def vehicle_file(type_or_path: str) -> Path | Traversable:
+    """The file a vehicle type is read from: the packaged TOML of a type name, else the path.
+
+    Examples
+    --------
+    >>> vehicle_file("medusa").name, vehicle_file("boats/mine.toml")
+    ('medusa.toml', PosixPath('boats/mine.toml'))
+    """
+    if type_or_path in packaged_vehicle_types():
+        return _data_dir("vehicles").joinpath(f"{type_or_path}.toml")
+    return Path(type_or_path)
+
+
 def packaged_propeller_tables() -> tuple[str, ...]:
     """Names of the propeller tables shipped with auvplan.
 
@@ -288,7 +301,7 @@ def load_vehicle(type_or_path: str | Path) -> VehicleParams:
     """
     name = str(type_or_path)
     if isinstance(type_or_path, str) and name in packaged_vehicle_types():
-        document = read_toml(_data_dir("vehicles").joinpath(f"{name}.toml"), what="vehicle file")
+        document = read_toml(vehicle_file(name), what="vehicle file")
         base_dir: Path | None = None
         origin = f"packaged vehicle {name}"
     else:
@@ -315,4 +328,5 @@ __all__ = [
     "load_vehicle",
     "packaged_propeller_tables",
     "packaged_vehicle_types",
+    "vehicle_file",
 ]

@@ -25,6 +25,7 @@ from auvplan.io.text import read_toml
 from auvplan.mission.tables import (
     CommConfig,
     DeconflictionConfig,
+    ExecutionConfig,
     FleetConfig,
     GoalPose,
     MapsConfig,
@@ -58,6 +59,7 @@ class MissionConfig(TableModel):
     planner: PlannerConfig = Field(default_factory=PlannerConfig)
     deconfliction: DeconflictionConfig = Field(default_factory=DeconflictionConfig)
     solver: SolverConfig = Field(default_factory=SolverConfig)
+    mission: ExecutionConfig = Field(default_factory=ExecutionConfig)
     source: Path | None = Field(None, exclude=True, description="the mission file (not a key)")
 
     @model_validator(mode="before")
@@ -140,6 +142,46 @@ def parse_mission(
     return config.model_copy(update={"vehicles": vehicles})
 
 
+def resolved_document(config: MissionConfig) -> dict[str, Any]:
+    """The mission as a TOML document: every default filled in, every file path absolute.
+
+    Written as ``mission.toml`` into each output folder, so that ``auvplan plan
+    OUTPUT/mission.toml`` runs the same mission (same start time) from anywhere.
+    :func:`parse_mission` of the document gives back ``config`` (less its ``source``).
+
+    Examples
+    --------
+    >>> config = parse_mission({
+    ...     "terrain": {"synthetic": True},
+    ...     "fleet": {"horizon_s": 60.0, "safety_radius_m": 5.0},
+    ...     "vehicle": [{"start": {"north": 10.0, "east": 400.0},
+    ...                  "goal": {"north": 40.0, "east": 400.0}}]})
+    >>> document = resolved_document(config)
+    >>> document["maps"]["w"], document["vehicle"][0]["name"], document["solver"]["dt_s"]
+    (10.0, 'vehicle1', 0.5)
+    >>> parse_mission(document) == config
+    True
+    """
+    from auvplan.io.vehicles import packaged_vehicle_types
+
+    document: dict[str, Any] = config.model_dump(by_alias=True, exclude_none=True)
+    for table in document["vehicle"]:
+        if table["type"] not in packaged_vehicle_types():  # a vehicle file, as load_vehicle
+            table["type"] = str(Path(table["type"]).resolve())
+    return {key: _toml_values(value) for key, value in document.items()}
+
+
+def _toml_values(value: Any) -> Any:
+    """Tuples as arrays and paths as absolute strings (TOML has neither)."""
+    if isinstance(value, dict):
+        return {key: _toml_values(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [_toml_values(item) for item in value]
+    if isinstance(value, Path):
+        return str(value.resolve())
+    return value
+
+
 def _resolve_vehicle_file(vehicle: VehicleConfig, base_dir: Path) -> VehicleConfig:
     """A ``type`` naming an existing file next to the mission is made absolute."""
     candidate = base_dir / vehicle.type
@@ -198,6 +240,7 @@ def _one_line(error: ValidationError) -> str:
 __all__ = [
     "CommConfig",
     "DeconflictionConfig",
+    "ExecutionConfig",
     "FleetConfig",
     "GoalPose",
     "MapsConfig",
@@ -213,4 +256,5 @@ __all__ = [
     "WindowConfig",
     "load_mission",
     "parse_mission",
+    "resolved_document",
 ]

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from auvplan import __version__
 from auvplan.io.maps_file import write_maps_netcdf
 from auvplan.io.results import (
     write_desired_csv,
@@ -13,6 +14,10 @@ from auvplan.io.results import (
     write_paths_geojson,
     write_trajectories_csv,
 )
+from auvplan.io.text import write_toml
+from auvplan.io.trajectories_file import SERIES, write_trajectories_netcdf
+from auvplan.mission.config import resolved_document
+from auvplan.mission.evaluation import OptimizedPlan
 from auvplan.mission.pipeline import MissionResult
 from auvplan.mission.summary import mission_summary
 from auvplan.vehicle import headings, positions
@@ -21,17 +26,31 @@ from auvplan.vehicle import headings, positions
 def write_mission_files(result: MissionResult, directory: Path) -> list[Path]:
     """Write the mission's data files into ``directory`` and return their paths.
 
-    Always ``summary.json``, ``maps.nc`` and ``paths.geojson``; after deconfliction
-    ``desired.csv``; after optimisation ``trajectories.csv`` (and
-    ``trajectories_energy_only.csv`` when the comparison was run).
+    Always ``summary.json``, ``mission.toml`` (the resolved mission: ``auvplan plan`` of it
+    reruns the mission), ``maps.nc`` and ``paths.geojson``; after deconfliction
+    ``desired.csv``; after optimisation ``trajectories.csv`` and ``trajectories.nc`` (and
+    ``trajectories_energy_only.csv``/``.nc`` when the comparison was run).
     """
     preplan = result.preplan
     names = preplan.names
-    written = [directory / "summary.json", directory / "maps.nc", directory / "paths.geojson"]
+    written = [
+        directory / "summary.json",
+        directory / "mission.toml",
+        directory / "maps.nc",
+        directory / "paths.geojson",
+    ]
     write_json(mission_summary(result), written[0])
-    write_maps_netcdf(preplan.maps, written[1])
+    source = result.config.source
+    write_toml(
+        resolved_document(result.config),
+        written[1],
+        header=f"The mission as auvplan {__version__} ran it"
+        + ("" if source is None else f" (from {source})")
+        + ": every default filled in.\nRun it again with: auvplan plan mission.toml -o NEW_FOLDER",
+    )
+    write_maps_netcdf(preplan.maps, written[2])
     write_paths_geojson(
-        written[2],
+        written[3],
         names,
         preplan.paths,
         preplan.bathymetry.projection,
@@ -46,14 +65,44 @@ def write_mission_files(result: MissionResult, directory: Path) -> list[Path]:
         ]
         write_desired_csv(path, names, stage2.time, np.stack(poses))
         written.append(path)
-    for plan, file_name in (
-        (result.plan, "trajectories.csv"),
-        (result.energy_only, "trajectories_energy_only.csv"),
+    for plan, stem in (
+        (result.plan, "trajectories"),
+        (result.energy_only, "trajectories_energy_only"),
     ):
         if plan is not None and stage2 is not None:
-            path = directory / file_name
+            csv_path, netcdf_path = directory / f"{stem}.csv", directory / f"{stem}.nc"
             write_trajectories_csv(
-                path, names, stage2.time, plan.states, plan.inputs, np.asarray(plan.power)
+                csv_path, names, stage2.time, plan.states, plan.inputs, np.asarray(plan.power)
             )
-            written.append(path)
+            _write_trajectories_netcdf(result, plan, netcdf_path)
+            written += [csv_path, netcdf_path]
     return written
+
+
+def _write_trajectories_netcdf(result: MissionResult, plan: OptimizedPlan, path: Path) -> None:
+    """``trajectories.nc`` of one optimised plan (:mod:`auvplan.io.trajectories_file`)."""
+    assert result.deconfliction is not None  # a plan exists only after stage 2
+    models = result.deconfliction.layout.models
+    series = {
+        name: np.stack([plan.states[i, :, model.index(name)] for i, model in enumerate(models)])
+        for name in SERIES
+        if name != "power"
+    }
+    psi = np.stack([headings(model, plan.states[i]) for i, model in enumerate(models)])
+    write_trajectories_netcdf(
+        path,
+        result.preplan.names,
+        result.deconfliction.time,
+        {**series, "power": np.asarray(plan.power)},
+        psi=psi,
+        start_time=result.config.mission.start_time,
+        depth=result.config.mission.depth,
+        projection=result.preplan.bathymetry.projection,
+        attributes={
+            "source": f"auvplan {__version__}",
+            "history": f"written by auvplan {__version__} (auvplan plan)",
+            "references": "Häusler et al., Cooperative AUV Motion Planning using Terrain "
+            "Information, OCEANS 2013",
+            "terrain_weight": plan.terrain_weight,
+        },
+    )

@@ -4,15 +4,22 @@ from __future__ import annotations
 
 import dataclasses
 from enum import Enum
+from importlib.resources.abc import Traversable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from auvplan import __version__
+from auvplan.io.text import file_sha256
+from auvplan.io.vehicles import vehicle_file
 from auvplan.mission.assembly import integration_substeps
+from auvplan.mission.config import MissionConfig
 from auvplan.mission.evaluation import OptimizedPlan
 from auvplan.mission.pipeline import MissionResult
-from auvplan.planning import path_length
+from auvplan.mission.preplan import PreplanStage
+from auvplan.planning import CircleObstacle, path_length
+from auvplan.terrain import LocalProjection
 
 
 def _record(record: Any) -> Any:
@@ -55,6 +62,51 @@ def _pose(pose: np.ndarray) -> dict[str, float]:
     return {"north": float(pose[0]), "east": float(pose[1]), "heading_rad": float(pose[2])}
 
 
+def _place(projection: LocalProjection | None, north: float, east: float) -> dict[str, float]:
+    """A local point [m], with its WGS 84 ``lat``/``lon`` [deg] on georeferenced terrain."""
+    point = {"north": float(north), "east": float(east)}
+    if projection is not None:
+        lat, lon = projection.to_geographic(np.array([north]), np.array([east]))
+        point.update(lat=float(lat[0]), lon=float(lon[0]))
+    return point
+
+
+def _obstacles(preplan: PreplanStage) -> list[dict[str, Any]]:
+    """The obstacles in the map frame (and lat/lon), as the planners saw them."""
+    projection = preplan.bathymetry.projection
+    shapes: list[dict[str, Any]] = []
+    for name, obstacle in zip(preplan.obstacle_names, preplan.obstacles, strict=True):
+        if isinstance(obstacle, CircleObstacle):
+            shapes.append(
+                {
+                    "name": name,
+                    "shape": "circle",
+                    "center": _place(projection, obstacle.north, obstacle.east),
+                    "radius_m": obstacle.radius,
+                }
+            )
+        else:
+            vertices = [_place(projection, north, east) for north, east in obstacle.vertices]
+            shapes.append({"name": name, "shape": "polygon", "vertices": vertices})
+    return shapes
+
+
+def _fingerprint(path: Path | Traversable) -> dict[str, str]:
+    location = str(path.resolve()) if isinstance(path, Path) else str(path)
+    return {"path": location, "sha256": file_sha256(path)}
+
+
+def _inputs(config: MissionConfig) -> dict[str, Any]:
+    """Path and SHA-256 of every file the run read: mission, bathymetry, vehicle files."""
+    return {
+        "mission": None if config.source is None else _fingerprint(config.source),
+        "bathymetry": None if config.terrain.file is None else _fingerprint(config.terrain.file),
+        "vehicles": {
+            vehicle.type: _fingerprint(vehicle_file(vehicle.type)) for vehicle in config.vehicles
+        },
+    }
+
+
 def mission_summary(result: MissionResult) -> dict[str, Any]:
     """Build the ``summary.json`` document of a mission run."""
     config = result.config
@@ -64,6 +116,8 @@ def mission_summary(result: MissionResult) -> dict[str, Any]:
     summary: dict[str, Any] = {
         "auvplan_version": __version__,
         "mission": None if config.source is None else str(config.source),
+        "inputs": _inputs(config),
+        "start_time": config.mission.start_time.isoformat(),
         "stage": result.stage.value,
         "terrain": {
             "name": preplan.bathymetry.name,
@@ -75,7 +129,9 @@ def mission_summary(result: MissionResult) -> dict[str, Any]:
                 maps.cost_geometry.spacing_east,
             ],
             "map_parameters": dataclasses.asdict(maps.parameters),
+            "origin": _place(preplan.bathymetry.projection, 0.0, 0.0),
         },
+        "obstacles": _obstacles(preplan),
         "fleet": {
             "safety_radius_m": config.fleet.safety_radius,
             "edge_model": config.planner.edge_model,

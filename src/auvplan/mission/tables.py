@@ -8,10 +8,11 @@ from __future__ import annotations
 
 import math
 import types
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Annotated, Any, Final, Literal, Union, get_args, get_origin
 
-from pydantic import BaseModel, ConfigDict, Field, Strict, model_validator
+from pydantic import BaseModel, ConfigDict, Field, Strict, field_validator, model_validator
 
 from auvplan.errors import InputError
 from auvplan.optimization import ProntoOptions
@@ -28,6 +29,8 @@ BlockSize = Annotated[int, Strict(), Field(ge=1, le=256)]
 FORBIDDEN_NAME_CHARACTERS: Final = ",\n\"'"
 
 _SOLVER_DEFAULTS: Final = ProntoOptions()
+#: Years a start time may fall in (timestamps stay within numpy's datetime64[ns] range).
+START_YEARS: Final = (1900, 2200)
 
 
 def _unit(unit: str) -> dict[str, Any]:
@@ -372,6 +375,49 @@ class SolverConfig(TableModel):
     def harmonics(self) -> int | None:
         """``propeller_order`` with ``"full"`` as ``None``."""
         return None if self.propeller_order == "full" else self.propeller_order
+
+
+class ExecutionConfig(TableModel):
+    """When and at what depth the plan is flown (timestamps and depths of the exports).
+
+    ``start_time`` is an ISO 8601 date and time with its time zone (a TOML offset date-time
+    or a string such as ``"2026-05-01T08:00:00Z"``), kept in UTC; the plan's time ``t`` [s] is
+    flown at ``start_time + t``. ``depth_m`` is the constant depth of the planar plan.
+    """
+
+    start_time: datetime = Field(
+        default_factory=lambda: datetime.now(UTC).replace(microsecond=0),
+        description="UTC time of t = 0, ISO 8601 with time zone (default: the time of the run)",
+    )
+    depth: Number = Field(
+        0.0, alias="depth_m", ge=0.0, le=11_000.0, description="constant depth of the plan",
+        json_schema_extra=_unit("m"),
+    )  # fmt: skip
+
+    @field_validator("start_time", mode="before")
+    @classmethod
+    def _iso_time(cls, value: Any) -> Any:
+        if isinstance(value, str):
+            try:
+                return datetime.fromisoformat(value)
+            except ValueError:
+                raise ValueError(
+                    f"not an ISO 8601 time, got {value!r} (e.g. '2026-05-01T08:00:00Z')"
+                ) from None
+        if not isinstance(value, datetime):
+            raise ValueError(f"an ISO 8601 date and time, got {value!r}")  # noqa: TRY004 (pydantic)
+        return value
+
+    @field_validator("start_time", mode="after")
+    @classmethod
+    def _in_utc(cls, value: datetime) -> datetime:
+        if value.tzinfo is None or value.utcoffset() is None:
+            raise ValueError(
+                f"give a time zone, e.g. {value.isoformat()}Z for UTC, got {value.isoformat()}"
+            )
+        if not START_YEARS[0] <= value.year <= START_YEARS[1]:
+            raise ValueError(f"year {value.year} is outside {START_YEARS[0]}-{START_YEARS[1]}")
+        return value.astimezone(UTC)
 
 
 def nested_model(annotation: Any) -> tuple[type[BaseModel] | None, bool]:

@@ -1,0 +1,74 @@
+"""``auvplan export OUTPUT_DIR --format FORMAT,... [-o EXPORT_DIR] [--tolerance-m X]``."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+from auvplan.export import DEFAULT_TOLERANCE_M, FORMATS
+
+
+def tolerance_m(text: str) -> float:
+    """A finite, non-negative waypoint tolerance [m] (argparse type)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value >= 0.0):
+        raise argparse.ArgumentTypeError(f"expected a distance >= 0 m, got {text!r}")
+    return value
+
+
+def add_export_options(parser: argparse.ArgumentParser, *, required: bool) -> None:
+    """``--format`` (``--export`` for ``plan``) and ``--tolerance-m``."""
+    flag = "--format" if required else "--export"
+    parser.add_argument(
+        flag,
+        dest="formats",
+        required=required,
+        metavar="FORMAT,...",
+        help=f"export formats, comma-separated: {', '.join(FORMATS)}"
+        + ("" if required else " (written into OUTPUT/export)"),
+    )
+    parser.add_argument(
+        "--tolerance-m",
+        type=tolerance_m,
+        default=DEFAULT_TOLERANCE_M,
+        help="largest distance between the exported waypoints, flown at their leg speeds, and "
+        f"the plan at any time [m] (default {DEFAULT_TOLERANCE_M:g})",
+    )
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``export`` verb."""
+    export = subparsers.add_parser(
+        "export",
+        help="export a finished plan for vehicles, ground stations and GIS",
+        description="Write the optimised plan of an output folder as MOOS-IvP behaviours, "
+        "QGroundControl plans (ArduSub), Neptus/IMC plans, GPX, KML or GeoJSON.",
+    )
+    export.add_argument("folder", type=Path, help="output folder of auvplan plan")
+    export.add_argument(
+        "-o", "--output", type=Path, default=None, help="export folder (default FOLDER/export)"
+    )
+    add_export_options(export, required=True)
+    export.set_defaults(run=run_export)
+
+
+def run_export(args: argparse.Namespace) -> int:
+    """Read the folder's plan and write the exports all-or-nothing."""
+    from auvplan.export import parse_formats, write_exports
+    from auvplan.io.output import staged_output_dir
+    from auvplan.mission.folder import load_export_plan
+
+    formats = parse_formats(args.formats)
+    plan = load_export_plan(args.folder)
+    target = args.output if args.output is not None else args.folder / "export"
+    with staged_output_dir(target) as staging:
+        written = write_exports(plan, staging, formats, tolerance=args.tolerance_m)
+    if not args.quiet:
+        print("wrote: " + ", ".join(str(target / path.name) for path in written), file=sys.stdout)
+    return 0

@@ -1,0 +1,109 @@
+"""Exports of a finished plan for vehicles, ground stations and GIS.
+
+=========== ======================= ================================================
+format      files                   for
+=========== ======================= ================================================
+``moos``    ``NAME.bhv``,           MOOS-IvP pHelmIvP (``BHV_Waypoint``, local x/y)
+            ``origin.moos``
+``qgc``     ``NAME.plan``           QGroundControl / ArduSub (waypoints, geofences)
+``imc``     ``NAME.imc.json``       Neptus / LSTS IMC (``FollowTrajectory``, timed)
+``gpx``     ``trajectories.gpx``    GPX 1.1 viewers (timed tracks)
+``kml``     ``trajectories.kml``    Google Earth (``gx:Track`` with time stamps)
+``geojson`` ``trajectories.geojson`` GIS (``LineString`` per vehicle, times in properties)
+=========== ======================= ================================================
+
+Every format is written from the same waypoints: each track thinned to ``tolerance`` with its
+time law kept (:func:`auvplan.export.waypoints.thin_track`). The plan they are written from is
+an :class:`auvplan.export.plan.ExportPlan`. This module imports nothing heavy (not even numpy)
+until a format is rendered, so that the command line starts fast.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Final
+
+from auvplan.errors import InputError
+
+if TYPE_CHECKING:
+    from auvplan.export.plan import ExportPlan
+
+#: The export formats, each rendered by the module of the same name in this package.
+FORMATS: Final = ("moos", "qgc", "imc", "gpx", "kml", "geojson")
+#: Default waypoint tolerance [m] (see :func:`auvplan.export.waypoints.thin_track`).
+DEFAULT_TOLERANCE_M: Final = 1.0
+
+
+def parse_formats(text: str) -> tuple[str, ...]:
+    """The formats of a comma-separated list, in the order given, without repeats.
+
+    Raises
+    ------
+    InputError
+        If a name is not one of :data:`FORMATS` or the list is empty.
+
+    Examples
+    --------
+    >>> parse_formats("gpx, kml,gpx")
+    ('gpx', 'kml')
+    """
+    names = [name.strip().lower() for name in text.split(",") if name.strip()]
+    unknown = [name for name in names if name not in FORMATS]
+    if unknown or not names:
+        shown = repr(unknown[0]) if unknown else "none given"
+        raise InputError(f"unknown export format {shown} (choose from {', '.join(FORMATS)})")
+    return tuple(dict.fromkeys(names))
+
+
+def render_exports(
+    plan: ExportPlan, formats: Sequence[str], *, tolerance: float = DEFAULT_TOLERANCE_M
+) -> dict[str, str]:
+    """The text of every export file, by file name.
+
+    Parameters
+    ----------
+    plan : ExportPlan
+        The finished plan.
+    formats : sequence of str
+        Names from :data:`FORMATS`.
+    tolerance : float
+        Waypoint tolerance [m].
+
+    Returns
+    -------
+    dict of str to str
+        File name (no folder) to its text.
+    """
+    from auvplan.export import geojson, gpx, imc, kml, moos, qgc
+    from auvplan.export.waypoints import thin_track
+
+    renderers = {
+        "moos": moos.render,
+        "qgc": qgc.render,
+        "imc": imc.render,
+        "gpx": gpx.render,
+        "kml": kml.render,
+        "geojson": geojson.render,
+    }
+    fleet = [thin_track(track, tolerance) for track in plan.tracks]
+    files: dict[str, str] = {}
+    for name in parse_formats(",".join(formats)):
+        files.update(renderers[name](plan, fleet))
+    return files
+
+
+def write_exports(
+    plan: ExportPlan,
+    directory: Path,
+    formats: Sequence[str],
+    *,
+    tolerance: float = DEFAULT_TOLERANCE_M,
+) -> list[Path]:
+    """Write :func:`render_exports` into ``directory`` (created) and return the paths."""
+    from auvplan.io.results import write_text_files
+
+    return write_text_files(directory, render_exports(plan, formats, tolerance=tolerance))
+
+
+__all__ = ["DEFAULT_TOLERANCE_M", "FORMATS", "parse_formats", "render_exports", "write_exports"]

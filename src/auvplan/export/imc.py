@@ -1,0 +1,87 @@
+"""Neptus / IMC plans (JSON): one ``PlanSpecification`` with a ``FollowTrajectory`` per vehicle.
+
+Message definitions: LSTS IMC (``IMC.xml``): ``FollowTrajectory`` (id 463) gives the start
+point in WGS 84 **radians**, the depth ``z`` with ``z_units`` 1 (DEPTH), a speed with
+``speed_units`` 0 (metres per second) and the list of ``TrajectoryPoint``: ``x`` north, ``y``
+east, ``z`` down offsets [m] from the start point and ``t``, the time [s] after the previous
+point, so that the vehicle follows the time law, not only the path. The offsets are taken in a
+transverse Mercator tangent at the start point. The JSON layout is the one of LSTS's Neptus
+integration (``abbrev`` names each message).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from typing import Any, Final
+
+import numpy as np
+
+from auvplan.export.plan import ExportPlan
+from auvplan.export.waypoints import Waypoints, by_file_stem
+from auvplan.terrain.projection import LocalProjection
+
+Z_UNITS_DEPTH: Final = 1
+SPEED_UNITS_METERS_PS: Final = 0
+#: Manoeuvre timeout as a multiple of the trajectory's duration (IMC field ``timeout``, uint16).
+TIMEOUT_FACTOR: Final = 1.5
+MAX_TIMEOUT_S: Final = 65_535
+
+
+def trajectory_points(waypoints: Waypoints) -> list[dict[str, Any]]:
+    """``TrajectoryPoint`` messages: offsets [m] from the first waypoint, ``t`` after the last."""
+    lat_0, lon_0 = float(waypoints.lat[0]), float(waypoints.lon[0])
+    north, east = LocalProjection(lat_0, lon_0).to_local(waypoints.lat, waypoints.lon)
+    north, east = north - north[0], east - east[0]  # exactly 0 at the start (not 1e-9)
+    steps = np.diff(waypoints.time, prepend=waypoints.time[0])
+    return [
+        {"abbrev": "TrajectoryPoint", "x": float(n), "y": float(e), "z": 0.0, "t": float(t)}
+        for n, e, t in zip(north, east, steps, strict=True)
+    ]
+
+
+def plan_specification(plan: ExportPlan, waypoints: Waypoints) -> dict[str, Any]:
+    """The ``PlanSpecification`` of one vehicle."""
+    duration = float(waypoints.time[-1] - waypoints.time[0])
+    maneuver = {
+        "abbrev": "FollowTrajectory",
+        "timeout": min(MAX_TIMEOUT_S, math.ceil(TIMEOUT_FACTOR * duration)),
+        "lat": math.radians(float(waypoints.lat[0])),
+        "lon": math.radians(float(waypoints.lon[0])),
+        "z": plan.depth,
+        "z_units": Z_UNITS_DEPTH,
+        "speed": waypoints.mean_speed,
+        "speed_units": SPEED_UNITS_METERS_PS,
+        "custom": "",
+        "points": trajectory_points(waypoints),
+    }
+    return {
+        "abbrev": "PlanSpecification",
+        "plan_id": waypoints.name,
+        "description": f"auvplan plan for {waypoints.name}, starting {plan.start_time.isoformat()}",
+        "start_man_id": "follow_trajectory",
+        "maneuvers": [
+            {
+                "abbrev": "PlanManeuver",
+                "maneuver_id": "follow_trajectory",
+                "data": maneuver,
+                "start_actions": [],
+                "end_actions": [],
+            }
+        ],
+        "transitions": [],
+        "start_actions": [],
+        "end_actions": [],
+    }
+
+
+def render(plan: ExportPlan, fleet: Sequence[Waypoints]) -> dict[str, str]:
+    """``NAME.imc.json`` per vehicle."""
+    return {
+        f"{stem}.imc.json": json.dumps(plan_specification(plan, waypoints), indent=2) + "\n"
+        for stem, waypoints in by_file_stem(fleet)
+    }
+
+
+__all__ = ["plan_specification", "render", "trajectory_points"]

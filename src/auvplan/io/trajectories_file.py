@@ -1,0 +1,230 @@
+"""``trajectories.nc``: the optimised trajectories as a CF-1.8 ``featureType = "trajectory"`` file.
+
+The layout follows the NCEI NetCDF trajectory template (v2.0, multidimensional array
+representation, CF §H.4.1): one ``trajectory`` per vehicle (the ``trajectory`` variable holds
+the vehicle names, ``cf_role = "trajectory_id"``) and ``obs`` samples on the solver's time
+grid. ``time``, ``lat``, ``lon`` and ``depth`` are the auxiliary coordinates of every variable
+(the names of ``trajectories.csv`` are kept where the quantity is the same):
+
+* ``time`` [seconds since ``start_time``, UTC] (standard name ``time``);
+* ``lat``, ``lon`` [degrees, WGS 84] (``latitude``, ``longitude``; georeferenced terrain only);
+* ``depth`` [m, positive down], the plan's constant depth (``depth``);
+* ``north``, ``east`` [m]: the position in the local frame of ``maps.nc``;
+* ``heading`` [degree]: ψ clockwise from true north (``platform_orientation``);
+* ``u``, ``v`` [m s-1]: surge (body x, forward) and sway (body y, to starboard) speed through
+  the water (``platform_surge_rate_fore``, ``platform_sway_rate_starboard``);
+* ``r`` [rad s-1]: yaw rate, positive bow to starboard (``platform_yaw_rate_fore_starboard``);
+* ``n_ps``, ``n_sb`` [s-1]: port and starboard propeller speeds (revolutions per second);
+* ``power`` [W]: electrical power drawn from the battery.
+
+On a georeferenced terrain the local frame's north is the north of a transverse Mercator
+projection centred on the map, which differs from true north by the meridian convergence
+(about 1e-4 rad a kilometre off the central meridian); ``heading`` is corrected for it, so it
+is a true heading. On terrain without georeference (the synthetic bank) there is no ``lat`` /
+``lon`` and ``heading`` is relative to the local north.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from datetime import datetime
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Final
+
+import numpy as np
+
+from auvplan._typing import FloatArray
+from auvplan.errors import DataFormatError
+from auvplan.terrain.projection import LocalProjection
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+#: The state and output series written, by their ``trajectories.csv`` names: CF attributes.
+SERIES: Final[Mapping[str, Mapping[str, str]]] = {
+    "north": {"units": "m", "long_name": "north of the local frame's origin"},
+    "east": {"units": "m", "long_name": "east of the local frame's origin"},
+    "u": {
+        "units": "m s-1",
+        "standard_name": "platform_surge_rate_fore",
+        "long_name": "surge speed through the water (body x, forward)",
+    },
+    "v": {
+        "units": "m s-1",
+        "standard_name": "platform_sway_rate_starboard",
+        "long_name": "sway speed through the water (body y, to starboard)",
+    },
+    "r": {
+        "units": "rad s-1",
+        "standard_name": "platform_yaw_rate_fore_starboard",
+        "long_name": "yaw rate (positive: bow to starboard)",
+    },
+    "n_ps": {"units": "s-1", "long_name": "port propeller speed (revolutions per second)"},
+    "n_sb": {"units": "s-1", "long_name": "starboard propeller speed (revolutions per second)"},
+    "power": {"units": "W", "long_name": "electrical power drawn from the battery"},
+}
+_LAT_ATTRIBUTES: Final = {
+    "standard_name": "latitude",
+    "long_name": "latitude (WGS 84)",
+    "units": "degrees_north",
+    "axis": "Y",
+}
+_LON_ATTRIBUTES: Final = {
+    "standard_name": "longitude",
+    "long_name": "longitude (WGS 84)",
+    "units": "degrees_east",
+    "axis": "X",
+}
+#: Length [m] of the step along ψ used to measure the meridian convergence.
+_HEADING_STEP_M: Final = 1.0
+
+
+def true_heading(
+    projection: LocalProjection | None, north: FloatArray, east: FloatArray, psi: FloatArray
+) -> FloatArray:
+    """Heading [deg] in ``[0, 360)``, clockwise from true north, of ψ [rad] in the local frame.
+
+    The geodesic azimuth (WGS 84) from each point to the point one metre ahead along ψ, so
+    that the projection's meridian convergence is accounted for. Without a projection, ψ in
+    degrees.
+    """
+    if projection is None:
+        return np.mod(np.degrees(psi), 360.0)
+    from pyproj import Geod
+
+    lat, lon = projection.to_geographic(north, east)
+    ahead_lat, ahead_lon = projection.to_geographic(
+        north + _HEADING_STEP_M * np.cos(psi), east + _HEADING_STEP_M * np.sin(psi)
+    )
+    azimuth, _, _ = Geod(ellps="WGS84").inv(lon, lat, ahead_lon, ahead_lat)
+    return np.mod(np.asarray(azimuth, dtype=np.float64), 360.0)
+
+
+def write_trajectories_netcdf(
+    path: Path,
+    names: Sequence[str],
+    time: FloatArray,
+    series: Mapping[str, FloatArray],
+    *,
+    psi: FloatArray,
+    start_time: datetime,
+    depth: float,
+    projection: LocalProjection | None,
+    attributes: Mapping[str, Any],
+) -> None:
+    """Write ``trajectories.nc`` (see the module notes for its variables).
+
+    Parameters
+    ----------
+    path : Path
+        Output file.
+    names : sequence of str
+        Vehicle names, length ``n_vehicles``.
+    time : ndarray of shape (n_t,)
+        Time since ``start_time`` [s].
+    series : mapping of str to ndarray of shape (n_vehicles, n_t)
+        Every entry of :data:`SERIES` by name, in its unit.
+    psi : ndarray of shape (n_vehicles, n_t)
+        Yaw angle [rad], clockwise from the local north.
+    start_time : datetime
+        UTC time of ``t = 0`` (time-zone aware).
+    depth : float
+        Constant depth [m] of the plan.
+    projection : LocalProjection or None
+        Local frame to WGS 84; ``None`` writes no ``lat``/``lon``.
+    attributes : mapping
+        Extra global attributes (strings or numbers).
+    """
+    import xarray as xr
+
+    n_vehicles, n_t = len(names), time.size
+    shape = (n_vehicles, n_t)
+    dims = ("trajectory", "obs")
+    north, east = series["north"], series["east"]
+    epoch = start_time.strftime("%Y-%m-%dT%H:%M:%S.%fZ")
+    coords: dict[str, Any] = {
+        "trajectory": (
+            "trajectory",
+            np.array(names, dtype=object),
+            {"cf_role": "trajectory_id", "long_name": "vehicle name"},
+        ),
+        "time": (
+            dims,
+            np.broadcast_to(time, shape).copy(),
+            {
+                "standard_name": "time",
+                "long_name": "time (UTC)",
+                "units": f"seconds since {epoch}",
+                "calendar": "standard",
+                "axis": "T",
+            },
+        ),
+        "depth": (
+            dims,
+            np.full(shape, float(depth)),
+            {
+                "standard_name": "depth",
+                "long_name": "depth below the sea surface",
+                "units": "m",
+                "positive": "down",
+                "axis": "Z",
+            },
+        ),
+    }
+    if projection is not None:
+        lat, lon = projection.to_geographic(north, east)
+        coords["lat"] = (dims, lat, _LAT_ATTRIBUTES)
+        coords["lon"] = (dims, lon, _LON_ATTRIBUTES)
+    heading_reference = "true north" if projection is not None else "the local frame's north"
+    data = {
+        name: (dims, np.asarray(series[name], dtype=np.float64), dict(attrs))
+        for name, attrs in SERIES.items()
+    }
+    data["heading"] = (
+        dims,
+        true_heading(projection, north, east, psi),
+        {
+            "units": "degree",
+            "standard_name": "platform_orientation",
+            "long_name": f"heading, clockwise from {heading_reference}",
+        },
+    )
+    dataset = xr.Dataset(data, coords=coords)
+    dataset.attrs = {
+        "Conventions": "CF-1.8",
+        "featureType": "trajectory",
+        "cdm_data_type": "Trajectory",
+        "title": "auvplan optimised trajectories",
+        "time_coverage_start": start_time.isoformat(),
+        **attributes,
+    }
+    encoding: dict[str, dict[str, Any]] = {
+        name: {"_FillValue": None} for name in [*dataset.data_vars, *dataset.coords]
+    }
+    encoding["trajectory"] = {"dtype": "S1", "char_dim_name": "name_strlen"}
+    dataset.to_netcdf(path, encoding=encoding)
+
+
+def read_trajectories_netcdf(path: Path) -> xr.Dataset:
+    """Read ``trajectories.nc`` into memory (times decoded as UTC ``datetime64``).
+
+    Raises
+    ------
+    DataFormatError
+        If the file cannot be read or lacks a variable of :data:`SERIES`, ``time`` or
+        ``trajectory``; the message names the file.
+    """
+    import xarray as xr
+
+    try:
+        with xr.open_dataset(path) as dataset:
+            loaded = dataset.load()
+    except (OSError, ValueError, RuntimeError, TypeError, KeyError) as error:
+        raise DataFormatError(f"{path}: unreadable NetCDF ({error})") from None
+    missing = sorted({"time", "trajectory", *SERIES} - set(map(str, loaded.variables)))
+    if missing:
+        raise DataFormatError(f"{path}: not an auvplan trajectories file (no {', '.join(missing)})")
+    return loaded
+
+
+__all__ = ["SERIES", "read_trajectories_netcdf", "true_heading", "write_trajectories_netcdf"]

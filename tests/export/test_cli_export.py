@@ -1,0 +1,219 @@
+"""End to end on a small georeferenced plan: trajectories.nc, mission.toml, ``auvplan export``."""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import shutil
+from pathlib import Path
+
+import gpxpy
+import numpy as np
+import pandas as pd
+import pytest
+import xarray as xr
+
+from auvplan.cli.main import main
+from auvplan.export import FORMATS
+from auvplan.mission.config import load_mission, parse_mission
+from auvplan.terrain import LocalProjection
+
+from ._plans import MISSION
+from ._readers import cf_findings
+
+ALL = ",".join(FORMATS)
+
+
+def test_trajectories_netcdf_is_a_cf_trajectory_file(planned_folder: Path, tmp_path: Path) -> None:
+    path = planned_folder / "trajectories.nc"
+    findings = cf_findings(path, tmp_path / "cf.json")
+    assert findings["high"] == [], findings
+    assert findings["medium"] == [], findings
+    table = pd.read_csv(planned_folder / "trajectories.csv")
+    summary = json.loads((planned_folder / "summary.json").read_text())
+    with xr.open_dataset(path) as dataset:
+        assert dataset.attrs["featureType"] == "trajectory"
+        assert dataset["trajectory"].attrs["cf_role"] == "trajectory_id"
+        assert list(dataset["trajectory"].values) == ["blue", "green"]
+        # 10:00 at +02:00 in the mission file is 08:00 UTC
+        assert dataset["time"].values[0, 0] == np.datetime64("2026-05-01T08:00:00")
+        assert summary["start_time"] == "2026-05-01T08:00:00+00:00"
+        np.testing.assert_array_equal(dataset["depth"].values, 3.0)
+        origin = LocalProjection(
+            summary["terrain"]["origin"]["lat"], summary["terrain"]["origin"]["lon"]
+        )
+        for i, name in enumerate(["blue", "green"]):
+            rows = table[table["vehicle"] == name]
+            seconds = (dataset["time"].values[i] - dataset["time"].values[i, 0]) / np.timedelta64(
+                1, "s"
+            )
+            np.testing.assert_allclose(seconds, rows["t"], atol=1e-9)
+            for column in ("north", "east", "u", "v", "r", "n_ps", "n_sb", "power"):
+                np.testing.assert_array_equal(dataset[column].values[i], rows[column])
+            # lat/lon place the local north/east (a tangent plane at the origin agrees to cm)
+            north, east = origin.to_local(dataset["lat"].values[i], dataset["lon"].values[i])
+            assert np.max(np.hypot(north - rows["north"], east - rows["east"])) < 0.05
+            # a true heading differs from ψ by the meridian convergence only (< 0.01 deg here)
+            turn = (
+                dataset["heading"].values[i] - np.degrees(rows["psi"].to_numpy()) + 180.0
+            ) % 360.0 - 180.0
+            assert np.max(np.abs(turn)) < 0.01
+
+
+def test_summary_records_version_inputs_and_start_time(planned_folder: Path) -> None:
+    summary = json.loads((planned_folder / "summary.json").read_text())
+    assert summary["auvplan_version"]
+    inputs = summary["inputs"]
+    for entry in [inputs["mission"], inputs["bathymetry"], *inputs["vehicles"].values()]:
+        digest = hashlib.sha256(Path(entry["path"]).read_bytes()).hexdigest()
+        assert entry["sha256"] == digest
+    assert Path(inputs["bathymetry"]["path"]).name == "grid.nc"
+    assert [obstacle["name"] for obstacle in summary["obstacles"]] == ["rock", "wreck"]
+    assert set(summary["obstacles"][0]["center"]) == {"north", "east", "lat", "lon"}
+
+
+def test_mission_toml_is_the_resolved_mission_and_reruns_the_plan(
+    planned_folder: Path, tmp_path: Path
+) -> None:
+    import tomllib
+
+    resolved = load_mission(planned_folder / "mission.toml")
+    original = parse_mission(
+        tomllib.loads(MISSION),
+        base_dir=Path(
+            json.loads((planned_folder / "summary.json").read_text())["inputs"]["bathymetry"][
+                "path"
+            ]
+        ).parent,
+    )
+    assert resolved.model_dump() == original.model_dump()
+    again = tmp_path / "again"
+    assert (
+        main(["-q", "plan", str(planned_folder / "mission.toml"), "-o", str(again), "--no-figures"])
+        == 0
+    )
+    first, second = (pd.read_csv(folder / "trajectories.csv") for folder in (planned_folder, again))
+    assert list(first["vehicle"]) == list(second["vehicle"])
+    numbers = first.columns[1:]
+    np.testing.assert_allclose(second[numbers], first[numbers], rtol=0.0, atol=1e-9)
+    with (
+        xr.open_dataset(planned_folder / "trajectories.nc") as a,
+        xr.open_dataset(again / "trajectories.nc") as b,
+    ):
+        xr.testing.assert_allclose(a, b, rtol=0.0, atol=1e-9)
+
+
+def _tree(root: Path) -> dict[str, bytes]:
+    return {
+        str(p.relative_to(root)): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()
+    }
+
+
+def test_export_later_gives_the_files_of_plan_export(planned_folder: Path, tmp_path: Path) -> None:
+    target = tmp_path / "exports"
+    assert main(["-q", "export", str(planned_folder), "--format", ALL, "-o", str(target)]) == 0
+    assert _tree(target) == _tree(planned_folder / "export")
+    gpx = gpxpy.parse((target / "trajectories.gpx").read_text())
+    assert [track.name for track in gpx.tracks] == ["blue", "green"]
+    for track in gpx.tracks:
+        times = [point.time for point in track.segments[0].points]
+        assert times[0] is not None
+        assert times[0].isoformat() == "2026-05-01T08:00:00+00:00"
+        assert all(b > a for a, b in itertools.pairwise(times))
+
+
+def test_export_from_csv_when_the_netcdf_is_gone(planned_folder: Path, tmp_path: Path) -> None:
+    folder = tmp_path / "copy"
+    shutil.copytree(planned_folder, folder)
+    (folder / "trajectories.nc").unlink()
+    shutil.rmtree(folder / "export")
+    assert main(["-q", "export", str(folder), "--format", "gpx,qgc"]) == 0
+    for name in ("trajectories.gpx", "blue.plan", "green.plan"):
+        from_csv = (folder / "export" / name).read_text()
+        from_netcdf = (planned_folder / "export" / name).read_text()
+        if name.endswith(".plan"):
+            a, b = json.loads(from_csv), json.loads(from_netcdf)
+            np.testing.assert_allclose(
+                [p for item in a["mission"]["items"] for p in item["params"] if p is not None],
+                [p for item in b["mission"]["items"] for p in item["params"] if p is not None],
+                rtol=1e-12,
+                atol=1e-12,
+            )
+        else:
+            assert from_csv == from_netcdf
+
+
+def _fails_cleanly(args: list[str], where: Path, capsys: pytest.CaptureFixture[str]) -> str:
+    before = sorted(p.name for p in where.iterdir())
+    assert main(args) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line.startswith("auvplan")
+    assert sorted(p.name for p in where.iterdir()) == before  # nothing written, no staging left
+    return line
+
+
+def test_export_user_errors(
+    planned_folder: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    missing = tmp_path / "nothing"
+    assert "not found" in _fails_cleanly(
+        ["export", str(missing), "--format", "gpx"], tmp_path, capsys
+    )
+    folder = tmp_path / "copy"
+    shutil.copytree(
+        planned_folder, folder, ignore=shutil.ignore_patterns("export", "trajectories*")
+    )
+    message = _fails_cleanly(["export", str(folder), "--format", "gpx,dxf"], folder, capsys)
+    assert "unknown export format 'dxf'" in message
+    message = _fails_cleanly(["export", str(folder), "--format", "gpx"], folder, capsys)
+    assert "holds no optimised plan" in message
+    assert _fails_cleanly(["export", str(tmp_path), "--format", "gpx"], tmp_path, capsys).endswith(
+        "(no summary.json)"
+    )
+    local = tmp_path / "local"
+    shutil.copytree(planned_folder, local, ignore=shutil.ignore_patterns("export"))
+    summary = json.loads((local / "summary.json").read_text())
+    summary["terrain"]["origin"] = {"north": 0.0, "east": 0.0}  # as on the synthetic bank
+    (local / "summary.json").write_text(json.dumps(summary))
+    assert "exports need lat/lon" in _fails_cleanly(
+        ["export", str(local), "--format", "kml"], local, capsys
+    )
+
+
+def test_plan_export_refuses_before_planning(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    mission = tmp_path / "mission.toml"
+    mission.write_text(MISSION.replace('file = "grid.nc"', "synthetic = true"))
+    message = _fails_cleanly(
+        ["plan", str(mission), "-o", str(tmp_path / "out"), "--export", "gpx"], tmp_path, capsys
+    )
+    assert "synthetic bank has no geographic reference" in message
+    message = _fails_cleanly(
+        [
+            "plan",
+            str(mission),
+            "-o",
+            str(tmp_path / "out"),
+            "--stage",
+            "preplan",
+            "--export",
+            "gpx",
+        ],
+        tmp_path,
+        capsys,
+    )
+    assert "--stage preplan" in message
+
+
+@pytest.mark.slow
+def test_monterey_example_exports_everything(monterey_folder: Path, tmp_path: Path) -> None:
+    """The issue's acceptance: the Monterey example's trajectories.nc is CF and every export is
+    written (each is read back by its reader in test_formats' slow variant)."""
+    findings = cf_findings(monterey_folder / "trajectories.nc", tmp_path / "cf.json")
+    assert findings["high"] == [], findings
+    names = {path.name for path in (monterey_folder / "export").iterdir()}
+    for vehicle in ("blue", "green"):
+        assert {f"{vehicle}.bhv", f"{vehicle}.plan", f"{vehicle}.imc.json"} <= names
+    assert {"origin.moos", "trajectories.gpx", "trajectories.kml", "trajectories.geojson"} <= names

@@ -1,0 +1,216 @@
+"""Every export format read back by an independent reader carries the waypoints and times."""
+
+from __future__ import annotations
+
+import math
+from datetime import datetime, timedelta
+from xml.etree import ElementTree
+
+import gpxpy
+import numpy as np
+import pytest
+from pyproj import Geod
+
+from auvplan.errors import InputError
+from auvplan.export import FORMATS, parse_formats, render_exports
+from auvplan.export.plan import CircleZone, ExportPlan, PolygonZone, file_stems
+from auvplan.export.waypoints import Waypoints, thin_track
+from auvplan.terrain import LocalProjection
+
+from ._readers import moos_points, parse_moos, validate_json
+
+TOLERANCE = 0.5
+GEOD = Geod(ellps="WGS84")
+KML = "{http://www.opengis.net/kml/2.2}"
+GX = "{http://www.google.com/kml/ext/2.2}"
+
+
+def _fleet(plan: ExportPlan) -> list[Waypoints]:
+    return [thin_track(track, TOLERANCE) for track in plan.tracks]
+
+
+def _render(plan: ExportPlan, name: str) -> dict[str, str]:
+    return render_exports(plan, [name], tolerance=TOLERANCE)
+
+
+def _distance_m(
+    lat_a: np.ndarray, lon_a: np.ndarray, lat_b: np.ndarray, lon_b: np.ndarray
+) -> np.ndarray:
+    return np.asarray(GEOD.inv(lon_a, lat_a, lon_b, lat_b)[2])
+
+
+def _times(plan: ExportPlan, waypoints: Waypoints) -> list[datetime]:
+    return [plan.start_time + timedelta(seconds=float(t)) for t in waypoints.time]
+
+
+def test_gpx_tracks_read_by_gpxpy(export_plan: ExportPlan) -> None:
+    text = _render(export_plan, "gpx")["trajectories.gpx"]
+    assert ElementTree.fromstring(text).tag == "{http://www.topografix.com/GPX/1/1}gpx"
+    gpx = gpxpy.parse(text)
+    assert gpx.version == "1.1"
+    assert len(gpx.tracks) == len(export_plan.tracks)
+    for track, waypoints in zip(gpx.tracks, _fleet(export_plan), strict=True):
+        assert track.name == waypoints.name  # "r&d <2>" escaped and read back
+        points = track.segments[0].points
+        lat = np.array([p.latitude for p in points])
+        lon = np.array([p.longitude for p in points])
+        assert np.max(_distance_m(lat, lon, waypoints.lat, waypoints.lon)) < 1e-3
+        assert [p.time for p in points] == _times(export_plan, waypoints)
+        assert {p.elevation for p in points} == {-export_plan.depth}
+
+
+def test_kml_timed_tracks_and_obstacle_outlines(export_plan: ExportPlan) -> None:
+    root = ElementTree.fromstring(_render(export_plan, "kml")["trajectories.kml"].encode())
+    assert root.tag == f"{KML}kml"
+    tracks = root.findall(f".//{GX}Track")
+    assert len(tracks) == len(export_plan.tracks)
+    names = [p.findtext(f"{KML}name") for p in root.iter(f"{KML}Placemark")]
+    for track, waypoints in zip(tracks, _fleet(export_plan), strict=True):
+        assert waypoints.name in names
+        when = [datetime.fromisoformat(w.text or "") for w in track.findall(f"{KML}when")]
+        coords = np.array([c.text.split() for c in track.findall(f"{GX}coord")], dtype=float)
+        assert when == _times(export_plan, waypoints)
+        assert np.max(_distance_m(coords[:, 1], coords[:, 0], waypoints.lat, waypoints.lon)) < 1e-6
+        np.testing.assert_array_equal(coords[:, 2], -export_plan.depth)
+    outlines = {
+        p.findtext(f"{KML}name"): np.array(
+            [c.split(",") for c in (p.findtext(f".//{KML}coordinates") or "").split()], dtype=float
+        )
+        for p in root.iter(f"{KML}Placemark")
+        if p.find(f".//{KML}Polygon") is not None
+    }
+    assert sorted(outlines) == sorted(zone.name for zone in export_plan.zones)
+    for zone in export_plan.zones:
+        ring = outlines[zone.name]
+        if isinstance(zone, CircleZone):
+            centre = (np.full(len(ring), zone.lat), np.full(len(ring), zone.lon))
+            radius = _distance_m(*centre, ring[:, 1], ring[:, 0])
+            np.testing.assert_allclose(radius, zone.radius, atol=1e-3)
+        else:
+            np.testing.assert_allclose(ring[:-1, 1], zone.lat)
+            np.testing.assert_allclose(ring[:-1, 0], zone.lon)
+
+
+def test_qgc_plans_for_ardusub(export_plan: ExportPlan) -> None:
+    files = _render(export_plan, "qgc")
+    stems = file_stems([track.name for track in export_plan.tracks])
+    assert sorted(files) == sorted(f"{stem}.plan" for stem in stems)
+    for stem, waypoints in zip(stems, _fleet(export_plan), strict=True):
+        document = validate_json(files[f"{stem}.plan"], "qgc_plan")
+        mission = document["mission"]
+        assert (mission["firmwareType"], mission["vehicleType"]) == (3, 12)
+        items = mission["items"]
+        assert [item["doJumpId"] for item in items] == list(range(1, len(items) + 1))
+        nav = [item for item in items if item["command"] == 16]
+        lat, lon = (np.array([item["params"][k] for item in nav]) for k in (4, 5))
+        assert np.max(_distance_m(lat, lon, waypoints.lat, waypoints.lon)) < 1e-6
+        assert all(item["frame"] == 3 and item["params"][6] == -export_plan.depth for item in nav)
+        # fly the items: hold, then each leg at the last commanded speed: the plan's times
+        speed, clock, arrivals, last = None, 0.0, [], None
+        for item in items:
+            if item["command"] == 178:
+                assert item["frame"] == 2
+                assert item["params"][0] == 1
+                speed = item["params"][1]
+                continue
+            if last is not None:
+                length = _distance_m(
+                    *(np.array([x["params"][k]]) for x in (last, item) for k in (4, 5))
+                )
+                clock += last["params"][0] + (float(length[0]) / speed if length[0] > 0 else 0.0)
+            arrivals.append(clock)
+            last = item
+        np.testing.assert_allclose(arrivals, waypoints.time - waypoints.time[0], atol=0.01)
+        fence = document["geoFence"]
+        assert not any(zone["inclusion"] for zone in fence["circles"] + fence["polygons"])
+        circles = [zone for zone in export_plan.zones if isinstance(zone, CircleZone)]
+        assert [(c["circle"]["center"], c["circle"]["radius"]) for c in fence["circles"]] == [
+            ([zone.lat, zone.lon], zone.radius) for zone in circles
+        ]
+        polygons = [zone for zone in export_plan.zones if isinstance(zone, PolygonZone)]
+        assert len(fence["polygons"]) == len(polygons)
+        for polygon, zone in zip(fence["polygons"], polygons, strict=True):
+            vertices = np.array(polygon["polygon"])  # [lat, lon], clockwise on the map
+            lat, lon = vertices[:, 0], vertices[:, 1]
+            assert np.dot(lon, np.roll(lat, -1)) - np.dot(lat, np.roll(lon, -1)) < 0.0
+            assert sorted(map(tuple, vertices)) == sorted(zip(zone.lat, zone.lon, strict=True))
+
+
+def test_imc_follow_trajectory_plans(export_plan: ExportPlan) -> None:
+    files = _render(export_plan, "imc")
+    stems = file_stems([track.name for track in export_plan.tracks])
+    for stem, waypoints in zip(stems, _fleet(export_plan), strict=True):
+        document = validate_json(files[f"{stem}.imc.json"], "imc_plan")
+        assert document["plan_id"] == waypoints.name
+        (maneuver,) = document["maneuvers"]
+        assert maneuver["maneuver_id"] == document["start_man_id"]
+        data = maneuver["data"]
+        lat_0, lon_0 = math.degrees(data["lat"]), math.degrees(data["lon"])
+        assert (data["z"], data["z_units"], data["speed_units"]) == (export_plan.depth, 1, 0)
+        points = data["points"]
+        np.testing.assert_allclose(np.cumsum([p["t"] for p in points]), waypoints.time)
+        lat, lon = LocalProjection(lat_0, lon_0).to_geographic(
+            np.array([p["x"] for p in points]), np.array([p["y"] for p in points])
+        )
+        assert np.max(_distance_m(lat, lon, waypoints.lat, waypoints.lon)) < 1e-6
+        assert data["timeout"] >= waypoints.time[-1]
+
+
+def test_moos_behaviours_and_origin(export_plan: ExportPlan) -> None:
+    files = _render(export_plan, "moos")
+    origin, _ = parse_moos(files["origin.moos"])
+    lat_0, lon_0 = float(origin["LatOrigin"]), float(origin["LongOrigin"])
+    assert (lat_0, lon_0) == pytest.approx(
+        (export_plan.origin_lat, export_plan.origin_lon), abs=1e-9
+    )
+    stems = file_stems([track.name for track in export_plan.tracks])
+    for stem, waypoints in zip(stems, _fleet(export_plan), strict=True):
+        settings, (block,) = parse_moos(files[f"{stem}.bhv"])
+        assert not settings
+        assert block["Behavior"] == "BHV_Waypoint"
+        assert block["condition"] == "DEPLOY = true"
+        assert float(block["capture_radius"]) == export_plan.capture_radius
+        assert float(block["slip_radius"]) > float(block["capture_radius"])
+        x, y = np.array(moos_points(block["points"])).T
+        lat, lon = LocalProjection(lat_0, lon_0).to_geographic(y, x)  # y north, x east
+        assert np.max(_distance_m(lat, lon, waypoints.lat, waypoints.lon)) < 0.01
+        duration = waypoints.time[-1] - waypoints.time[0]
+        length = np.sum(np.hypot(np.diff(x), np.diff(y)))
+        assert float(block["speed"]) == pytest.approx(length / duration, abs=1e-3)
+
+
+def test_geojson_trajectories(export_plan: ExportPlan) -> None:
+    document = validate_json(
+        _render(export_plan, "geojson")["trajectories.geojson"], "geojson_trajectories"
+    )
+    for feature, waypoints in zip(document["features"], _fleet(export_plan), strict=True):
+        properties = feature["properties"]
+        assert properties["name"] == waypoints.name
+        lon, lat = np.array(feature["geometry"]["coordinates"]).T
+        np.testing.assert_array_equal(lat, waypoints.lat)
+        np.testing.assert_array_equal(lon, waypoints.lon)
+        assert [datetime.fromisoformat(t) for t in properties["times"]] == _times(
+            export_plan, waypoints
+        )
+        np.testing.assert_array_equal(properties["t_s"], waypoints.time)
+        np.testing.assert_allclose(properties["leg_speed_m_s"], waypoints.leg_speeds)
+
+
+def test_every_format_renders_its_files(export_plan: ExportPlan) -> None:
+    files = set(render_exports(export_plan, FORMATS))
+    stems = file_stems([track.name for track in export_plan.tracks])
+    per_vehicle = {f"{stem}.{suffix}" for stem in stems for suffix in ("bhv", "plan", "imc.json")}
+    shared = {"origin.moos", "trajectories.gpx", "trajectories.kml", "trajectories.geojson"}
+    assert files == per_vehicle | shared
+
+
+def test_file_stems_are_safe_and_unique() -> None:
+    assert file_stems(["blue", "r&d <2>", "r&d_<2>", ".hidden"]) == (
+        "blue", "r_d__2_", "r_d__2_-2", "hidden",
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize("text", ["gpx,shp", "", " , "])
+def test_unknown_formats_are_named(text: str) -> None:
+    with pytest.raises(InputError, match="export format"):
+        parse_formats(text)

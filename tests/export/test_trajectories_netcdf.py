@@ -1,0 +1,55 @@
+"""``trajectories.nc`` without planning: true headings, terrain without georeference."""
+
+from __future__ import annotations
+
+from datetime import UTC, datetime
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from pyproj import Proj
+
+from auvplan.io.trajectories_file import SERIES, true_heading, write_trajectories_netcdf
+from auvplan.terrain import LocalProjection
+
+from ._readers import cf_findings
+
+
+def test_true_heading_adds_the_meridian_convergence() -> None:
+    """Oracle: PROJ's meridian convergence of the same transverse Mercator (km off its centre)."""
+    projection = LocalProjection(36.8, -121.8)
+    north = np.array([0.0, 0.0, 3000.0, -4000.0])
+    east = np.array([5000.0, -5000.0, 5000.0, 20.0])
+    lat, lon = projection.to_geographic(north, east)
+    tmerc = Proj("+proj=tmerc +lat_0=36.8 +lon_0=-121.8 +k=1 +x_0=0 +y_0=0 +ellps=WGS84")
+    convergence = tmerc.get_factors(lon, lat).meridian_convergence
+    assert np.max(np.abs(convergence)) > 0.03  # large enough to be seen
+    for psi_deg in (0.0, 45.0, 90.0, 200.0):
+        psi = np.full(4, np.radians(psi_deg))
+        expected = np.mod(psi_deg + convergence, 360.0)
+        np.testing.assert_allclose(true_heading(projection, north, east, psi), expected, atol=1e-6)
+    np.testing.assert_allclose(true_heading(None, north, east, np.full(4, -np.pi / 2)), 270.0)
+
+
+def test_without_georeference_the_file_has_no_lat_lon_and_is_still_cf(tmp_path: Path) -> None:
+    rng = np.random.default_rng(3)
+    time = np.arange(0.0, 10.5, 0.5)
+    series = {name: rng.normal(size=(2, time.size)) for name in SERIES}
+    psi = rng.uniform(-np.pi, np.pi, size=(2, time.size))
+    path = tmp_path / "trajectories.nc"
+    start = datetime(2026, 5, 1, 8, 0, 0, 500000, tzinfo=UTC)
+    write_trajectories_netcdf(
+        path, ["a", "b c"], time, series, psi=psi, start_time=start, depth=0.0, projection=None,
+        attributes={"history": "test"},
+    )  # fmt: skip
+    findings = cf_findings(path, tmp_path / "cf.json")
+    assert findings["high"] == [], findings
+    assert findings["medium"] == [], findings
+    with xr.open_dataset(path) as dataset:
+        assert "lat" not in dataset.variables
+        assert "lon" not in dataset.variables
+        assert list(dataset["trajectory"].values) == ["a", "b c"]
+        assert dataset["time"].values[1, 0] == np.datetime64("2026-05-01T08:00:00.500")
+        np.testing.assert_allclose(dataset["heading"].values, np.mod(np.degrees(psi), 360.0))
+        for name in SERIES:
+            np.testing.assert_array_equal(dataset[name].values, series[name])
