@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import hashlib
 import logging
-import os
 import shutil
 import subprocess
 import tempfile
@@ -21,18 +20,16 @@ from pathlib import Path
 
 import casadi as ca
 
+from auvplan.optimization._kernel_cache import cache_root
+
 __all__ = ["compile_functions", "default_cache_dir"]
 
 logger = logging.getLogger(__name__)
 
 
 def default_cache_dir() -> Path:
-    """``$AUVPLAN_CACHE_DIR``, else ``$XDG_CACHE_HOME/auvplan/casadi`` (``~/.cache`` default)."""
-    explicit = os.environ.get("AUVPLAN_CACHE_DIR")
-    if explicit:
-        return Path(explicit)
-    base = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
-    return base / "auvplan" / "casadi"
+    """The ``casadi`` folder of the cache root (:func:`~._kernel_cache.cache_root`)."""
+    return cache_root() / "casadi"
 
 
 def compile_functions(
