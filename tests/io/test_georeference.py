@@ -1,0 +1,154 @@
+"""Projected (UTM) grids, as GeoTIFF and as CF NetCDF, keep their georeference end to end.
+
+The inputs are made as a user's GIS would: a geographic grid (synthetic, or a window of the
+real Monterey grid) reprojected into UTM with rioxarray, written with ``rio.to_raster`` and
+as a CF NetCDF whose ``grid_mapping`` rioxarray writes. Read back, a lat/lon point must find
+the seabed depth it has in the geographic source.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import rasterio
+import rioxarray  # noqa: F401  (the .rio accessor)
+import xarray as xr
+from pyproj import CRS, Proj
+from rasterio.enums import Resampling
+from scipy.interpolate import RegularGridInterpolator
+
+from auvplan.errors import InputError
+from auvplan.io.bathymetry import read_bathymetry
+from auvplan.terrain import BathymetryGrid, LocalProjection
+
+# rioxarray computes transforms with the `*` operator that affine >= 2.4 deprecates.
+pytestmark = pytest.mark.filterwarnings("ignore:Use `@` matmul:PendingDeprecationWarning")
+
+UTM_29N, UTM_10N = "EPSG:32629", "EPSG:32610"
+
+#: Synthetic source: WGS 84 lon/lat nodes off Lisbon, about 22 m apart.
+LAT = 38.70 + 0.0002 * np.arange(101)
+LON = -9.20 + 0.00025 * np.arange(121)
+
+
+def synthetic_depth(lat: np.ndarray, lon: np.ndarray) -> np.ndarray:
+    """A sloping shelf [m] with a 300 m wide mound: depth 15 … 100 m over the area."""
+    north, east = (lat - 38.71) * 111_000.0, (lon + 9.185) * 86_800.0
+    return 60.0 + 0.03 * north - 0.02 * east + 8.0 * np.exp(-(north**2 + east**2) / 300.0**2)
+
+
+def geographic_elevation() -> xr.DataArray:
+    lat2, lon2 = np.meshgrid(LAT, LON, indexing="ij")
+    return xr.DataArray(
+        -synthetic_depth(lat2, lon2),
+        dims=("y", "x"),
+        coords={"y": LAT, "x": LON},
+        name="elevation",
+    ).rio.write_crs("EPSG:4326")
+
+
+def write_utm(elevation: xr.DataArray, utm: str, folder: Path) -> tuple[Path, Path]:
+    """``elevation`` reprojected to ``utm`` (bilinear), as a GeoTIFF and as a CF NetCDF."""
+    projected = elevation.rio.reproject(utm, resampling=Resampling.bilinear, nodata=np.nan)
+    tif, nc = folder / "utm.tif", folder / "utm.nc"
+    projected.rio.to_raster(tif)
+    projected.to_dataset(name="elevation").to_netcdf(nc)
+    return tif, nc
+
+
+def depth_at(grid: BathymetryGrid, lat: np.ndarray, lon: np.ndarray) -> np.ndarray:
+    """Bilinear depth [m] of ``grid`` at geographic points, through its own projection."""
+    assert grid.projection is not None
+    north, east = grid.projection.to_local(lat, lon)
+    interpolator = RegularGridInterpolator((grid.geometry.north, grid.geometry.east), grid.depth)
+    return np.asarray(interpolator(np.column_stack([north, east])))
+
+
+def test_utm_geotiff_and_cf_netcdf_keep_their_crs_and_depths(
+    tmp_path: Path, rng: np.random.Generator
+) -> None:
+    tif, nc = write_utm(geographic_elevation(), UTM_29N, tmp_path)
+    with xr.open_dataset(nc) as ds:  # the NetCDF holds a CF grid mapping, not a GeoTIFF tag
+        assert ds["elevation"].attrs["grid_mapping"] == "spatial_ref"
+        assert ds["spatial_ref"].attrs["grid_mapping_name"] == "transverse_mercator"
+    lat, lon = rng.uniform(38.703, 38.717, 500), rng.uniform(-9.195, -9.175, 500)
+    truth = synthetic_depth(lat, lon)
+    for path in (tif, nc):
+        grid = read_bathymetry(path)
+        assert CRS(grid.attributes["crs"]) == CRS(UTM_29N)  # the source CRS, kept
+        assert grid.projection is not None
+        assert LocalProjection.from_crs(grid.projection.crs) == grid.projection
+        # 22 m nodes resampled twice (to UTM, then to the local frame): centimetres of
+        # interpolation error over a 0.036 m/m slope, where one cell of misplacement is 0.8 m.
+        error = np.abs(depth_at(grid, lat, lon) - truth)
+        assert error.max() < 0.1, path.name
+        assert np.median(error) < 0.01, path.name
+        # The local frame is metric: its spacing is the UTM spacing over the UTM point scale.
+        with rasterio.open(tif) as source:
+            utm_spacing = source.res[1]
+        scale = Proj(UTM_29N).get_factors(-9.185, 38.71).meridional_scale
+        assert grid.geometry.spacing_north == pytest.approx(utm_spacing / scale, rel=1e-5)
+
+
+def test_utm_grid_is_read_like_its_geographic_source(tmp_path: Path) -> None:
+    geographic = tmp_path / "geographic.nc"
+    geographic_elevation().to_dataset().to_netcdf(geographic)
+    tif, _ = write_utm(geographic_elevation(), UTM_29N, tmp_path)
+    source, utm = read_bathymetry(geographic), read_bathymetry(tif)
+    assert source.projection is not None
+    north, east = np.meshgrid(source.geometry.north[2:-2], source.geometry.east[2:-2])
+    lat, lon = source.projection.to_geographic(north.ravel(), east.ravel())
+    error = np.abs(depth_at(utm, lat, lon) - depth_at(source, lat, lon))
+    assert error.max() < 0.1
+    # A lat/lon window selects the same area in both.
+    window = {"window_lat": (38.705, 38.715), "window_lon": (-9.19, -9.18)}
+    a, b = read_bathymetry(geographic, **window), read_bathymetry(tif, **window)
+    assert a.projection is not None
+    assert b.projection is not None
+    for grid in (a, b):
+        corners = grid.projection.to_geographic(  # type: ignore[union-attr]
+            np.array([0.0, grid.geometry.north[-1]]), np.array([0.0, grid.geometry.east[-1]])
+        )
+        np.testing.assert_allclose(corners[0], [38.705, 38.715], atol=0.0003)
+        np.testing.assert_allclose(corners[1], [-9.19, -9.18], atol=0.0004)
+
+
+def test_real_grid_window_reprojected_to_utm(
+    tmp_path: Path, bathymetry_dir: Path, rng: np.random.Generator
+) -> None:
+    """Monterey canyon head (10 m nodes, 170 m of relief) through UTM zone 10N and back."""
+    with xr.open_dataset(bathymetry_dir / "monterey_canyon_head_ncei_13arcsec.nc") as ds:
+        window = ds.isel(lat=slice(40, 140), lon=slice(60, 180)).load()
+    geographic = tmp_path / "window.nc"
+    window.to_netcdf(geographic)
+    elevation = window["elevation"].astype(np.float64).rename(lat="y", lon="x")
+    tif, nc = write_utm(elevation.rio.write_crs("EPSG:4326"), UTM_10N, tmp_path)
+    source = read_bathymetry(geographic)
+    assert source.projection is not None
+    north = rng.uniform(100.0, source.geometry.north[-1] - 100.0, 1000)
+    east = rng.uniform(100.0, source.geometry.east[-1] - 100.0, 1000)
+    lat, lon = source.projection.to_geographic(north, east)
+    expected = depth_at(source, lat, lon)
+    for path in (tif, nc):
+        grid = read_bathymetry(path)
+        assert CRS(grid.attributes["crs"]) == CRS(UTM_10N)
+        error = np.abs(depth_at(grid, lat, lon) - expected)
+        # Interpolation on canyon walls of up to 10 m per cell: a median of 0.13 m and at
+        # most 2.4 m; the same grid misplaced by one cell (10 m) differs by 1.9 m in median.
+        assert np.median(error) < 0.3, path.name
+        assert error.max() < 4.0, path.name
+
+
+def test_metric_grid_without_crs_has_no_georeference(tmp_path: Path) -> None:
+    path = tmp_path / "local.nc"
+    xr.Dataset(
+        {"depth": (("y", "x"), np.full((4, 5), 30.0))},
+        {"y": ("y", 100.0 * np.arange(4), {"units": "m"}), "x": ("x", 50.0 * np.arange(5))},
+    ).to_netcdf(path)
+    grid = read_bathymetry(path)
+    assert grid.projection is None
+    assert "crs" not in grid.attributes
+    with pytest.raises(InputError, match="needs a grid with a geographic or projected CRS"):
+        read_bathymetry(path, window_lat=(1.0, 2.0))
