@@ -19,8 +19,10 @@ from pyproj import CRS, Proj
 from rasterio.enums import Resampling
 from scipy.interpolate import RegularGridInterpolator
 
+from auvplan.cli.main import main
 from auvplan.errors import InputError
 from auvplan.io.bathymetry import read_bathymetry
+from auvplan.io.maps_file import read_maps_netcdf
 from auvplan.terrain import BathymetryGrid, LocalProjection
 
 # rioxarray computes transforms with the `*` operator that affine >= 2.4 deprecates.
@@ -152,3 +154,46 @@ def test_metric_grid_without_crs_has_no_georeference(tmp_path: Path) -> None:
     assert "crs" not in grid.attributes
     with pytest.raises(InputError, match="needs a grid with a geographic or projected CRS"):
         read_bathymetry(path, window_lat=(1.0, 2.0))
+
+
+def test_plan_on_a_utm_geotiff_with_lat_lon_poses(tmp_path: Path) -> None:
+    """``auvplan plan`` end to end: lat/lon start and goal on a UTM survey grid.
+
+    A 60 m x 45 m leg over a 300 m x 330 m grid of 5.5 m nodes (a small, fast mission).
+    """
+    lat = 38.705 + 0.00005 * np.arange(61)
+    lon = -9.19 + 0.0000625 * np.arange(81)
+    lat2, lon2 = np.meshgrid(lat, lon, indexing="ij")
+    elevation = xr.DataArray(
+        -synthetic_depth(lat2, lon2), dims=("y", "x"), coords={"y": lat, "x": lon}
+    ).rio.write_crs("EPSG:4326")
+    tif, _ = write_utm(elevation, UTM_29N, tmp_path)
+    start, goal = (38.7060, -9.1880), (38.7064, -9.1879)
+    mission = tmp_path / "mission.toml"
+    mission.write_text(
+        f'[terrain]\nfile = "{tif.name}"\n[fleet]\nhorizon_s = 120.0\nsafety_radius_m = 5.0\n'
+        f'[[vehicle]]\nname = "blue"\n'
+        f"start = {{ lat = {start[0]}, lon = {start[1]}, heading_deg = 0.0, speed = 0.5 }}\n"
+        f"goal = {{ lat = {goal[0]}, lon = {goal[1]}, heading_deg = 0.0 }}\n"
+        "[solver]\ndt_s = 0.5\n"
+    )
+    out = tmp_path / "out"
+    assert main(["-q", "plan", str(mission), "-o", str(out), "--no-figures"]) == 0
+    maps = read_maps_netcdf(out / "maps.nc")
+    projection = maps.bathymetry.projection
+    assert projection is not None
+    with xr.open_dataset(out / "maps.nc", decode_coords="all") as ds:
+        assert CRS(ds["depth"].rio.crs) == projection.crs
+    # The seabed under the planned start and goal is the source's seabed at those lat/lon.
+    rows = np.genfromtxt(out / "trajectories.csv", delimiter=",", names=True, dtype=None)
+    first, last = rows[0], rows[-1]
+    for (north, east), (point_lat, point_lon) in (
+        ((first["north"], first["east"]), start),
+        ((last["north"], last["east"]), goal),
+    ):
+        lat_back, lon_back = projection.to_geographic(np.array([north]), np.array([east]))
+        assert float(lat_back[0]) == pytest.approx(point_lat, abs=2e-6)  # 0.2 m
+        assert float(lon_back[0]) == pytest.approx(point_lon, abs=2e-6)
+        assert depth_at(maps.bathymetry, lat_back, lon_back)[0] == pytest.approx(
+            synthetic_depth(np.array(point_lat), np.array(point_lon)), abs=0.05
+        )

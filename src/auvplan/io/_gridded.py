@@ -52,7 +52,8 @@ def read_netcdf(path: Path) -> Raster:
     with dataset:
         data_name = _pick_data_variable(dataset)
         data = dataset[data_name].squeeze(drop=True)
-        north_var, east_var, is_latlon = _horizontal_axes(dataset, data, data_name)
+        north_name, east_name, is_latlon = _horizontal_axes(dataset, data, data_name)
+        north_var, east_var = dataset.variables[north_name], dataset.variables[east_name]
         values = np.asarray(
             data.transpose(north_var.dims[0], east_var.dims[0]).values, dtype=np.float64
         )
@@ -71,8 +72,11 @@ def read_netcdf(path: Path) -> Raster:
         north_axis = np.asarray(north_var.values, dtype=np.float64)
         east_axis = np.asarray(east_var.values, dtype=np.float64)
         crs = grid_mapping_crs(dataset, data)
-        if crs is None and _is_geographic(east_var, is_latlon, north_axis, east_axis):
-            crs = CRS(GEOGRAPHIC_CRS)
+        is_local = (north_name, east_name) == (_NORTH_NAME, _EAST_NAME)
+        if crs is None and not is_local:
+            units = str(east_var.attrs.get("units", "")).lower()
+            if _is_geographic(units, is_latlon, north_axis, east_axis):
+                crs = CRS(GEOGRAPHIC_CRS)
     values, north_axis, east_axis = increasing(values, north_axis, east_axis)
     return Raster(values, north_axis, east_axis, crs, is_depth, attributes)
 
@@ -98,8 +102,8 @@ def _pick_data_variable(dataset: xr.Dataset) -> str:
 
 def _horizontal_axes(
     dataset: xr.Dataset, data: xr.DataArray, data_name: str
-) -> tuple[xr.Variable, xr.Variable, bool]:
-    """The 1-D (north-like, east-like) axes of ``data``, and whether they are lat/lon."""
+) -> tuple[str, str, bool]:
+    """Names of the 1-D (north-like, east-like) axes of ``data``; True if they are lat/lon."""
     import cf_xarray  # noqa: F401  (registers the .cf accessor)
     import xarray as xr
 
@@ -124,7 +128,7 @@ def _horizontal_axes(
             f"{data.dims} of {data_name}; has {sorted(map(str, dataset.variables))}"
         )
     north_name, east_name = pairs[0]
-    return along[north_name], along[east_name], north_name in latitude and east_name in longitude
+    return north_name, east_name, north_name in latitude and east_name in longitude
 
 
 def grid_mapping_crs(dataset: xr.Dataset, data: xr.DataArray) -> CRS | None:
@@ -144,14 +148,14 @@ def grid_mapping_crs(dataset: xr.Dataset, data: xr.DataArray) -> CRS | None:
 
 
 def _is_geographic(
-    east_var: xr.Variable, is_latlon: bool, north_axis: FloatArray, east_axis: FloatArray
+    units: str, is_latlon: bool, north_axis: FloatArray, east_axis: FloatArray
 ) -> bool:
-    """Whether the axes are latitude/longitude, without a CRS to say so.
+    """Whether axes other than auvplan's ``north``/``east`` are latitude/longitude.
 
-    True when cf_xarray named them latitude/longitude (attributes or names), when their units
-    are degrees, or when unit-less values fit the lat/lon ranges with a step below 0.05.
+    True when cf_xarray named them latitude/longitude (attributes or names), when the east
+    axis ``units`` are degrees, or when unit-less values fit the lat/lon ranges with a step
+    below 0.05 (:func:`~auvplan.io._raster.looks_geographic`).
     """
-    units = str(east_var.attrs.get("units", "")).lower()
     return (
         is_latlon
         or "deg" in units
