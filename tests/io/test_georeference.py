@@ -105,8 +105,10 @@ def test_utm_grid_is_read_like_its_geographic_source(tmp_path: Path) -> None:
     error = np.abs(depth_at(utm, lat, lon) - depth_at(source, lat, lon))
     assert error.max() < 0.1
     # A lat/lon window selects the same area in both.
-    window = {"window_lat": (38.705, 38.715), "window_lon": (-9.19, -9.18)}
-    a, b = read_bathymetry(geographic, **window), read_bathymetry(tif, **window)
+    a, b = (
+        read_bathymetry(path, window_lat=(38.705, 38.715), window_lon=(-9.19, -9.18))
+        for path in (geographic, tif)
+    )
     assert a.projection is not None
     assert b.projection is not None
     for grid in (a, b):

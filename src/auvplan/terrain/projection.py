@@ -138,15 +138,23 @@ class LocalProjection:
     def from_crs(cls, crs: CRS) -> LocalProjection | None:
         """The local frame that ``crs`` is, or None if it is not one.
 
-        A CRS is a local frame when it is a transverse Mercator with scale factor 1 on a
-        known ellipsoid, such as :attr:`crs` (e.g. read back from a CF ``grid_mapping``).
-        Its parameters are those of the CRS (PROJ keeps 15 significant digits).
+        ``crs`` is a local frame when it is equivalent (PROJ) to the :attr:`crs` of some
+        LocalProjection: a transverse Mercator with scale factor 1 whose datum is WGS 84 (or
+        an unnamed datum on a PROJ ellipsoid), e.g. read back from a CF ``grid_mapping``. A
+        transverse Mercator on another datum (ETRS89, a Gauss-Krüger zone on DHDN) is not one:
+        taking it as one would drop its datum shift to WGS 84.
+
+        Examples
+        --------
+        >>> LocalProjection.from_crs(CRS("EPSG:31467")) is None  # DHDN / 3-degree GK zone 3
+        True
         """
         parameters = _frame_parameters(crs)
         ellipsoid = _ellipsoid_name(crs)
         if parameters is None or ellipsoid is None:
             return None
-        return cls(*parameters, ellipsoid)
+        candidate = cls(*parameters, ellipsoid)
+        return candidate if candidate.crs.equals(crs, ignore_axis_order=True) else None
 
 
 _PARAMETER_NAMES: Final = ("lat_0", "lon_0", "offset_north", "offset_east")
