@@ -15,7 +15,7 @@ import pytest
 import rasterio
 import rioxarray  # noqa: F401  (the .rio accessor)
 import xarray as xr
-from pyproj import CRS, Proj
+from pyproj import CRS, Proj, Transformer
 from rasterio.enums import Resampling
 from scipy.interpolate import RegularGridInterpolator
 
@@ -199,3 +199,39 @@ def test_plan_on_a_utm_geotiff_with_lat_lon_poses(tmp_path: Path) -> None:
         assert depth_at(maps.bathymetry, lat_back, lon_back)[0] == pytest.approx(
             synthetic_depth(np.array(point_lat), np.array(point_lon)), abs=0.05
         )
+
+
+def test_cf_grid_mapping_parameters_without_wkt(tmp_path: Path) -> None:
+    """A Lambert conformal conic grid described only by CF grid-mapping parameters."""
+    mapping = {
+        "grid_mapping_name": "lambert_conformal_conic",
+        "standard_parallel": [38.0, 40.0],
+        "longitude_of_central_meridian": -9.0,
+        "latitude_of_projection_origin": 39.0,
+        "false_easting": 0.0,
+        "false_northing": 0.0,
+        "semi_major_axis": 6378137.0,
+        "inverse_flattening": 298.257223563,
+    }
+    y = -30_000.0 + 20.0 * np.arange(40)
+    x = -12_000.0 + 25.0 * np.arange(50)
+    plane = 50.0 + 0.02 * (y[:, None] - y[0]) - 0.01 * (x - x[0])
+    path = tmp_path / "lcc.nc"
+    xr.Dataset(
+        {"depth": (("y", "x"), plane, {"units": "m", "grid_mapping": "lambert"})},
+        {
+            "y": ("y", y, {"standard_name": "projection_y_coordinate", "units": "m"}),
+            "x": ("x", x, {"standard_name": "projection_x_coordinate", "units": "m"}),
+            "lambert": ((), 0, mapping),
+        },
+    ).to_netcdf(path)
+    grid = read_bathymetry(path)
+    assert grid.projection is not None
+    assert CRS(grid.attributes["crs"]).to_cf()["grid_mapping_name"] == "lambert_conformal_conic"
+    north, east = np.meshgrid(grid.geometry.north, grid.geometry.east, indexing="ij")
+    lcc = CRS.from_cf(mapping)
+    to_lcc = Transformer.from_crs(grid.projection.crs, lcc, always_xy=True)
+    node_x, node_y = to_lcc.transform(east, north)
+    expected = 50.0 + 0.02 * (node_y - y[0]) - 0.01 * (node_x - x[0])
+    assert grid.geometry.shape == (39, 49)  # the inscribed rectangle of the rotated source
+    np.testing.assert_allclose(grid.depth, expected, atol=0.01)
