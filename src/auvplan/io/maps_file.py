@@ -129,12 +129,13 @@ def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
     if projection is not None:
         dataset = _georeference(dataset, projection, fine, coarse)
     # Encodings replace those set by rioxarray (the grid_mapping reference): merge them.
+    compressed = {"zlib": True, "complevel": 4}
     encoding: dict[str, dict[str, object]] = {
-        name: {**dataset[name].encoding, "zlib": True, "complevel": 4} for name in data_vars
+        str(name): {**variable.encoding, **(compressed if variable.ndim == 2 else {})}
+        for name, variable in dataset.variables.items()
     }
-    encoding.update(
-        {str(name): {**dataset[name].encoding, "_FillValue": None} for name in dataset.coords}
-    )
+    for name in dataset.coords:  # CF: no _FillValue on coordinates
+        encoding[str(name)]["_FillValue"] = None
     if GRID_MAPPING in dataset.coords:
         encoding[GRID_MAPPING]["dtype"] = "int32"  # CF 1.8 has no 64-bit integers
     dataset.to_netcdf(path, format="NETCDF4", engine="netcdf4", encoding=encoding)
