@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
 import pytest
+import rioxarray  # noqa: F401  (the .rio accessor)
 import xarray as xr
+from pyproj import CRS
 
 from auvplan.errors import DataFormatError
 from auvplan.io.bathymetry import read_bathymetry
@@ -57,8 +60,72 @@ def test_layout_and_cf_attributes(tmp_path: Path, maps_with_projection: TerrainM
         assert attrs["source"] == "test grid"
         assert (attrs["information_exponent"], attrs["omega"], attrs["weight"]) == (2.0, 3.0, 7.0)
         assert (attrs["block_north"], attrs["block_east"]) == (2, 3)
-        assert attrs["projection_lat_0"] == 36.8
-        assert attrs["projection_offset_east"] == -60.0
+        # CF-1.8: coordinate variables without _FillValue, projected standard names, and
+        # the local frame as a grid mapping variable referenced by every data variable.
+        for name in ("north", "east", "north_block", "east_block", "lat", "lon"):
+            assert "_FillValue" not in ds[name].encoding, name
+        assert ds["north"].attrs["standard_name"] == "projection_y_coordinate"
+        assert ds["east"].attrs["standard_name"] == "projection_x_coordinate"
+        for name in ("depth", "information", "excitation", "cost", "shifted_cost"):
+            assert ds[name].attrs["grid_mapping"] == "crs"
+        mapping = ds["crs"].attrs
+        assert mapping["grid_mapping_name"] == "transverse_mercator"
+        assert mapping["scale_factor_at_central_meridian"] == 1.0
+        assert (mapping["latitude_of_projection_origin"], mapping["false_easting"]) == (36.8, 60.0)
+        assert CRS.from_cf(mapping) == maps.bathymetry.projection.crs  # type: ignore[union-attr]
+        # 2-D lat/lon auxiliary coordinates [deg] of every node.
+        geometry = maps.bathymetry.geometry
+        north, east = np.meshgrid(geometry.north, geometry.east, indexing="ij")
+        lat, lon = maps.bathymetry.projection.to_geographic(north, east)  # type: ignore[union-attr]
+        np.testing.assert_array_equal(ds["lat"].values, lat)
+        np.testing.assert_array_equal(ds["lon"].values, lon)
+        assert ds["lat_block"].shape == maps.cost.shape
+
+
+def test_rioxarray_places_the_maps(tmp_path: Path, maps_with_projection: TerrainMaps) -> None:
+    maps = maps_with_projection
+    path = write_maps_netcdf(maps, tmp_path / "maps.nc")
+    projection = maps.bathymetry.projection
+    assert projection is not None
+    with xr.open_dataset(path, decode_coords="all") as ds:
+        for name, geometry in (("depth", maps.bathymetry.geometry), ("cost", maps.cost_geometry)):
+            raster = ds[name].rio
+            assert raster.crs is not None
+            assert CRS(raster.crs) == projection.crs
+            west, south, east, north = raster.bounds()
+            assert (south, north) == pytest.approx(geometry.north_bounds, abs=1e-9)
+            assert (west, east) == pytest.approx(geometry.east_bounds, abs=1e-9)
+
+
+def test_cf_compliance_checker_finds_no_error(
+    tmp_path: Path, maps_with_projection: TerrainMaps
+) -> None:
+    """IOOS compliance checker, CF 1.8: no high-priority failure, georeferenced or not.
+
+    Medium priority, left: with a grid mapping the checker accepts one variable per
+    standard name ``projection_x/y_coordinate``, so ``north_block``/``east_block`` carry
+    only ``axis`` and it takes them for latitude/longitude without degree units (2 warnings).
+    """
+    compliance_checker = pytest.importorskip("compliance_checker.runner")
+    georeferenced = write_maps_netcdf(maps_with_projection, tmp_path / "geo.nc")
+    local = write_maps_netcdf(compute_terrain_maps(synthetic_bank()), tmp_path / "local.nc")
+    runner = compliance_checker.ComplianceChecker
+    compliance_checker.CheckSuite.load_all_available_checkers()
+    for path, n_medium in ((georeferenced, 2), (local, 0)):
+        report = tmp_path / f"{path.stem}.json"
+        runner.run_checker(
+            str(path), ["cf:1.8"], 0, "normal", output_filename=str(report), output_format="json"
+        )
+        results = json.loads(report.read_text())["cf:1.8"]
+        failed = {
+            priority: [r for r in results[priority] if r["value"][0] < r["value"][1]]
+            for priority in ("high_priorities", "medium_priorities")
+        }
+        assert failed["high_priorities"] == []
+        messages = [m for r in failed["medium_priorities"] for m in r["msgs"]]
+        assert len(messages) == n_medium, messages
+        assert all("_block' should define valid units" in m for m in messages)
+        assert len(results["high_priorities"]) > 10  # the checks did run
 
 
 def test_round_trip(tmp_path: Path, maps_with_projection: TerrainMaps) -> None:

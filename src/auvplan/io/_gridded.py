@@ -7,30 +7,42 @@ for the conversion in :mod:`auvplan.io.bathymetry`.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Hashable
 from typing import TYPE_CHECKING
 
 import numpy as np
+from pyproj import CRS
 
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError
 from auvplan.io._raster import Raster, first_line, increasing, looks_geographic
-from auvplan.terrain.projection import LocalProjection
+from auvplan.terrain.projection import GEOGRAPHIC_CRS
 
 if TYPE_CHECKING:
     from pathlib import Path
 
     import xarray as xr
 
-_LAT_NAMES = ("lat", "latitude", "y")
-_LON_NAMES = ("lon", "longitude", "x")
+#: Preferred names of the elevation/depth variable when a file holds several 2-D variables.
 _DATA_NAMES = ("depth", "elevation", "z", "Band1", "topo", "height", "bathymetry", "altitude")
+
+#: Names of auvplan's own local-frame axes (``maps.nc`` and metric grids), known without
+#: attributes; any other axis is recognised by cf_xarray (attributes, then names).
+_NORTH_NAME, _EAST_NAME = "north", "east"
 
 
 # --- NetCDF --------------------------------------------------------------------------------
 
 
 def read_netcdf(path: Path) -> Raster:
+    """Read the elevation/depth variable of a NetCDF file, its axes and its CRS.
+
+    The variable is the one 2-D variable (after dropping singleton dimensions), or the first
+    of :data:`_DATA_NAMES` among several. Its axes are the 1-D variables along its two
+    dimensions, told apart by cf_xarray (``axis``, ``standard_name``, ``units``, then names
+    such as ``lat``/``lon``/``y``/``x``). The CRS is the CF ``grid_mapping`` of the variable
+    (:meth:`pyproj.CRS.from_cf`, which also reads ``crs_wkt`` and GDAL's ``spatial_ref``);
+    without one, latitude/longitude axes are WGS 84 and metric axes have no georeference.
+    """
     import xarray as xr
 
     try:
@@ -38,37 +50,13 @@ def read_netcdf(path: Path) -> Raster:
     except (OSError, ValueError, RuntimeError, TypeError, KeyError) as error:
         raise DataFormatError(f"unreadable NetCDF ({first_line(error)})") from None
     with dataset:
-        names = set(dataset.variables)
-        if {"north", "east"} <= names:
-            lat_name, lon_name, is_geographic = "north", "east", False
-        else:
-            lat_name = next((n for n in _LAT_NAMES if n in names), "")
-            lon_name = next((n for n in _LON_NAMES if n in names), "")
-            if not lat_name or not lon_name:
-                raise DataFormatError(
-                    "no lat/lon (or north/east) coordinate variables; "
-                    f"has {sorted(map(str, names))}"
-                )
-            units = str(dataset[lon_name].attrs.get("units", "")).lower()
-            # Without units, variables named lat/lon are geographic; x/y are if they look so.
-            is_geographic = "deg" in units or (
-                units in ("", "1")
-                and (
-                    (lat_name, lon_name) != ("y", "x")
-                    or looks_geographic(dataset[lat_name].values, dataset[lon_name].values)
-                )
-            )
-        lat_var, lon_var = dataset[lat_name], dataset[lon_name]
-        if lat_var.ndim != 1 or lon_var.ndim != 1:
-            raise DataFormatError(f"coordinates {lat_name}/{lon_name} must be 1-D")
-        lat_dim, lon_dim = lat_var.dims[0], lon_var.dims[0]
-        data_name = _pick_data_variable(dataset, lat_dim, lon_dim)
+        data_name = _pick_data_variable(dataset)
         data = dataset[data_name].squeeze(drop=True)
-        if set(data.dims) != {lat_dim, lon_dim}:
-            raise DataFormatError(
-                f"variable {data_name} has dimensions {data.dims}, not ({lat_dim}, {lon_dim})"
-            )
-        values = np.asarray(data.transpose(lat_dim, lon_dim).values, dtype=np.float64)
+        north_name, east_name, is_latlon = _horizontal_axes(dataset, data, data_name)
+        north_var, east_var = dataset.variables[north_name], dataset.variables[east_name]
+        values = np.asarray(
+            data.transpose(north_var.dims[0], east_var.dims[0]).values, dtype=np.float64
+        )
         positive = str(data.attrs.get("positive", "")).lower()
         is_depth: bool | None = (
             True
@@ -77,56 +65,102 @@ def read_netcdf(path: Path) -> Raster:
             if data_name == "elevation" or positive == "up"
             else None
         )
-        attributes = {"variable": str(data_name)}
+        attributes = {"variable": data_name}
         for key in ("title", "source", "license"):
             if key in dataset.attrs:
                 attributes[key] = first_line(dataset.attrs[key])
-        projection = _projection_from_attributes(dict(dataset.attrs)) if not is_geographic else None
-        north_axis = np.asarray(lat_var.values, dtype=np.float64)
-        east_axis = np.asarray(lon_var.values, dtype=np.float64)
+        north_axis = np.asarray(north_var.values, dtype=np.float64)
+        east_axis = np.asarray(east_var.values, dtype=np.float64)
+        crs = grid_mapping_crs(dataset, data)
+        is_local = (north_name, east_name) == (_NORTH_NAME, _EAST_NAME)
+        if crs is None and not is_local:
+            units = str(east_var.attrs.get("units", "")).lower()
+            if _is_geographic(units, is_latlon, north_axis, east_axis):
+                crs = CRS(GEOGRAPHIC_CRS)
     values, north_axis, east_axis = increasing(values, north_axis, east_axis)
-    return Raster(
-        values,
-        north_axis,
-        east_axis,
-        is_geographic,
-        is_depth,
-        projection,
-        None if projection is None else projection.to_local,
-        attributes,
-    )
+    return Raster(values, north_axis, east_axis, crs, is_depth, attributes)
 
 
-def _pick_data_variable(dataset: xr.Dataset, lat_dim: Hashable, lon_dim: Hashable) -> str:
+def _pick_data_variable(dataset: xr.Dataset) -> str:
     candidates = [
         str(name)
         for name, variable in dataset.data_vars.items()
-        if {lat_dim, lon_dim} <= set(variable.dims)
-        and variable.size == (dataset.sizes[lat_dim] * dataset.sizes[lon_dim])
+        if sum(size > 1 for size in variable.shape) == 2
     ]
     for name in _DATA_NAMES:
         if name in candidates:
             return name
     if len(candidates) == 1:
         return candidates[0]
-    raise DataFormatError(
-        f"cannot tell the elevation/depth variable on ({lat_dim}, {lon_dim}) among {candidates}"
-    )
+    if not candidates:
+        raise DataFormatError(
+            "no 2-D elevation/depth variable on lat/lon (or north/east, y/x) coordinate "
+            f"variables; has {sorted(map(str, dataset.variables))}"
+        )
+    raise DataFormatError(f"cannot tell the elevation/depth variable among {candidates}")
 
 
-def _projection_from_attributes(attributes: dict[str, object]) -> LocalProjection | None:
-    """The LocalProjection recorded by :func:`auvplan.io.maps_file.write_maps_netcdf`."""
-    keys = (
-        "projection_lat_0",
-        "projection_lon_0",
-        "projection_offset_north",
-        "projection_offset_east",
-    )
-    if not all(key in attributes for key in keys):
+def _horizontal_axes(
+    dataset: xr.Dataset, data: xr.DataArray, data_name: str
+) -> tuple[str, str, bool]:
+    """Names of the 1-D (north-like, east-like) axes of ``data``; True if they are lat/lon."""
+    import cf_xarray  # noqa: F401  (registers the .cf accessor)
+    import xarray as xr
+
+    along = {
+        str(name): variable
+        for name, variable in dataset.variables.items()
+        if variable.ndim == 1 and variable.dims[0] in data.dims
+    }
+    probe = xr.Dataset(coords=along).cf.guess_coord_axis()
+    latitude = probe.cf.coordinates.get("latitude", [])
+    longitude = probe.cf.coordinates.get("longitude", [])
+    north = [
+        *latitude,
+        *probe.cf.axes.get("Y", []),
+        *([_NORTH_NAME] if _NORTH_NAME in along else []),
+    ]
+    east = [*longitude, *probe.cf.axes.get("X", []), *([_EAST_NAME] if _EAST_NAME in along else [])]
+    pairs = [(n, e) for n in north for e in east if along[n].dims[0] != along[e].dims[0]]
+    if not pairs:
+        raise DataFormatError(
+            f"no lat/lon (or north/east, y/x) coordinate variables along the dimensions "
+            f"{data.dims} of {data_name}; has {sorted(map(str, dataset.variables))}"
+        )
+    north_name, east_name = pairs[0]
+    return north_name, east_name, north_name in latitude and east_name in longitude
+
+
+def grid_mapping_crs(dataset: xr.Dataset, data: xr.DataArray) -> CRS | None:
+    """The CRS of the CF ``grid_mapping`` variable of ``data``, if it names one that exists."""
+    from pyproj.exceptions import CRSError
+
+    reference = str(data.attrs.get("grid_mapping", data.encoding.get("grid_mapping", "")))
+    name = reference.split(":", 1)[0].strip()  # also the extended form "crs: x y"
+    if not name or name not in dataset.variables:
         return None
-    lat_0, lon_0, offset_north, offset_east = (float(attributes[k]) for k in keys)  # type: ignore[arg-type]
-    ellipsoid = str(attributes.get("projection_ellipsoid", "WGS84"))
-    return LocalProjection(lat_0, lon_0, offset_north, offset_east, ellipsoid)
+    try:
+        return CRS.from_cf(dict(dataset[name].attrs))
+    except (CRSError, KeyError, ValueError) as error:
+        raise DataFormatError(
+            f"grid_mapping variable {name} is not a usable CRS ({first_line(error)})"
+        ) from None
+
+
+def _is_geographic(
+    units: str, is_latlon: bool, north_axis: FloatArray, east_axis: FloatArray
+) -> bool:
+    """Whether axes other than auvplan's ``north``/``east`` are latitude/longitude.
+
+    True when cf_xarray named them latitude/longitude (attributes or names), when the east
+    axis ``units`` are degrees, or when unit-less values fit the lat/lon ranges with a step
+    below 0.05 (:func:`~auvplan.io._raster.looks_geographic`).
+    """
+    return (
+        is_latlon
+        or "deg" in units
+        or (units in ("", "1") and looks_geographic(north_axis, east_axis))
+    )
 
 
 # --- GeoTIFF and ESRI ASCII grid -----------------------------------------------------------
@@ -151,19 +185,10 @@ def read_rasterio(path: Path) -> Raster:
     east_axis = transform.c + transform.a * (np.arange(n_cols) + 0.5)
     north_axis = transform.f + transform.e * (np.arange(n_rows) + 0.5)
     values, north_axis, east_axis = increasing(values, north_axis, east_axis)
-    attributes: dict[str, str] = {}
-    to_native = None
     if crs is not None:
-        attributes["crs"] = crs.to_string()
-        is_geographic = bool(crs.is_geographic)
-        if not is_geographic:
-            from pyproj import Transformer
-
-            transformer = Transformer.from_crs("EPSG:4326", crs, always_xy=True)
-
-            def to_native(lat: FloatArray, lon: FloatArray) -> tuple[FloatArray, FloatArray]:
-                east, north = transformer.transform(lon, lat)
-                return np.asarray(north), np.asarray(east)
+        georeference: CRS | None = CRS.from_user_input(crs)
+    elif looks_geographic(north_axis, east_axis):
+        georeference = CRS(GEOGRAPHIC_CRS)
     else:
-        is_geographic = looks_geographic(north_axis, east_axis)
-    return Raster(values, north_axis, east_axis, is_geographic, None, None, to_native, attributes)
+        georeference = None
+    return Raster(values, north_axis, east_axis, georeference, None)

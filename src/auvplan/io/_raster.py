@@ -6,15 +6,16 @@ conversion to depth and to the local metric frame in :mod:`auvplan.io.bathymetry
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Final
+from typing import TYPE_CHECKING, Final
 
 import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError
-from auvplan.terrain.projection import LocalProjection
+
+if TYPE_CHECKING:
+    from pyproj import CRS
 
 #: A coordinate step below this many units is taken as degrees, not metres, when a file does
 #: not say (no CRS / units): 0.05 deg is 5.5 km, and no metric survey has 5 cm spacing.
@@ -27,16 +28,23 @@ LONGITUDE_RANGE: Final = (-180.0, 360.0)
 
 @dataclass(frozen=True)
 class Raster:
-    """A raster as read, before conversion: rows along ``axis_north``, columns along east."""
+    """A raster as read, before conversion: rows along ``axis_north``, columns along east.
+
+    ``crs`` is the CRS of the axes: geographic (lat/lon [deg]), projected (northing/easting,
+    e.g. UTM [m]), or None for a purely local metric frame without georeference.
+    """
 
     values: FloatArray
-    axis_north: FloatArray  # lat [deg] or north [m], increasing
-    axis_east: FloatArray  # lon [deg] or east [m], increasing
-    is_geographic: bool
+    axis_north: FloatArray  # lat [deg] or northing [m], increasing
+    axis_east: FloatArray  # lon [deg] or easting [m], increasing
+    crs: CRS | None
     is_depth: bool | None  # None: decide from the values
-    projection: LocalProjection | None = None
-    to_native: Callable[[FloatArray, FloatArray], tuple[FloatArray, FloatArray]] | None = None
     attributes: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def is_geographic(self) -> bool:
+        """True when the axes are latitude and longitude [deg]."""
+        return self.crs is not None and bool(self.crs.is_geographic)
 
 
 def looks_geographic(lat: FloatArray, lon: FloatArray) -> bool:

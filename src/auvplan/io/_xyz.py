@@ -15,10 +15,12 @@ from pathlib import Path
 from typing import Final, Literal
 
 import numpy as np
+from pyproj import CRS
 
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError
 from auvplan.io._raster import Raster, first_line, looks_geographic
+from auvplan.terrain.projection import GEOGRAPHIC_CRS
 
 logger = logging.getLogger(__name__)
 
@@ -48,12 +50,13 @@ def read_xyz(path: Path, coordinates: XyzCoordinates) -> Raster:
         is_geographic = looks_geographic(second, first)
     else:
         is_geographic = coordinates == "geographic"
+    crs = CRS(GEOGRAPHIC_CRS) if is_geographic else None
     lattice = _as_lattice(first, second, z)
     if lattice is not None:
         values, east_axis, north_axis = lattice
-        return Raster(values, north_axis, east_axis, is_geographic, None)
+        return Raster(values, north_axis, east_axis, crs, None)
     # Scattered points: keep them as a one-row "raster" of points, gridded after conversion.
-    return Raster(z[None, :], second, first, is_geographic, None, attributes={"scattered": "yes"})
+    return Raster(z[None, :], second, first, crs, None, attributes={"scattered": "yes"})
 
 
 def drop_stray_fixes(

@@ -3,9 +3,11 @@
 :func:`read_bathymetry` detects the format from the file's content, reads it with the field's
 libraries (xarray/netCDF4, rasterio, numpy + scipy), and returns a
 :class:`~auvplan.terrain.grid.BathymetryGrid` in the local north/east frame with depth in
-metres, positive down, and NaN on land / no-data cells. Geographic (lon/lat) data are
-resampled onto a metric grid in a transverse Mercator frame centred on the map
-(:func:`~auvplan.terrain.resample.project_geographic_grid`).
+metres, positive down, and NaN on land / no-data cells. Data in a geographic (lon/lat) or
+projected (e.g. UTM) CRS (from GeoTIFF, or a CF ``grid_mapping`` in NetCDF) are resampled
+onto a metric grid in the local frame, a transverse Mercator centred on the map
+(:func:`~auvplan.terrain.resample.project_grid`); a grid already in such a frame (auvplan's
+own ``maps.nc``) and metric grids without a CRS keep their nodes.
 """
 
 from __future__ import annotations
@@ -16,19 +18,16 @@ from pathlib import Path
 from typing import Final, Literal
 
 import numpy as np
+from pyproj import Transformer
 
 from auvplan._typing import FloatArray
 from auvplan.errors import AuvplanError, DataFormatError, InputError
 from auvplan.io._gridded import read_netcdf, read_rasterio
-from auvplan.io._raster import (
-    Raster,
-    check_geographic_range,
-    first_line,
-)
+from auvplan.io._raster import Raster, check_geographic_range, first_line
 from auvplan.io._xyz import XyzCoordinates, read_xyz
 from auvplan.terrain.grid import BathymetryGrid, GridGeometry
-from auvplan.terrain.projection import LocalProjection
-from auvplan.terrain.resample import grid_scattered_points, project_geographic_grid
+from auvplan.terrain.projection import GEOGRAPHIC_CRS, LocalProjection
+from auvplan.terrain.resample import grid_scattered_points, project_grid
 
 logger = logging.getLogger(__name__)
 
@@ -58,16 +57,18 @@ def read_bathymetry(
     path : str or Path
         NetCDF-3/4 (``lon``/``lat``/``elevation`` as NOAA, GEBCO, EMODnet, with dimensions
         ``lat/lon`` or ``y/x``; or a metric file with ``north``/``east`` coordinates [m] and a
-        ``depth`` variable such as auvplan's own ``maps.nc``), GeoTIFF (geographic or projected
-        CRS), ESRI ASCII grid, or XYZ text (columns ``lon lat z`` or ``east north z``,
-        whitespace or comma separated, ``#`` comments). The format is detected from the
-        content, not the suffix.
+        ``depth`` variable such as auvplan's own ``maps.nc``; a CF ``grid_mapping`` gives the
+        CRS, geographic or projected), GeoTIFF (geographic or projected CRS), ESRI ASCII grid,
+        or XYZ text (columns ``lon lat z`` or ``east north z``, whitespace or comma separated,
+        ``#`` comments). The format is detected from the content, not the suffix.
     window_north, window_east : tuple of float, optional
         Crop ``(low, high)`` [m] in the frame of the grid as read (after any lat/lon window);
         the result is re-originated at its south-west node.
     window_lat, window_lon : tuple of float, optional
-        Crop ``(south, north)`` / ``(west, east)`` [deg], applied to geographic data before
-        projection (to metric data with a known projection via its bounding box).
+        Crop ``(south, north)`` / ``(west, east)`` [deg, WGS 84], applied before the
+        resampling: to geographic data directly, to projected data via the window's bounding
+        box in their CRS (:meth:`pyproj.Transformer.transform_bounds`). A missing one keeps
+        the data's whole extent.
     min_depth : float
         Cells with depth <= ``min_depth`` [m] (land, the surface) become NaN (no-go).
     vertical : {"auto", "elevation", "depth"}
@@ -82,8 +83,9 @@ def read_bathymetry(
     -------
     BathymetryGrid
         Depth [m], positive down, NaN = no-go, origin at the south-west node. ``projection``
-        is set for geographic sources (and for metric files that record one) so lat/lon poses
-        convert; ``attributes`` records the source file, format and CRS.
+        (whose ``crs`` is the local frame as a :class:`pyproj.CRS`) is set for every source
+        with a CRS, so lat/lon poses convert; ``attributes`` records the source file, format
+        and CRS (``attributes["crs"]``, the source CRS as a string pyproj reads back).
 
     Raises
     ------
@@ -94,7 +96,7 @@ def read_bathymetry(
         (:data:`~auvplan.terrain.resample.MAX_GRID_NODES`).
     InputError
         If a window is empty or outside the map, or a lat/lon window is given for a grid
-        without a geographic reference.
+        without a CRS.
 
     Notes
     -----
@@ -144,25 +146,28 @@ def _read(
         if isinstance(error, AuvplanError):
             raise
         raise DataFormatError(f"malformed {kind} file ({first_line(error)})") from None
-    raster = replace(
-        raster, attributes={"source_file": str(path), "format": kind, **raster.attributes}
-    )
+    attributes = {"source_file": str(path), "format": kind, **raster.attributes}
+    if raster.crs is not None:
+        attributes["crs"] = raster.crs.to_string()
+    raster = replace(raster, attributes=attributes)
     if raster.is_geographic:
         check_geographic_range(raster.axis_north, raster.axis_east)
     raster = _crop_geographic(raster, window_lat, window_lon)
     depth = _to_depth(raster, vertical, min_depth)
     try:
-        if raster.is_geographic and raster.attributes.get("scattered") == "yes":
-            return _geographic_scattered(raster, depth, path.name)
-        if raster.is_geographic:
-            return project_geographic_grid(
+        if raster.attributes.get("scattered") == "yes":
+            return _scattered(raster, depth, path.name)
+        local = None if raster.crs is None else LocalProjection.from_crs(raster.crs)
+        if raster.crs is not None and local is None:
+            return project_grid(
                 depth,
                 raster.axis_north,
                 raster.axis_east,
+                raster.crs,
                 name=path.name,
                 attributes=raster.attributes,
             )
-        return _metric_grid(depth, raster, path.name)
+        return _metric_grid(depth, raster, local, path.name)
     except InputError as error:  # the file's geometry, not a user's value, is at fault
         raise DataFormatError(str(error)) from None
 
@@ -210,20 +215,17 @@ def detect_format(path: Path) -> BathymetryFormat:
 def _crop_geographic(
     raster: Raster, window_lat: tuple[float, float] | None, window_lon: tuple[float, float] | None
 ) -> Raster:
-    """Apply a lat/lon window to the raster (in its native coordinates)."""
+    """Apply a lat/lon window to the raster, in its native coordinates (via its CRS)."""
     if window_lat is None and window_lon is None:
         return raster
-    if raster.is_geographic:
-        north_range, east_range = window_lat, window_lon
-    elif raster.to_native is not None:
-        lat = np.array(window_lat if window_lat is not None else (-89.0, 89.0), dtype=np.float64)
-        lon = np.array(window_lon if window_lon is not None else (-180.0, 180.0), dtype=np.float64)
-        corner_lat, corner_lon = np.meshgrid(lat, lon, indexing="ij")
-        north, east = raster.to_native(corner_lat.ravel(), corner_lon.ravel())
-        north_range = (float(north.min()), float(north.max())) if window_lat is not None else None
-        east_range = (float(east.min()), float(east.max())) if window_lon is not None else None
-    else:
-        raise InputError("a lat/lon window needs a geographic grid or a known projection")
+    if raster.crs is None:
+        raise InputError("a lat/lon window needs a grid with a geographic or projected CRS")
+    to_native = Transformer.from_crs(GEOGRAPHIC_CRS, raster.crs, always_xy=True)
+    west, south, east, north = to_native.transform_bounds(
+        *_window_lon_lat(raster, to_native, window_lat, window_lon), densify_pts=21
+    )
+    north_range = (south, north) if window_lat is not None else None
+    east_range = (west, east) if window_lon is not None else None
     if raster.attributes.get("scattered") == "yes":
         keep = np.ones(raster.axis_north.size, dtype=bool)
         for axis, bounds in ((raster.axis_north, north_range), (raster.axis_east, east_range)):
@@ -247,6 +249,28 @@ def _crop_geographic(
         axis_north=raster.axis_north[rows],
         axis_east=raster.axis_east[cols],
     )
+
+
+def _window_lon_lat(
+    raster: Raster,
+    to_native: Transformer,
+    window_lat: tuple[float, float] | None,
+    window_lon: tuple[float, float] | None,
+) -> tuple[float, float, float, float]:
+    """``(west, south, east, north)`` [deg] of the window; a missing side is the data's own."""
+    west, south, east, north = to_native.transform_bounds(
+        float(np.min(raster.axis_east)),
+        float(np.min(raster.axis_north)),
+        float(np.max(raster.axis_east)),
+        float(np.max(raster.axis_north)),
+        direction="INVERSE",
+        densify_pts=21,
+    )
+    if window_lat is not None:
+        south, north = float(min(window_lat)), float(max(window_lat))
+    if window_lon is not None:
+        west, east = float(min(window_lon)), float(max(window_lon))
+    return west, south, east, north
 
 
 def _range(axis: FloatArray, bounds: tuple[float, float] | None, name: str) -> slice:
@@ -301,16 +325,10 @@ def _to_depth(raster: Raster, vertical: Vertical, min_depth: float) -> FloatArra
     return np.asarray(depth, dtype=np.float64)
 
 
-def _metric_grid(depth: FloatArray, raster: Raster, name: str) -> BathymetryGrid:
-    if raster.attributes.get("scattered") == "yes":
-        return grid_scattered_points(
-            raster.axis_north,
-            raster.axis_east,
-            depth[0],
-            projection=raster.projection,
-            name=name,
-            attributes={k: v for k, v in raster.attributes.items() if k != "scattered"},
-        )
+def _metric_grid(
+    depth: FloatArray, raster: Raster, local: LocalProjection | None, name: str
+) -> BathymetryGrid:
+    """The raster's own regular lattice; ``local`` is its frame (None: no georeference)."""
     spacings = []
     for axis, label in ((raster.axis_north, "north"), (raster.axis_east, "east")):
         if axis.size < 2:
@@ -325,19 +343,22 @@ def _metric_grid(depth: FloatArray, raster: Raster, name: str) -> BathymetryGrid
     geometry = GridGeometry(depth.shape[0], depth.shape[1], spacings[0], spacings[1])
     projection = (
         None
-        if raster.projection is None
-        else raster.projection.shifted(float(raster.axis_north[0]), float(raster.axis_east[0]))
+        if local is None
+        else local.shifted(float(raster.axis_north[0]), float(raster.axis_east[0]))
     )
     return BathymetryGrid(depth, geometry, projection, None, name, dict(raster.attributes))
 
 
-def _geographic_scattered(raster: Raster, depth: FloatArray, name: str) -> BathymetryGrid:
-    lat, lon = raster.axis_north, raster.axis_east
-    centre = LocalProjection(
-        float(0.5 * (lat.min() + lat.max())), float(0.5 * (lon.min() + lon.max()))
-    )
-    north, east = centre.to_local(lat, lon)
+def _scattered(raster: Raster, depth: FloatArray, name: str) -> BathymetryGrid:
+    """Grid scattered soundings; lon/lat ones in the local frame centred on the survey."""
     attributes = {k: v for k, v in raster.attributes.items() if k != "scattered"}
+    north, east = raster.axis_north, raster.axis_east
+    projection = None
+    if raster.is_geographic:
+        projection = LocalProjection(
+            float(0.5 * (north.min() + north.max())), float(0.5 * (east.min() + east.max()))
+        )
+        north, east = projection.to_local(north, east)
     return grid_scattered_points(
-        north, east, depth[0], projection=centre, name=name, attributes=attributes
+        north, east, depth[0], projection=projection, name=name, attributes=attributes
     )

@@ -1,32 +1,44 @@
-"""Writing and reading ``maps.nc``: the terrain maps with CF-style metadata (SPEC §8).
+"""Writing and reading ``maps.nc``: the terrain maps as a CF-1.8 NetCDF-4 file (SPEC §8).
 
-Layout (NetCDF-4, CF-1.8):
+Layout:
 
-* fine grid, coordinates ``north(north)``, ``east(east)`` [m]: ``depth`` (standard name
-  ``sea_floor_depth_below_sea_surface``, positive down) and ``information``;
-* coarse (block) grid, coordinates ``north_block``, ``east_block`` [m]: ``excitation``,
-  ``cost`` and ``shifted_cost``;
+* fine grid, coordinate variables ``north(north)``, ``east(east)`` [m] (standard names
+  ``projection_y_coordinate`` / ``projection_x_coordinate``, no ``_FillValue``): ``depth``
+  (standard name ``sea_floor_depth_below_sea_surface``, positive down) and ``information``;
+* coarse (block) grid, coordinate variables ``north_block``, ``east_block`` [m]:
+  ``excitation``, ``cost`` and ``shifted_cost``;
+* when the grid is georeferenced: the grid mapping variable ``crs`` (the local frame's
+  :attr:`~auvplan.terrain.projection.LocalProjection.crs`, written by rioxarray's
+  ``write_crs`` from :meth:`pyproj.CRS.to_cf`, with its WKT), referenced by every data
+  variable's ``grid_mapping``, and the 2-D auxiliary coordinates ``lat``/``lon`` and
+  ``lat_block``/``lon_block`` [deg, WGS 84], so GIS software (QGIS, GDAL, rioxarray) places
+  the maps;
 * global attributes: the map parameters (``information_exponent``, ``block_north``,
-  ``block_east``, ``omega``, ``weight``), ``source``, ``Conventions``, and, when the grid has
-  one, its projection (``projection_lat_0``, ``projection_lon_0``, ``projection_offset_north``,
-  ``projection_offset_east``, ``projection_ellipsoid``).
+  ``block_east``, ``omega``, ``weight``), the fine spacing, ``source``, ``Conventions``.
 
 The file is also a valid bathymetry input: :func:`auvplan.io.bathymetry.read_bathymetry`
-reads its ``depth`` and projection back.
+reads its ``depth`` and local frame back.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING, Final
 
 import numpy as np
 
 from auvplan import __version__
-from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError
+from auvplan.io._gridded import grid_mapping_crs
 from auvplan.terrain.grid import BathymetryGrid, GridGeometry
 from auvplan.terrain.maps import MapParameters, TerrainMaps
 from auvplan.terrain.projection import LocalProjection
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+#: Name of the CF grid mapping variable of the local frame.
+GRID_MAPPING: Final = "crs"
 
 
 def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
@@ -49,20 +61,15 @@ def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
     path = Path(path)
     fine, coarse = maps.bathymetry.geometry, maps.cost_geometry
     parameters = maps.parameters
-
-    def coordinate(values: FloatArray, name: str, long_name: str) -> xr.Variable:
-        axis = "Y" if name.startswith("north") else "X"
-        return xr.Variable(
-            (name,),
-            values,
-            {"units": "m", "long_name": long_name, "axis": axis},
-        )
-
+    projection = maps.bathymetry.projection
     coords = {
-        "north": coordinate(fine.north, "north", "distance north of the map origin"),
-        "east": coordinate(fine.east, "east", "distance east of the map origin"),
-        "north_block": coordinate(coarse.north, "north_block", "block centre north of origin"),
-        "east_block": coordinate(coarse.east, "east_block", "block centre east of origin"),
+        **_axes(fine, "", "of the map origin", has_standard_name=True),
+        **_axes(
+            coarse,
+            "_block",
+            "of the map origin (block centre)",
+            has_standard_name=projection is None,
+        ),
     }
     fine_dims, coarse_dims = ("north", "east"), ("north_block", "east_block")
     data_vars = {
@@ -103,10 +110,13 @@ def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
     attributes: dict[str, str | float | int] = {
         "Conventions": "CF-1.8",
         "title": "auvplan terrain-information maps",
-        "source": maps.bathymetry.name,
+        "institution": "auvplan",
+        "source": maps.bathymetry.name or "auvplan",
         "history": f"created by auvplan {__version__}",
         "references": "Häusler et al., Cooperative AUV Motion Planning using Terrain "
         "Information, OCEANS 2013, Sec. III-A",
+        "comment": "north/east: metres from the map origin (the south-west node) in the local "
+        "frame, a transverse Mercator centred on the map (grid_mapping variable crs)",
         "information_exponent": float(parameters.exponent),
         "block_north": int(parameters.block[0]),
         "block_east": int(parameters.block[1]),
@@ -115,22 +125,67 @@ def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
         "spacing_north_m": float(fine.spacing_north),
         "spacing_east_m": float(fine.spacing_east),
     }
-    projection = maps.bathymetry.projection
-    if projection is not None:
-        attributes.update(
-            {
-                "projection": "transverse Mercator centred on the map (PROJ tmerc, k=1)",
-                "projection_lat_0": float(projection.lat_0),
-                "projection_lon_0": float(projection.lon_0),
-                "projection_offset_north": float(projection.offset_north),
-                "projection_offset_east": float(projection.offset_east),
-                "projection_ellipsoid": projection.ellipsoid,
-            }
-        )
     dataset = xr.Dataset(data_vars, coords, attributes)
-    encoding = {name: {"zlib": True, "complevel": 4} for name in data_vars}
+    if projection is not None:
+        dataset = _georeference(dataset, projection, fine, coarse)
+    # Encodings replace those set by rioxarray (the grid_mapping reference): merge them.
+    compressed = {"zlib": True, "complevel": 4}
+    encoding: dict[str, dict[str, object]] = {
+        str(name): {**variable.encoding, **(compressed if variable.ndim == 2 else {})}
+        for name, variable in dataset.variables.items()
+    }
+    for name in dataset.coords:  # CF: no _FillValue on coordinates
+        encoding[str(name)]["_FillValue"] = None
+    if GRID_MAPPING in dataset.coords:
+        encoding[GRID_MAPPING]["dtype"] = "int32"  # CF 1.8 has no 64-bit integers
     dataset.to_netcdf(path, format="NETCDF4", engine="netcdf4", encoding=encoding)
     return path
+
+
+def _axes(
+    geometry: GridGeometry, suffix: str, where: str, *, has_standard_name: bool
+) -> dict[str, xr.Variable]:
+    """The CF coordinate variables ``north<suffix>``, ``east<suffix>`` [m] of a grid.
+
+    With a grid mapping, CF checkers (IOOS) accept a single variable per standard name
+    ``projection_x/y_coordinate``, so only the fine grid's axes carry one then.
+    """
+    import xarray as xr
+
+    variables = {}
+    for axis, cf_axis, values in (("north", "Y", geometry.north), ("east", "X", geometry.east)):
+        attributes = {"units": "m", "long_name": f"distance {axis} {where}", "axis": cf_axis}
+        if has_standard_name:
+            attributes["standard_name"] = f"projection_{cf_axis.lower()}_coordinate"
+        variables[f"{axis}{suffix}"] = xr.Variable((f"{axis}{suffix}",), values, attributes)
+    return variables
+
+
+def _georeference(
+    dataset: xr.Dataset, projection: LocalProjection, fine: GridGeometry, coarse: GridGeometry
+) -> xr.Dataset:
+    """Add the grid mapping variable ``crs`` and 2-D ``lat``/``lon`` auxiliary coordinates."""
+    import rioxarray  # noqa: F401  (registers the .rio accessor)
+    import xarray as xr
+
+    for geometry, suffix in ((fine, ""), (coarse, "_block")):
+        north, east = np.meshgrid(geometry.north, geometry.east, indexing="ij")
+        lat, lon = projection.to_geographic(north, east)
+        dims = (f"north{suffix}", f"east{suffix}")
+        dataset = dataset.assign_coords(
+            {
+                f"lat{suffix}": xr.Variable(
+                    dims, lat, {"units": "degrees_north", "standard_name": "latitude"}
+                ),
+                f"lon{suffix}": xr.Variable(
+                    dims, lon, {"units": "degrees_east", "standard_name": "longitude"}
+                ),
+            }
+        )
+    georeferenced: xr.Dataset = dataset.rio.write_crs(
+        projection.crs, grid_mapping_name=GRID_MAPPING
+    )
+    return georeferenced
 
 
 def read_maps_netcdf(path: str | Path) -> TerrainMaps:
@@ -174,15 +229,7 @@ def read_maps_netcdf(path: str | Path) -> TerrainMaps:
                 name: np.asarray(dataset[name].values, dtype=np.float64)
                 for name in ("depth", "information", "excitation", "cost", "shifted_cost")
             }
-            projection = None
-            if "projection_lat_0" in attrs:
-                projection = LocalProjection(
-                    float(attrs["projection_lat_0"]),
-                    float(attrs["projection_lon_0"]),
-                    float(attrs["projection_offset_north"]),
-                    float(attrs["projection_offset_east"]),
-                    str(attrs["projection_ellipsoid"]),
-                )
+            projection = _local_frame(dataset, path)
             source = str(attrs.get("source", path.name))
             fine = GridGeometry(
                 north.size,
@@ -212,3 +259,16 @@ def read_maps_netcdf(path: str | Path) -> TerrainMaps:
         coarse,
         parameters,
     )
+
+
+def _local_frame(dataset: xr.Dataset, path: Path) -> LocalProjection | None:
+    """The local frame of the ``depth`` variable's grid mapping (None without one)."""
+    crs = grid_mapping_crs(dataset, dataset["depth"])
+    if crs is None:
+        return None
+    projection = LocalProjection.from_crs(crs)
+    if projection is None:
+        raise DataFormatError(
+            f"maps file {path}: its grid mapping is not an auvplan local frame ({crs.name})"
+        )
+    return projection

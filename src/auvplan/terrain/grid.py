@@ -163,8 +163,9 @@ class BathymetryGrid:
     geometry : GridGeometry
         Cell geometry; ``geometry.shape == depth.shape``.
     projection : LocalProjection or None
-        Link to geographic coordinates when the grid came from lat/lon data (or carries a CRS);
-        ``None`` for purely local (e.g. synthetic) grids.
+        The local frame, linking north/east to lat/lon (``projection.crs`` is it as a
+        :class:`pyproj.CRS`), when the source had a CRS (geographic or projected); ``None``
+        for purely local grids (synthetic, metric files without a CRS).
     depth_std : ndarray of shape (n_rows, n_cols) or None
         Optional per-cell standard deviation of the depth [m].
     name : str
