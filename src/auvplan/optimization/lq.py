@@ -52,7 +52,11 @@ def convexify(weights: StageWeights, floor: float) -> StageWeights:
     stacked = np.concatenate([top, bottom], axis=1)
     stacked = 0.5 * (stacked + np.swapaxes(stacked, 1, 2))
     values, vectors = np.linalg.eigh(stacked)
-    clipped = np.einsum("kij,kj,klj->kil", vectors, np.maximum(values, floor), vectors)
+    clipped = stacked.copy()
+    low = np.nonzero(values[:, 0] < floor)[0]  # only these stages change
+    clipped[low] = (vectors[low] * np.maximum(values[low], floor)[:, None, :]) @ np.swapaxes(
+        vectors[low], 1, 2
+    )
     p_values, p_vectors = np.linalg.eigh(0.5 * (weights.P_N + weights.P_N.T))
     p_clipped = (p_vectors * np.maximum(p_values, floor)) @ p_vectors.T
     return StageWeights(
