@@ -10,7 +10,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from auvplan._typing import FloatArray
+from auvplan._typing import BoolArray, FloatArray
 
 
 @numba.njit(cache=True)
@@ -49,6 +49,21 @@ def _cholesky_solve(lower: FloatArray, rhs: FloatArray) -> FloatArray:
             for k in range(i + 1, n):
                 value -= lower[k, i] * out[k, c]
             out[i, c] = value / lower[i, i]
+    return out
+
+
+@numba.njit(cache=True)
+def below_floor(matrices: FloatArray, floor: float) -> BoolArray:
+    """Per stage, whether ``matrices[k] − floor·I`` is not positive definite (Cholesky test)."""
+    n_stages, n, _ = matrices.shape
+    out = np.zeros(n_stages, dtype=np.bool_)
+    shifted = np.empty((n, n))
+    for k in range(n_stages):
+        shifted[:, :] = matrices[k]
+        for i in range(n):
+            shifted[i, i] -= floor
+        _, is_pd = _cholesky(shifted)
+        out[k] = not is_pd
     return out
 
 

@@ -51,12 +51,10 @@ def convexify(weights: StageWeights, floor: float) -> StageWeights:
     bottom = np.concatenate([np.swapaxes(weights.S, 1, 2), weights.R], axis=2)
     stacked = np.concatenate([top, bottom], axis=1)
     stacked = 0.5 * (stacked + np.swapaxes(stacked, 1, 2))
-    values, vectors = np.linalg.eigh(stacked)
-    clipped = stacked.copy()
-    low = np.nonzero(values[:, 0] < floor)[0]  # only these stages change
-    clipped[low] = (vectors[low] * np.maximum(values[low], floor)[:, None, :]) @ np.swapaxes(
-        vectors[low], 1, 2
-    )
+    clipped = np.ascontiguousarray(stacked)
+    low = np.nonzero(_kernels.below_floor(clipped, floor))[0]  # only these stages change
+    values, vectors = np.linalg.eigh(clipped[low])
+    clipped[low] = (vectors * np.maximum(values, floor)[:, None, :]) @ np.swapaxes(vectors, 1, 2)
     p_values, p_vectors = np.linalg.eigh(0.5 * (weights.P_N + weights.P_N.T))
     p_clipped = (p_vectors * np.maximum(p_values, floor)) @ p_vectors.T
     return StageWeights(
