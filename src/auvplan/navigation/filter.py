@@ -60,9 +60,7 @@ class ParticleFilterOptions:
         if self.n_particles < 2:
             raise InputError(f"particle filter needs >= 2 particles, got {self.n_particles}")
         if not 0.0 < self.resample_fraction <= 1.0:
-            raise InputError(
-                f"resample_fraction must be in (0, 1], got {self.resample_fraction}"
-            )
+            raise InputError(f"resample_fraction must be in (0, 1], got {self.resample_fraction}")
         if not (np.isfinite(self.roughening) and self.roughening >= 0.0):
             raise InputError(f"roughening must be finite and >= 0, got {self.roughening}")
         if not (np.isfinite(self.initial_sigma) and self.initial_sigma > 0.0):
@@ -95,8 +93,8 @@ class FilterTrace:
 
     @property
     def sigma(self) -> FloatArray:
-        """Position standard deviation :math:`\\sqrt{P_{nn} + P_{ee}}` [m], shape ``(K + 1,)``."""
-        return np.sqrt(np.trace(self.covariance, axis1=1, axis2=2))
+        r"""Position standard deviation :math:`\sqrt{P_{nn} + P_{ee}}` [m], shape ``(K + 1,)``."""
+        return np.asarray(np.sqrt(np.trace(self.covariance, axis1=1, axis2=2)), dtype=np.float64)
 
 
 def run_particle_filter(

@@ -38,11 +38,12 @@ def rmse(error: FloatArray) -> FloatArray:
     >>> rmse(np.array([[3.0, 4.0, 0.0, 0.0], [1.0, 1.0, 1.0, 1.0]]))
     array([2.5, 1. ])
     """
-    return np.sqrt(np.mean(np.asarray(error, dtype=np.float64) ** 2, axis=-1))
+    squared = np.asarray(error, dtype=np.float64) ** 2
+    return np.asarray(np.sqrt(np.mean(squared, axis=-1)), dtype=np.float64)
 
 
 def nees(errors: FloatArray, covariance: FloatArray) -> FloatArray:
-    """:math:`e_k^\\top P_k^{-1} e_k` for errors ``(K + 1, 2)`` and covariances ``(K + 1, 2, 2)``.
+    r""":math:`e_k^\top P_k^{-1} e_k` for errors ``(K + 1, 2)`` and covariances ``(K + 1, 2, 2)``.
 
     A singular covariance gives ``inf`` unless the error is zero along its null direction.
 

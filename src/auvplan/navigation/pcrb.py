@@ -34,7 +34,7 @@ def posterior_crb(
     process_sigma: FloatArray,
     initial_sigma: float,
 ) -> FloatArray:
-    """Posterior Cramér-Rao bound on the position covariance at every update.
+    r"""Posterior Cramér-Rao bound on the position covariance at every update.
 
     Parameters
     ----------
@@ -59,12 +59,11 @@ def posterior_crb(
     Examples
     --------
     A plane of slope 0.1 north and 4 soundings of variance 1 m²: the north variance is
-    :math:`1 / (1 / 10^2 + 4 \\cdot 0.1^2) = 20` m², the east variance stays at the prior.
+    :math:`1 / (1 / 10^2 + 4 \cdot 0.1^2) = 20` m², the east variance stays at the prior.
 
     >>> from auvplan.terrain import GridGeometry
-    >>> grid = BathymetryGrid(
-    ...     30.0 + 0.1 * np.arange(20.0)[:, None] + np.zeros((20, 20)), GridGeometry(20, 20, 1.0, 1.0)
-    ... )
+    >>> depth = 30.0 + 0.1 * np.arange(20.0)[:, None] + np.zeros((20, 20))
+    >>> grid = BathymetryGrid(depth, GridGeometry(20, 20, 1.0, 1.0))
     >>> bound = posterior_crb(
     ...     grid, np.full((4, 2), 10.0), np.zeros((4, 1, 2)), np.ones((4, 1)), np.zeros(3), 10.0
     ... )
@@ -86,4 +85,4 @@ def posterior_crb(
         predicted = bound[k - 1] + process_sigma[k - 1] ** 2 * np.eye(2)
         information = np.linalg.inv(predicted) + fisher[k]
         bound[k] = np.linalg.inv(information)
-    return bound
+    return np.asarray(bound, dtype=np.float64)
