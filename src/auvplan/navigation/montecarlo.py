@@ -19,7 +19,13 @@ import numpy as np
 from auvplan._typing import BoolArray, FloatArray
 from auvplan.errors import InputError
 from auvplan.navigation.filter import ParticleFilterOptions, run_particle_filter
-from auvplan.navigation.metrics import convergence_time, has_diverged, nees, rmse
+from auvplan.navigation.metrics import (
+    CONVERGENCE_UPDATES,
+    convergence_time,
+    has_diverged,
+    nees,
+    rmse,
+)
 from auvplan.navigation.motion import (
     DeadReckoningModel,
     dead_reckon,
@@ -97,13 +103,24 @@ class NavigationSettings:
     filter : ParticleFilterOptions
         Particle-filter settings.
     update_period : float
-        Time [s] between filter updates (one ping each). Default 1 s.
+        Time [s] between filter updates (one sounding each). Default 3 s: MB-System
+        ``mbtrnpp`` decimates its TRN updates to one every few seconds (``trn-decs=3.0`` in
+        ``src/mbtrn/tools/cfg/mbtrnpp-cfg.example``; the alternative ``trn-decn=9`` pings).
+    convergence_updates : int
+        Consecutive updates with position sigma <= 5 m that declare convergence. Default 200:
+        MB-System ``mbtrnpp``'s ``convergence-repeat-min`` (counted in its TRN updates; at
+        3 s that is 10 minutes, so shorter missions may ask for fewer).
     """
 
     sensor: SensorModel = field(default_factory=SensorModel.altimeter)
     motion: DeadReckoningModel = field(default_factory=DeadReckoningModel)
     filter: ParticleFilterOptions = field(default_factory=ParticleFilterOptions)
     update_period: float = 3.0
+    convergence_updates: int = CONVERGENCE_UPDATES
+
+    def __post_init__(self) -> None:
+        if self.convergence_updates < 1:
+            raise InputError(f"convergence_updates must be >= 1, got {self.convergence_updates}")
 
 
 @dataclass(frozen=True)
@@ -116,7 +133,7 @@ class MonteCarloResult:
     of shape ``(R, K + 1)``. ``pcrb_sigma`` ``(K + 1,)`` is the posterior Cramér-Rao bound on
     the position standard deviation [m]. Per run ``(R,)``: ``n_resamples``. Run 0's tracks
     (``example_estimate``, ``example_dead_reckoning``, ``(K + 1, 2)``) and the true track
-    ``truth`` serve the figures.
+    ``truth`` serve the figures. ``convergence_updates`` is the convergence rule's run length.
     """
 
     time: FloatArray
@@ -130,6 +147,7 @@ class MonteCarloResult:
     n_resamples: FloatArray
     example_estimate: FloatArray
     example_dead_reckoning: FloatArray
+    convergence_updates: int = CONVERGENCE_UPDATES
 
     @property
     def n_runs(self) -> int:
@@ -149,7 +167,12 @@ class MonteCarloResult:
     @property
     def convergence_time(self) -> FloatArray:
         """Time [s] each run met the convergence rule, NaN if it never did, ``(R,)``."""
-        return np.array([convergence_time(self.time, sigma) for sigma in self.sigma])
+        return np.array(
+            [
+                convergence_time(self.time, sigma, n_updates=self.convergence_updates)
+                for sigma in self.sigma
+            ]
+        )
 
     @property
     def diverged(self) -> BoolArray:
@@ -242,6 +265,7 @@ def run_monte_carlo(
         n_resamples=n_resamples,
         example_estimate=estimates[0],
         example_dead_reckoning=dead_reckoned[0],
+        convergence_updates=settings.convergence_updates,
     )
 
 
