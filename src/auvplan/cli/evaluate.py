@@ -170,8 +170,8 @@ def _print_report(document: dict[str, Any], written: list[Path]) -> None:
         print(
             f"{label:<14s} {plan['energy_J'] / 1e3:8.1f} kJ "
             f"{plan['rmse_m']:7.2f} ± {plan['rmse_std_m']:4.2f} m "
-            f"{plan['dead_reckoning_rmse_m']:9.2f} m {plan['pcrb_rms_m']:5.2f} m {plan['converged_fraction']:10.0%} "
-            f"{plan['divergence_rate']:9.1%}"
+            f"{plan['dead_reckoning_rmse_m']:9.2f} m {plan['pcrb_rms_m']:5.2f} m "
+            f"{plan['converged_fraction']:10.0%} {plan['divergence_rate']:9.1%}"
         )
     comparison = document.get("comparison")
     if comparison is not None:
