@@ -106,3 +106,45 @@ def test_inconsistent_shapes_are_refused(featured_grid: BathymetryGrid) -> None:
             options=ParticleFilterOptions(n_particles=10),
             rng=np.random.default_rng(0),
         )
+
+
+def test_soundings_no_particle_explains_are_left_out(featured_grid: BathymetryGrid) -> None:
+    """All particles off the map: every update is skipped and the filter dead-reckons."""
+    n_updates = 20
+    increments = np.tile([2.0, 1.0], (n_updates - 1, 1))
+    trace = run_particle_filter(
+        featured_grid,
+        np.array([-5000.0, -5000.0]),
+        increments,
+        np.full(n_updates - 1, 0.01),
+        np.full((n_updates, 1), 50.0),
+        np.zeros((n_updates, 1, 2)),
+        np.ones((n_updates, 1)),
+        options=ParticleFilterOptions(n_particles=500, initial_sigma=1.0),
+        rng=np.random.default_rng(1),
+    )
+    assert trace.n_skipped == n_updates
+    assert trace.n_resamples == 0
+    np.testing.assert_allclose(trace.ess, 500.0)
+    expected = np.array([-5000.0, -5000.0]) + np.vstack([[0.0, 0.0], np.cumsum(increments, 0)])
+    np.testing.assert_allclose(trace.estimate, expected, atol=0.2)
+
+
+def test_a_wildly_unlikely_sounding_keeps_weights_finite(featured_grid: BathymetryGrid) -> None:
+    """Residuals of ~1000 sigma: log weights below exp's range are taken relative to the best."""
+    soundings = np.array([[60.0], [1000.0]])  # the second ping is 1 km off every particle
+    trace = run_particle_filter(
+        featured_grid,
+        np.array([500.0, 500.0]),
+        np.array([[1.0, 0.0]]),
+        np.array([0.25]),
+        soundings,
+        np.zeros((2, 1, 2)),
+        np.ones((2, 1)),
+        options=ParticleFilterOptions(n_particles=500, initial_sigma=5.0),
+        rng=np.random.default_rng(2),
+    )
+    assert np.all(np.isfinite(trace.estimate))
+    assert np.all(np.isfinite(trace.covariance))
+    assert 1.0 <= trace.ess[1] <= 500.0
+    assert trace.n_skipped == 0

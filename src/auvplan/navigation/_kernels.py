@@ -16,10 +16,15 @@ thread runs it (the kernels release the GIL).
 
 from __future__ import annotations
 
+from typing import Final
+
 import numba
 import numpy as np
 
 from auvplan._typing import FloatArray
+
+#: Below this best log weight, exp(log w) and its square could underflow: weigh relative to it.
+_UNDERFLOW_LOG_WEIGHT: Final = -300.0
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -138,69 +143,48 @@ def particle_filter(
     n_beams = soundings.shape[1]
     north = initial[0] + initial_sigma * rng.standard_normal(n_particles)
     east = initial[1] + initial_sigma * rng.standard_normal(n_particles)
-    log_w = np.zeros(n_particles)
+    log_w = np.zeros(n_particles)  # log weights up to a constant; their maximum is `shift`
+    prior = np.empty(n_particles)
     weight = np.empty(n_particles)
-    log_like = np.empty(n_particles)
     spare_n = np.empty(n_particles)
     spare_e = np.empty(n_particles)
     jitter = roughening / np.sqrt(n_particles)
+    shift = 0.0
     n_resamples = 0
     n_skipped = 0
     for k in range(soundings.shape[0]):
         has_beam = False
         for b in range(n_beams):
             has_beam = has_beam or not np.isnan(soundings[k, b])
+        step_n = step_e = sigma = 0.0
         if k > 0:
             step_n, step_e, sigma = increments[k - 1, 0], increments[k - 1, 1], process_sigma[k - 1]
-            for i in range(n_particles):
+        # one fused pass: predict and weigh, w = exp(log w) <= 1 (log w <= shift = 0, loglik <= 0)
+        best = -np.inf
+        for i in range(n_particles):
+            if k > 0:
                 north[i] += step_n + sigma * rng.standard_normal()
                 east[i] += step_e + sigma * rng.standard_normal()
-        best = -np.inf
-        if has_beam:
-            for i in range(n_particles):
-                total = 0.0
-                for b in range(n_beams):
-                    z = soundings[k, b]
-                    if np.isnan(z):
-                        continue
-                    h = _bilinear(
-                        depth,
-                        (north[i] + offsets[k, b, 0] - origin_n) * inv_n,
-                        (east[i] + offsets[k, b, 1] - origin_e) * inv_e,
-                    )
-                    if np.isnan(h):
-                        total = -np.inf
-                        break
-                    total -= 0.5 * (z - h) * (z - h) / variances[k, b]
-                log_like[i] = total
-                best = max(best, log_w[i] + total)
-            if best == -np.inf:
-                n_skipped += 1
-        is_updated = best > -np.inf
-        if not is_updated:
+            prior[i] = log_w[i] - shift
+            log_w[i] = prior[i]
+            if has_beam:
+                log_w[i] += _log_likelihood(
+                    depth, north[i], east[i], soundings[k], offsets[k], variances[k],
+                    origin_n, origin_e, inv_n, inv_e,
+                )  # fmt: skip
+            best = max(best, log_w[i])
+            weight[i] = np.exp(log_w[i])
+        if best == -np.inf:  # no particle can explain the soundings: leave them out
+            n_skipped += 1
+            log_w[:] = prior
             best = np.max(log_w)
-        # weights relative to the best particle (exp <= 1), moments about particle 0
-        ref_n, ref_e = north[0], east[0]
-        s = s2 = m_n = m_e = m_nn = m_ee = m_ne = 0.0
-        for i in range(n_particles):
-            log_w[i] += (log_like[i] if is_updated else 0.0) - best
-            w = np.exp(log_w[i])
-            weight[i] = w
-            dn, de = north[i] - ref_n, east[i] - ref_e
-            s += w
-            s2 += w * w
-            m_n += w * dn
-            m_e += w * de
-            m_nn += w * dn * dn
-            m_ee += w * de * de
-            m_ne += w * dn * de
-        m_n /= s
-        m_e /= s
-        estimate[k, 0] = ref_n + m_n
-        estimate[k, 1] = ref_e + m_e
-        covariance[k, 0] = max(m_nn / s - m_n * m_n, 0.0)
-        covariance[k, 1] = max(m_ee / s - m_e * m_e, 0.0)
-        covariance[k, 2] = m_ne / s - m_n * m_e
+            weight[:] = np.exp(log_w - best)
+        elif best < _UNDERFLOW_LOG_WEIGHT:  # rare: weigh relative to the best particle
+            weight[:] = np.exp(log_w - best)
+        shift = best
+        s, s2, mean_n, mean_e, p_nn, p_ee, p_ne = _weighted_moments(weight, north, east)
+        estimate[k, 0], estimate[k, 1] = mean_n, mean_e
+        covariance[k, 0], covariance[k, 1], covariance[k, 2] = p_nn, p_ee, p_ne
         ess[k] = s * s / s2
         if ess[k] < resample_below:
             _systematic_resample(weight, s, north, east, spare_n, spare_e, rng)
@@ -209,8 +193,72 @@ def particle_filter(
             _roughen(north, jitter, rng)
             _roughen(east, jitter, rng)
             log_w[:] = 0.0
+            shift = 0.0
             n_resamples += 1
     return n_resamples, n_skipped
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _log_likelihood(
+    depth: FloatArray,
+    north: float,
+    east: float,
+    soundings: FloatArray,
+    offsets: FloatArray,
+    variances: FloatArray,
+    origin_n: float,
+    origin_e: float,
+    inv_n: float,
+    inv_e: float,
+) -> float:
+    """Gaussian log-likelihood of one ping's soundings at a particle; -inf if a beam is off-map."""
+    total = 0.0
+    for b in range(soundings.size):
+        z = soundings[b]
+        if np.isnan(z):
+            continue
+        h = _bilinear(
+            depth,
+            (north + offsets[b, 0] - origin_n) * inv_n,
+            (east + offsets[b, 1] - origin_e) * inv_e,
+        )
+        if np.isnan(h):
+            return -np.inf
+        total -= 0.5 * (z - h) * (z - h) / variances[b]
+    return total
+
+
+@numba.njit(cache=True, nogil=True)
+def _weighted_moments(
+    weight: FloatArray, north: FloatArray, east: FloatArray
+) -> tuple[float, float, float, float, float, float, float]:
+    """Sum and sum of squares of the weights, weighted mean and covariance of the particles.
+
+    Returns ``sum w, sum w², mean north, mean east, P_nn, P_ee, P_ne``; the sums run about
+    particle 0, so that the covariance loses no digits to the mean's magnitude.
+    """
+    ref_n, ref_e = north[0], east[0]
+    s = s2 = s_n = s_e = s_nn = s_ee = s_ne = 0.0
+    for i in range(weight.size):
+        w = weight[i]
+        dn, de = north[i] - ref_n, east[i] - ref_e
+        s += w
+        s2 += w * w
+        s_n += w * dn
+        s_e += w * de
+        s_nn += w * dn * dn
+        s_ee += w * de * de
+        s_ne += w * dn * de
+    m_n, m_e = s_n / s, s_e / s
+    return (
+        s,
+        s2,
+        ref_n + m_n,
+        ref_e + m_e,
+        max(s_nn / s - m_n * m_n, 0.0),
+        max(s_ee / s - m_e * m_e, 0.0),
+        s_ne / s - m_n * m_e,
+    )
 
 
 @numba.njit(cache=True, nogil=True)
