@@ -9,6 +9,12 @@ of what the terrain allows. Defaults and their sources are in each model's docst
 from __future__ import annotations
 
 from auvplan.navigation.depth import depth_at, depth_gradient_at
+from auvplan.navigation.evaluation import (
+    PlanNavigation,
+    VehiclePlan,
+    evaluate_plans,
+    navigation_summary,
+)
 from auvplan.navigation.filter import FilterTrace, ParticleFilterOptions, run_particle_filter
 from auvplan.navigation.metrics import convergence_time, has_diverged, nees, rmse
 from auvplan.navigation.montecarlo import (
@@ -36,14 +42,18 @@ __all__ = [
     "MonteCarloResult",
     "NavigationSettings",
     "ParticleFilterOptions",
+    "PlanNavigation",
     "SensorModel",
     "Track",
+    "VehiclePlan",
     "beam_geometry",
     "convergence_time",
     "dead_reckon",
     "depth_at",
     "depth_gradient_at",
+    "evaluate_plans",
     "has_diverged",
+    "navigation_summary",
     "nees",
     "posterior_crb",
     "process_noise_sigma",

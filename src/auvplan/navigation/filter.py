@@ -24,6 +24,7 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
+from auvplan.navigation._checks import require_nonnegative
 from auvplan.navigation._kernels import particle_filter
 from auvplan.terrain import BathymetryGrid
 
@@ -61,8 +62,7 @@ class ParticleFilterOptions:
             raise InputError(f"particle filter needs >= 2 particles, got {self.n_particles}")
         if not 0.0 < self.resample_fraction <= 1.0:
             raise InputError(f"resample_fraction must be in (0, 1], got {self.resample_fraction}")
-        if not (np.isfinite(self.roughening) and self.roughening >= 0.0):
-            raise InputError(f"roughening must be finite and >= 0, got {self.roughening}")
+        require_nonnegative("roughening", self.roughening)
         if not (np.isfinite(self.initial_sigma) and self.initial_sigma > 0.0):
             raise InputError(f"initial_sigma must be finite and > 0 m, got {self.initial_sigma}")
 

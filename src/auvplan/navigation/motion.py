@@ -35,7 +35,7 @@ from typing import Final
 import numpy as np
 
 from auvplan._typing import FloatArray
-from auvplan.errors import InputError
+from auvplan.navigation._checks import require_nonnegative
 
 #: Ratio CEP / sigma of an isotropic 2-D Gaussian: the median radius, sqrt(2 ln 2) = 1.1774.
 CEP_PER_SIGMA: Final = float(np.sqrt(2.0 * np.log(2.0)))
@@ -72,9 +72,7 @@ class DeadReckoningModel:
 
     def __post_init__(self) -> None:
         for name in ("drift_fraction", "velocity_noise", "noise_multiplier", "noise_floor"):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value >= 0.0):
-                raise InputError(f"dead reckoning {name} must be finite and >= 0, got {value}")
+            require_nonnegative(f"dead reckoning {name}", getattr(self, name))
 
     @property
     def bias_sigma(self) -> float:

@@ -28,6 +28,7 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
+from auvplan.navigation._checks import require_nonnegative
 from auvplan.navigation.depth import depth_at
 from auvplan.terrain import BathymetryGrid
 
@@ -67,9 +68,7 @@ class SensorModel:
         if not 0.0 <= self.swath_angle < math.pi:
             raise InputError(f"sensor swath_angle must be in [0, pi) rad, got {self.swath_angle}")
         for name in ("range_error_fraction", "map_variance", "vehicle_depth"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise InputError(f"sensor {name} must be finite and >= 0, got {value}")
+            require_nonnegative(f"sensor {name}", getattr(self, name))
         if self.map_variance == 0.0 and self.range_error_fraction == 0.0:
             raise InputError("sensor needs a non-zero map_variance or range_error_fraction")
 
