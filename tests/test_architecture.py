@@ -29,6 +29,16 @@ FORBIDDEN = {
         "viz",
     },
     "mission": {"cli", "viz", "scenarios"},
+    "navigation": {
+        "planning",
+        "deconfliction",
+        "vehicle",
+        "optimization",
+        "mission",
+        "cli",
+        "viz",
+        "io",
+    },
     "scenarios": {"optimization", "mission", "cli", "viz"},
     "viz": {"cli"},
 }

@@ -1,0 +1,186 @@
+"""``auvplan evaluate OUTPUT_DIR``: terrain-aided navigation along the plans of an output folder.
+
+Reads ``maps.nc`` and ``trajectories.csv`` (and ``trajectories_energy_only.csv`` when the plan
+was run with ``--compare-energy-only``) from the folder of ``auvplan plan``/``demo``, runs
+Monte-Carlo particle-filter navigation along every vehicle's track and writes
+``navigation.json`` and ``navigation.png`` into the same folder, all-or-nothing
+(:func:`auvplan.io.output.staged_output_dir`: the folder's other files are kept).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+
+def register(subparsers: argparse._SubParsersAction[Any]) -> None:
+    """Add the ``evaluate`` verb."""
+    parser = subparsers.add_parser(
+        "evaluate",
+        help="simulate terrain-aided navigation along the plans of an output folder",
+        description="Monte-Carlo terrain-aided navigation (particle filter, dead reckoning, "
+        "altimeter or multibeam) along each vehicle's planned track; writes "
+        "OUTPUT_DIR/navigation.json and OUTPUT_DIR/navigation.png.",
+    )
+    parser.add_argument(
+        "output", metavar="OUTPUT_DIR", type=Path, help="output folder of 'plan' or 'demo'"
+    )
+    parser.add_argument("--runs", type=int, default=100, help="Monte-Carlo runs (default 100)")
+    parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    parser.add_argument(
+        "--sensor",
+        choices=("altimeter", "multibeam"),
+        default="altimeter",
+        help="depth sensor (default altimeter; multibeam: 11 beams over 90 degrees)",
+    )
+    parser.add_argument(
+        "--particles", type=int, default=5000, help="particles per filter (default 5000)"
+    )
+    parser.add_argument(
+        "--update-period", type=float, default=3.0, help="seconds between updates (default 3)"
+    )
+    parser.add_argument(
+        "--initial-sigma",
+        type=float,
+        default=7.0,
+        help="initial position error, standard deviation per axis [m] (default 7)",
+    )
+    parser.add_argument(
+        "--drift",
+        type=float,
+        default=1.0,
+        help="dead-reckoning drift, CEP in %% of distance travelled (default 1)",
+    )
+    parser.add_argument(
+        "--convergence-updates",
+        type=int,
+        default=200,
+        help="updates with sigma <= 5 m in a row that count as converged (default 200, "
+        "MB-System's rule)",
+    )
+    parser.add_argument("--no-figure", action="store_true", help="write navigation.json only")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Evaluate the folder's plans and write the results; returns the exit code."""
+    from auvplan.errors import InputError
+    from auvplan.io.output import staged_output_dir
+    from auvplan.io.plan_folder import read_plan_folder
+    from auvplan.io.results import write_json
+    from auvplan.navigation import (
+        DeadReckoningModel,
+        NavigationSettings,
+        ParticleFilterOptions,
+        SensorModel,
+        Track,
+    )
+    from auvplan.navigation.evaluation import VehiclePlan, evaluate_plans, navigation_summary
+
+    if args.runs < 1:
+        raise InputError(f"--runs must be >= 1, got {args.runs}")
+    settings = NavigationSettings(
+        sensor=SensorModel.named(args.sensor),
+        motion=DeadReckoningModel(drift_fraction=args.drift / 100.0),
+        filter=ParticleFilterOptions(n_particles=args.particles, initial_sigma=args.initial_sigma),
+        update_period=args.update_period,
+        convergence_updates=args.convergence_updates,
+    )
+    folder = read_plan_folder(args.output)
+    plans = {
+        label: {
+            name: VehiclePlan(Track(v.time, v.positions, v.heading), v.energy)
+            for name, v in vehicles.items()
+        }
+        for label, vehicles in folder.plans.items()
+    }
+    n_tracks = sum(len(vehicles) for vehicles in plans.values())
+    with _progress(n_tracks * args.runs, args.runs, quiet=args.quiet) as progress:
+        evaluations = evaluate_plans(
+            folder.bathymetry, plans, settings, n_runs=args.runs, seed=args.seed, progress=progress
+        )
+    document = navigation_summary(
+        evaluations,
+        settings,
+        n_runs=args.runs,
+        seed=args.seed,
+        plan_records={label: folder.plan_record(label) for label in plans},
+    )
+    figure = None
+    if not args.no_figure:
+        from auvplan.viz.navigation import plot_navigation
+
+        figure = plot_navigation(folder.bathymetry, evaluations)
+    with staged_output_dir(args.output) as staging:
+        write_json(document, staging / "navigation.json")
+        written = [args.output / "navigation.json"]
+        if figure is not None:
+            figure.savefig(staging / "navigation.png", dpi=110)
+            written.append(args.output / "navigation.png")
+    if not args.quiet:
+        _print_report(document, written)
+    return 0
+
+
+@contextmanager
+def _progress(total: int, n_runs: int, *, quiet: bool) -> Iterator[Callable[[str, str, int], None]]:
+    """A progress callback: a rich bar on a terminal, one line per finished track otherwise."""
+    started = time.perf_counter()
+    finished_tracks = 0
+
+    def line(label: str, name: str, done: int) -> None:
+        if done == n_runs and not quiet:
+            print(f"{label} / {name}: {n_runs} runs ({time.perf_counter() - started:.1f} s)")
+
+    if quiet or not sys.stderr.isatty():
+        yield line
+        return
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
+
+    columns = (*Progress.get_default_columns()[:1], BarColumn(), MofNCompleteColumn())
+    with Progress(*columns, TimeElapsedColumn(), console=Console(stderr=True)) as bar:
+        task = bar.add_task("navigation", total=total)
+
+        def update(label: str, name: str, done: int) -> None:
+            nonlocal finished_tracks
+            bar.update(
+                task, completed=finished_tracks * n_runs + done, description=f"{label} / {name}"
+            )
+            if done == n_runs:
+                finished_tracks += 1
+
+        yield update
+
+
+def _print_report(document: dict[str, Any], written: list[Path]) -> None:
+    def number(value: float | None, unit: str = "") -> str:
+        return "n/a" if value is None else f"{value:.2f}{unit}"
+
+    print(
+        f"{'plan':<14s} {'energy':>10s} {'TAN RMSE':>16s} {'dead reck.':>11s} {'PCRB':>7s} "
+        f"{'converged':>10s} {'diverged':>9s}"
+    )
+    for label, plan in document["plans"].items():
+        print(
+            f"{label:<14s} {plan['energy_J'] / 1e3:8.1f} kJ "
+            f"{plan['rmse_m']:7.2f} ± {plan['rmse_std_m']:4.2f} m "
+            f"{plan['dead_reckoning_rmse_m']:9.2f} m {plan['pcrb_rms_m']:5.2f} m "
+            f"{plan['converged_fraction']:10.0%} {plan['divergence_rate']:9.1%}"
+        )
+    comparison = document.get("comparison")
+    if comparison is not None:
+        print(
+            f"terrain-aware vs energy-only: TAN RMSE {-comparison['rmse_reduction']:+.1%}, "
+            f"energy {comparison['energy_increase']:+.1%}"
+        )
+    convergence = {
+        label: number(plan["convergence_time_s"], " s") for label, plan in document["plans"].items()
+    }
+    print("median convergence time: " + ", ".join(f"{k} {v}" for k, v in convergence.items()))
+    print("wrote: " + ", ".join(str(path) for path in written))
