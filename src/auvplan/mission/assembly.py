@@ -18,6 +18,7 @@ from auvplan.mission.fleet import (
     build_fleet_functions,
 )
 from auvplan.mission.preplan import PreplanStage
+from auvplan.mission.reward import information_reward
 from auvplan.mission.timing import DeconflictStage
 from auvplan.optimization import PathConstraint, Trajectory, TrajectoryProblem
 from auvplan.planning import CircleObstacle
@@ -121,6 +122,7 @@ def assemble_problem(
         limits,
     )
     stacked_desired = layout.stack(desired)
+    reward = information_reward(layout, preplan.maps, terrain_weight * weights.information)
     problem = TrajectoryProblem(
         dynamics=functions.dynamics,
         running_cost=functions.running_cost,
@@ -138,6 +140,7 @@ def assemble_problem(
         n_substeps=integration_substeps(layout, deconfliction.dt),
         regulator_floor=layout.per_state(regulator_floor, 0.0),
         blocks=functions.blocks,
+        node_costs=() if reward is None else (reward,),
     )
     guess = Trajectory(
         states=stacked_desired, inputs=np.zeros((deconfliction.time.size - 1, layout.n_u))

@@ -270,11 +270,17 @@ class WeightsConfig(TableModel):
 
     ``terrain`` scales the pull towards the terrain-informed desired trajectory (0 gives the
     energy-only plan), ``energy`` the electrical power, ``terminal`` the arrival stiffness.
+    ``information`` [W] rewards the optimiser directly for staying over informative terrain
+    (the information map's spline surface, times ``terrain``; 0 leaves it to the desired path).
     """
 
     terrain: Number = Field(1.0, ge=0.0, le=1e6, description="terrain (desired-path) weight")
     energy: Number = Field(1.0, ge=0.0, le=1e6, description="electrical-energy weight")
     terminal: Number = Field(1.0, gt=0.0, le=1e6, description="arrival-pose weight")
+    information: Number = Field(
+        0.0, ge=0.0, le=1e4, description="reward for information in the optimiser (x terrain)",
+        json_schema_extra=_unit("W"),
+    )  # fmt: skip
 
 
 class PlannerConfig(TableModel):

@@ -51,7 +51,7 @@ from auvplan.optimization.options import (
     StageBackend,
     TerminalRegulator,
 )
-from auvplan.optimization.problem import PathConstraint, Trajectory, TrajectoryProblem
+from auvplan.optimization.problem import NodeCost, PathConstraint, Trajectory, TrajectoryProblem
 from auvplan.optimization.projection import design_regulator, project, project_guess
 from auvplan.optimization.pronto import solve_pronto
 from auvplan.optimization.result import ProntoIteration, ProntoResult, ProntoStatus
@@ -85,6 +85,7 @@ __all__ = [
     "LocalModel",
     "LqDirection",
     "ModelCache",
+    "NodeCost",
     "PathConstraint",
     "ProntoIteration",
     "ProntoModel",

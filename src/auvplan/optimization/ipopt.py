@@ -118,9 +118,12 @@ def solve_ipopt(
     Raises
     ------
     InputError
-        If the guess has the wrong shape or ``barrier`` is not ``(ε > 0, δ > 0)``.
+        If the guess has the wrong shape, ``barrier`` is not ``(ε > 0, δ > 0)`` or the
+        problem has node costs (not CasADi expressions, so not in the NLP).
     """
     start = time.perf_counter()
+    if problem.node_costs:
+        raise InputError("the IPOPT reference cannot include node costs (set them to none)")
     n_x, n_u, n_steps = problem.n_states, problem.n_inputs, problem.n_steps
     if guess.states.shape != (n_steps + 1, n_x) or guess.inputs.shape != (n_steps, n_u):
         raise InputError(

@@ -20,7 +20,7 @@ the nodes ``k = 0..N-1`` (where an input exists); ``x_N`` is steered by the term
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Literal, Protocol, runtime_checkable
 
 import casadi as ca
 import numpy as np
@@ -32,7 +32,24 @@ from auvplan.optimization.integration import check_substeps
 from auvplan.optimization.options import named_choice
 from auvplan.optimization.separable import StageBlock, check_tiling
 
-__all__ = ["PathConstraint", "Trajectory", "TrajectoryProblem"]
+__all__ = ["NodeCost", "PathConstraint", "Trajectory", "TrajectoryProblem"]
+
+
+@runtime_checkable
+class NodeCost(Protocol):
+    """A cost rate ``r(x)`` [cost/s] charged at the nodes: ``dt Σ_{k<N} r(x_k)``.
+
+    For terms that are not CasADi expressions (e.g. a spline surface of a terrain map),
+    evaluated with exact derivatives by the implementation.
+    """
+
+    def values(self, states: FloatArray) -> FloatArray:
+        """``r(x_k)`` at states ``(N, n_x)``, shape ``(N,)``."""
+        ...
+
+    def derivatives(self, states: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``r`` ``(N,)``, ``∇r`` ``(N, n_x)`` and ``∇²r`` ``(N, n_x, n_x)``."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -125,6 +142,9 @@ class TrajectoryProblem:
         (0: unchanged). A model whose input authority vanishes at rest (thrust ∝ n|n| has
         ``∂T/∂n = 0`` at ``n = 0``) stays controllable in the design; the Newton model keeps the
         exact linearisation. Default: the exact linearisation.
+    node_costs : tuple of NodeCost
+        Cost rates charged at the nodes ``k = 0..N-1`` (rectangle rule, ``dt Σ_k r(x_k)``),
+        added to the running cost. Default: none.
     blocks : tuple of StageBlock
         The separable structure of ``dynamics`` and ``running_cost`` when they were stacked
         from independent subsystems by :func:`~auvplan.optimization.separable.stack_blocks`:
@@ -144,6 +164,7 @@ class TrajectoryProblem:
     regulator_R: FloatArray | None = field(default=None)
     n_substeps: int = 1
     regulator_floor: FloatArray | None = None
+    node_costs: tuple[NodeCost, ...] = ()
     blocks: tuple[StageBlock, ...] = ()
 
     def __post_init__(self) -> None:
@@ -184,6 +205,10 @@ class TrajectoryProblem:
                 raise InputError(f"regulator_floor must be finite, >= 0, with shape ({n_x},)")
             object.__setattr__(self, "regulator_floor", floor)
         object.__setattr__(self, "blocks", tuple(self.blocks))
+        object.__setattr__(self, "node_costs", tuple(self.node_costs))
+        for term in self.node_costs:
+            if not isinstance(term, NodeCost):
+                raise InputError(f"node_costs must implement NodeCost, got {term!r}")
         if self.blocks:
             check_tiling(self.blocks, (n_x, n_u, n_p))
         object.__setattr__(self, "constraints", tuple(self.constraints))

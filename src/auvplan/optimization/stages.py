@@ -101,6 +101,8 @@ def evaluate_cost(
         running = float(
             np.sum(model.discrete.cost(trajectory.states[:-1], trajectory.inputs, params))
         )
+        for term in model.problem.node_costs:
+            running += model.problem.dt * float(np.sum(term.values(trajectory.states[:-1])))
         terminal = model.terminal.value(trajectory.states[-1])
         barrier = 0.0
         smallest = float("inf")
@@ -168,6 +170,10 @@ def linearize(
     problem = model.problem
     states, inputs, params = trajectory.states[:-1], trajectory.inputs, problem.parameters
     f_x, f_u, stage_cost, l_x, l_u = model.discrete.first_order(states, inputs, params)
+    for term in problem.node_costs:
+        value, gradient, _ = term.derivatives(states)
+        stage_cost = stage_cost + problem.dt * value
+        l_x = l_x + problem.dt * gradient
     terminal, m_x, m_xx = model.terminal.evaluate(trajectory.states[-1])
     n_stages = trajectory.n_steps
     n_c = model.constraints.n_c if model.constraints is not None else 0
@@ -238,8 +244,13 @@ def _with_barrier_hessians(
     lin: Linearization,
     blocks: tuple[FloatArray, FloatArray, FloatArray],
 ) -> StageWeights:
-    """``blocks`` plus the barrier Hessian ``Σ_j [w''_j c_j' c_j'ᵀ + w'_j ∇²c_j]``."""
+    """``blocks`` plus the node costs' and the barrier's Hessians.
+
+    The barrier Hessian is ``Σ_j [w''_j c_j' c_j'ᵀ + w'_j ∇²c_j]``, a node cost's ``dt ∇²r``.
+    """
     q, s, r = blocks
+    for term in model.problem.node_costs:
+        q = q + model.problem.dt * term.derivatives(trajectory.states[:-1])[2]
     if model.has_constraints:
         assert model.constraints is not None
         h_xx, h_xu, h_uu = model.constraints.weighted_hessians(
