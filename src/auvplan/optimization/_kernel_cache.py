@@ -90,10 +90,11 @@ def load_kernel_module(
     path = directory / path.name
     is_new = not path.with_suffix(".ready").exists()
     if not path.exists():
+        source = make_source()  # first: a model it refuses leaves nothing behind
         with tempfile.NamedTemporaryFile(
             "w", dir=directory, suffix=".tmp", delete=False, encoding="utf-8"
         ) as handle:
-            handle.write(make_source())
+            handle.write(source)
         Path(handle.name).replace(path)
     spec = importlib.util.spec_from_file_location(f"auvplan_kernels_{path.stem}", path)
     assert spec is not None

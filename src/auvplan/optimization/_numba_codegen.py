@@ -14,6 +14,7 @@ Only the scalar operations that smooth models use are translated; any other oper
 
 from __future__ import annotations
 
+import math
 from typing import Final
 
 import casadi as ca
@@ -21,7 +22,7 @@ import casadi as ca
 __all__ = ["UnsupportedOperation", "numba_source"]
 
 #: Version of the generated code; part of every cache key (bump on any change of the output).
-GENERATOR_VERSION: Final = 2
+GENERATOR_VERSION: Final = 3
 
 _BINARY: Final = {ca.OP_ADD: "+", ca.OP_SUB: "-", ca.OP_MUL: "*", ca.OP_DIV: "/"}
 _UNARY: Final = {
@@ -30,8 +31,8 @@ _UNARY: Final = {
     ca.OP_ASIN: "math.asin", ca.OP_ACOS: "math.acos", ca.OP_ATAN: "math.atan",
     ca.OP_SINH: "math.sinh", ca.OP_COSH: "math.cosh", ca.OP_TANH: "math.tanh",
     ca.OP_ASINH: "math.asinh", ca.OP_ACOSH: "math.acosh", ca.OP_ATANH: "math.atanh",
-    ca.OP_ERF: "math.erf", ca.OP_FABS: "abs", ca.OP_FLOOR: "math.floor",
-    ca.OP_CEIL: "math.ceil",
+    ca.OP_ERF: "math.erf", ca.OP_FABS: "abs", ca.OP_FLOOR: "np.floor",
+    ca.OP_CEIL: "np.ceil",
 }  # fmt: skip
 _TEMPLATES: Final = {
     ca.OP_ASSIGN: "{0}",
@@ -45,15 +46,15 @@ _TEMPLATES: Final = {
     ca.OP_FMIN: "min({0}, {1})",
     ca.OP_FMAX: "max({0}, {1})",
     ca.OP_COPYSIGN: "math.copysign({0}, {1})",
-    ca.OP_FMOD: "math.fmod({0}, {1})",
+    ca.OP_FMOD: "np.fmod({0}, {1})",
     ca.OP_SIGN: "(1.0 if {0} > 0.0 else (-1.0 if {0} < 0.0 else 0.0))",
-    ca.OP_LT: "float({0} < {1})",
-    ca.OP_LE: "float({0} <= {1})",
-    ca.OP_EQ: "float({0} == {1})",
-    ca.OP_NE: "float({0} != {1})",
-    ca.OP_NOT: "float({0} == 0.0)",
-    ca.OP_AND: "float({0} != 0.0 and {1} != 0.0)",
-    ca.OP_OR: "float({0} != 0.0 or {1} != 0.0)",
+    ca.OP_LT: "(1.0 if {0} < {1} else 0.0)",
+    ca.OP_LE: "(1.0 if {0} <= {1} else 0.0)",
+    ca.OP_EQ: "(1.0 if {0} == {1} else 0.0)",
+    ca.OP_NE: "(1.0 if {0} != {1} else 0.0)",
+    ca.OP_NOT: "(1.0 if {0} == 0.0 else 0.0)",
+    ca.OP_AND: "(1.0 if {0} != 0.0 and {1} != 0.0 else 0.0)",
+    ca.OP_OR: "(1.0 if {0} != 0.0 or {1} != 0.0 else 0.0)",
     ca.OP_IF_ELSE_ZERO: "({1} if {0} != 0.0 else 0.0)",
 }
 
@@ -74,6 +75,15 @@ def _expression(function: ca.Function, k: int) -> str:
     raise UnsupportedOperation(f"{function.name()}: CasADi operation {op} is not translated")
 
 
+def _literal(value: float) -> str:
+    """``value`` as Python source (``math.inf``/``math.nan`` for the non-finite ones)."""
+    if math.isnan(value):
+        return "math.nan"
+    if math.isinf(value):
+        return "math.inf" if value > 0 else "-math.inf"
+    return repr(value)
+
+
 def _kernel_lines(function: ca.Function) -> list[str]:
     """The body of ``function`` as one assignment per SX instruction."""
     lines = []
@@ -86,7 +96,7 @@ def _kernel_lines(function: ca.Function) -> list[str]:
         elif op == ca.OP_OUTPUT:
             lines.append(f"    o{out[0]}[{out[1]}] = w{function.instruction_input(k)[0]}")
         elif op == ca.OP_CONST:
-            lines.append(f"    w{out[0]} = {float(function.instruction_constant(k))!r}")
+            lines.append(f"    w{out[0]} = {_literal(float(function.instruction_constant(k)))}")
         else:
             lines.append(f"    w{out[0]} = {_expression(function, k)}")
     return lines

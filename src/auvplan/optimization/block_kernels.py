@@ -67,8 +67,9 @@ def closed_loop_batch(x0, alpha, mu, gains, p, w, h, n_sub, path, inputs):
     rates = np.empty((4, n_x))
     q = np.empty(1)
     for b in range(n_points):
-        z[:] = x0[b]
-        path[b, 0] = z
+        for t in range(n_x):
+            z[t] = x0[b, t]
+            path[b, 0, t] = z[t]
         for k in range(n_stages):
             for i in range(n_u):
                 s = mu[b, k, i]
@@ -89,7 +90,7 @@ def closed_loop_batch(x0, alpha, mu, gains, p, w, h, n_sub, path, inputs):
                 for t in range(n_x):
                     s = rates[0, t] + 2.0 * (rates[1, t] + rates[2, t]) + rates[3, t]
                     z[t] += h / 6.0 * s
-                path[b, k * n_sub + j + 1] = z
+                    path[b, k * n_sub + j + 1, t] = z[t]
 """
 _BUILT: dict[tuple[str, Path | None], BlockKernels] = {}
 
