@@ -1,0 +1,245 @@
+"""Compiled block kernels: the numba translation and the RK4 chain rule vs CasADi.
+
+Oracles: CasADi's own evaluation of the translated Functions, the CasADi discretisation
+(:func:`~auvplan.optimization.discretize_rk4`, which differentiates the RK4 expression graph)
+of the same ``f`` and ``l`` with the weights fixed, central differences of the kernel
+gradient, and a Python loop of single substeps for the closed loop.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from auvplan.optimization import BlockKernels, block_kernels, discretize_rk4
+from auvplan.optimization._kernel_cache import load_kernel_module
+from auvplan.optimization._numba_codegen import (
+    _BINARY,
+    _TEMPLATES,
+    _UNARY,
+    UnsupportedOperation,
+    numba_source,
+)
+
+from ._kernel_models import assert_close, cart, fixed_weights, pendulum
+
+# the package exports the function ``block_kernels`` under the module's name
+kernel_module = importlib.import_module("auvplan.optimization.block_kernels")
+
+DT = 0.4
+N_POINTS = 6
+MODELS: dict[str, tuple[Callable[[], tuple[ca.Function, ca.Function]], np.ndarray]] = {
+    "pendulum": (pendulum, np.array([1.5, 0.4])),
+    "cart": (cart, np.array([0.7])),
+}
+
+
+def _compiled(function: ca.Function, cache: Path) -> Callable[[np.ndarray], np.ndarray]:
+    """The numba kernel of a one-input, one-output Function, on rows of a 2-D array."""
+    source = numba_source({"kernel": function}, "test kernel")
+    module, _ = load_kernel_module(source, lambda: source, cache)
+
+    def evaluate(rows: np.ndarray) -> np.ndarray:
+        out = np.empty((rows.shape[0], function.numel_out(0)))
+        module.kernel_batch(np.ascontiguousarray(rows), out)
+        return out
+
+    return evaluate
+
+
+def _casadi_rows(function: ca.Function, rows: np.ndarray) -> np.ndarray:
+    return np.asarray(function.map(rows.shape[0])(rows.T)).T
+
+
+def test_every_translated_operation_evaluates_like_casadi(
+    kernel_cache: Path, rng: np.random.Generator
+) -> None:
+    a = ca.SX.sym("a", 8)
+    # x, y in (-0.9, 0.9); s, t in (0.5, 2); big in (1.5, 3); q, r in (-3, 3); z in {-1, 0, 1}
+    x, y, s, t, big, q, r, z = (a[i] for i in range(8))
+    expressions = [
+        x + y, x - y, x * y, x / s,
+        ca.sqrt(s), ca.sin(q), ca.cos(q), ca.tan(x), ca.exp(q), ca.log(s), ca.asin(x),
+        ca.acos(y), ca.atan(q), ca.sinh(q), ca.cosh(q), ca.tanh(q), ca.asinh(q), ca.acosh(big),
+        ca.atanh(x), ca.erf(q), ca.fabs(q), ca.floor(q), ca.ceil(q),
+        -q, q**2, 2 * q, 1 / s, s**t, s**3.5, q**3, ca.atan2(q, r), ca.fmin(q, r), ca.fmax(q, r),
+        ca.copysign(s, q), ca.fmod(q, s), ca.sign(z), q < r, q <= r, q == z, q != z,
+        ca.logic_not(z), ca.logic_and(z, q < 0), ca.logic_or(z, q < 0),
+        ca.if_else(q < r, q * s, r * t),
+    ]  # fmt: skip
+    function = ca.Function("every_op", [a], [ca.vertcat(*expressions)])
+    used = {function.instruction_id(k) for k in range(function.n_instructions())}
+    # OP_ASSIGN never occurs in an SX Function's instruction list (it is an MX/codegen op)
+    assert used >= set(_BINARY) | set(_UNARY) | set(_TEMPLATES) - {ca.OP_ASSIGN}
+    n_rows = 200
+    rows = np.column_stack(
+        [
+            rng.uniform(-0.9, 0.9, (n_rows, 2)),
+            rng.uniform(0.5, 2.0, (n_rows, 2)),
+            rng.uniform(1.5, 3.0, n_rows),
+            rng.uniform(-3.0, 3.0, (n_rows, 2)),
+            rng.integers(-1, 2, n_rows).astype(float),
+        ]
+    )
+    rows[:20, 5] = rows[:20, 7]  # q == z: equality true, floor/ceil and sign at integers
+    rows[20:25, 6] = rows[20:25, 5]  # q == r: the ties of <, <=, fmin, fmax
+    rows[25:27, 5] = (1e30, -1e30)  # floor and ceil beyond the int64 range
+    expected = _casadi_rows(function, rows)
+    actual = _compiled(function, kernel_cache)(rows)
+    np.testing.assert_allclose(actual, expected, rtol=1e-12, atol=0.0)
+
+
+def test_infinite_and_nan_constants_evaluate_like_casadi(kernel_cache: Path) -> None:
+    """A constant ``inf`` or ``nan`` is translated, or refused (the caller keeps CasADi)."""
+    x = ca.SX.sym("x", 1)
+    saturated = ca.if_else(x > 0, x + ca.inf, -ca.inf)
+    function = ca.Function("limits", [x], [ca.vertcat(saturated, x + float("nan"), x * 2.0)])
+    rows = np.array([[-1.5], [0.5], [2.0]])
+    try:
+        evaluate = _compiled(function, kernel_cache)
+    except UnsupportedOperation:
+        return
+    np.testing.assert_array_equal(evaluate(rows), _casadi_rows(function, rows))
+
+
+def test_untranslatable_functions_raise_unsupported_operation() -> None:
+    x = ca.SX.sym("x", 2)
+    with pytest.raises(UnsupportedOperation, match="operation"):
+        numba_source({"k": ca.Function("inverse_erf", [x], [ca.erfinv(0.5 * ca.tanh(x))])}, "")
+    y = ca.MX.sym("y", 2)
+    with pytest.raises(UnsupportedOperation, match="not an SX Function"):
+        numba_source({"k": ca.Function("mx", [y], [ca.sin(y)])}, "")
+    with pytest.raises(UnsupportedOperation, match="not dense"):
+        numba_source({"k": ca.Function("sparse", [x], [ca.vertcat(x[0], ca.SX(1, 1))])}, "")
+
+
+@pytest.fixture(scope="module")
+def compiled(kernel_cache: Path) -> dict[str, BlockKernels]:
+    """The kernels of the small models (compiled once per worker)."""
+    return {name: block_kernels(*make(), kernel_cache) for name, (make, _) in MODELS.items()}
+
+
+def _points(
+    kernels: BlockKernels, weights: np.ndarray, rng: np.random.Generator, n_points: int = N_POINTS
+) -> tuple[np.ndarray, ...]:
+    return (
+        0.6 * rng.standard_normal((n_points, kernels.n_x)),
+        0.8 * rng.standard_normal((n_points, kernels.n_u)),
+        rng.standard_normal((n_points, kernels.n_p)),
+        np.tile(weights, (n_points, 1)),
+    )
+
+
+def _full(h_xx: np.ndarray, h_xu: np.ndarray, h_uu: np.ndarray) -> np.ndarray:
+    """The ``(N, n_z, n_z)`` Hessian from its blocks."""
+    return np.block([[h_xx, h_xu], [np.swapaxes(h_xu, 1, 2), h_uu]])
+
+
+@pytest.mark.parametrize("n_substeps", [1, 2, 5])
+@pytest.mark.parametrize("name", list(MODELS))
+def test_kernels_equal_the_casadi_discretization(
+    name: str, n_substeps: int, compiled: dict[str, BlockKernels], rng: np.random.Generator
+) -> None:
+    make, weights = MODELS[name]
+    dynamics, running_cost = make()
+    kernels = compiled[name]
+    reference = discretize_rk4(
+        dynamics, fixed_weights(running_cost, weights), DT, n_substeps=n_substeps
+    )
+    x, u, p, w = _points(kernels, weights, rng)
+    h = DT / n_substeps
+    costate = rng.standard_normal((N_POINTS, kernels.n_x))
+
+    stepped, cost = kernels.step(x, u, p, w, h, n_substeps)
+    assert_close(stepped, reference.step(x, u, p), 1e-12)
+    assert_close(cost, reference.cost(x, u, p), 1e-12)
+
+    f_x, f_u, total, l_x, l_u = reference.first_order(x, u, p)
+    jac, cost_first, grad = kernels.first_order(x, u, p, w, h, n_substeps)
+    assert_close(jac, np.concatenate([f_x, f_u], axis=2), 1e-10)
+    assert_close(cost_first, total, 1e-12)
+    assert_close(grad, np.concatenate([l_x, l_u], axis=1), 1e-10)
+
+    lagrangian = kernels.hessian(x, u, p, w, h, n_substeps, costate, 1.0)
+    assert_close(lagrangian, _full(*reference.lagrangian_hessians(x, u, p, costate)), 1e-10)
+    dynamics_only = kernels.hessian(x, u, p, w, h, n_substeps, costate, 0.0)
+    assert_close(dynamics_only, _full(*reference.weighted_hessians(x, u, p, costate)), 1e-10)
+    assert_close(
+        kernels.hessian(x, u, p, w, h, n_substeps, costate, 0.3),
+        dynamics_only + 0.3 * _full(*reference.cost_hessians(x, u, p)),
+        1e-10,
+    )
+
+
+def test_hessian_matches_differences_of_the_kernel_gradient(
+    compiled: dict[str, BlockKernels], rng: np.random.Generator
+) -> None:
+    kernels, weights = compiled["pendulum"], MODELS["pendulum"][1]
+    x, u, p, w = _points(kernels, weights, rng)
+    costate = rng.standard_normal((N_POINTS, kernels.n_x))
+    h, n_substeps, eps = DT / 3, 3, 1e-5
+
+    def lagrangian_gradient(z: np.ndarray) -> np.ndarray:
+        jac, _, grad = kernels.first_order(z[:, : kernels.n_x], z[:, kernels.n_x :], p, w, h, 3)
+        return grad + np.einsum("bi,bij->bj", costate, jac)
+
+    z = np.concatenate([x, u], axis=1)
+    columns = []
+    for j in range(z.shape[1]):
+        step = np.zeros(z.shape[1])
+        step[j] = eps
+        columns.append((lagrangian_gradient(z + step) - lagrangian_gradient(z - step)) / (2 * eps))
+    differences = np.stack(columns, axis=2)
+    assert_close(kernels.hessian(x, u, p, w, h, n_substeps, costate), differences, 1e-7)
+
+
+def test_chunked_points_give_the_one_chunk_results(
+    compiled: dict[str, BlockKernels], rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    kernels, weights = compiled["cart"], MODELS["cart"][1]
+    x, u, p, w = _points(kernels, weights, rng, n_points=8)
+    costate = rng.standard_normal((8, kernels.n_x))
+    arguments = (x, u, p, w, DT / 2, 2)
+    whole = (*kernels.first_order(*arguments), kernels.hessian(*arguments, costate, 0.7))
+    monkeypatch.setattr(kernel_module, "CHUNK", 3)  # chunks of 3, 3 and 2 points
+    assert len(list(kernel_module._chunks(8))) == 3
+    chunked = (*kernels.first_order(*arguments), kernels.hessian(*arguments, costate, 0.7))
+    for one, many in zip(whole, chunked, strict=True):
+        assert_close(many, one, 1e-14)
+
+
+def test_closed_loop_equals_a_loop_of_substeps(
+    compiled: dict[str, BlockKernels], rng: np.random.Generator
+) -> None:
+    kernels = compiled["pendulum"]
+    n_points, n_stages, n_substeps = 3, 4, 3
+    h = DT / n_substeps
+    x0 = 0.5 * rng.standard_normal((n_points, kernels.n_x))
+    alpha = 0.5 * rng.standard_normal((n_points, n_stages, kernels.n_x))
+    mu = 0.5 * rng.standard_normal((n_points, n_stages, kernels.n_u))
+    gains = 0.8 * rng.standard_normal((n_points, n_stages, kernels.n_u, kernels.n_x))
+    p = rng.standard_normal((n_points, n_stages, kernels.n_p))
+    w = rng.uniform(0.1, 2.0, (n_points, kernels.n_w))  # different weights per point
+
+    path, inputs = kernels.closed_loop(x0, alpha, mu, gains, p, w, h, n_substeps)
+
+    assert path.shape == (n_points, n_stages * n_substeps + 1, kernels.n_x)
+    for b in range(n_points):
+        state = x0[b]
+        expected_path, expected_inputs = [state], []
+        for k in range(n_stages):
+            control = mu[b, k] + gains[b, k] @ (alpha[b, k] - state)
+            expected_inputs.append(control)
+            args = (control[None], p[b, k][None], w[b][None], h)
+            stage_end = kernels.step(state[None], *args, n_substeps)[0][0]
+            for _ in range(n_substeps):
+                state = kernels.step(state[None], *args, 1)[0][0]
+                expected_path.append(state)
+            assert_close(state, stage_end, 1e-13)
+        assert_close(path[b], np.array(expected_path), 1e-12)
+        assert_close(inputs[b], np.array(expected_inputs), 1e-12)
