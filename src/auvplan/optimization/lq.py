@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from auvplan._typing import FloatArray
+from auvplan._typing import FloatArray, IntArray
 from auvplan.errors import SolverError
 from auvplan.optimization import _kernels
 from auvplan.optimization.stages import Linearization, StageWeights
@@ -38,8 +38,15 @@ class DirectionType(enum.Enum):
     STEEPEST = "steepest"
 
 
-def convexify(weights: StageWeights, floor: float) -> StageWeights:
+def convexify(
+    weights: StageWeights, floor: float, groups: tuple[IntArray, ...] = ()
+) -> StageWeights:
     """Clip the eigenvalues of every ``[[Q, S], [Sᵀ, R]]`` and of ``P_N`` at ``floor``.
+
+    Only stages that fail a Cholesky test above the floor change. ``groups`` (index sets of
+    ``z = (x, u)`` that tile it, e.g. one per vehicle) speeds this up without changing the
+    result: a stage with no entry outside the groups' diagonal blocks is block-diagonal, so
+    its blocks are clipped one by one.
 
     Returns
     -------
@@ -50,11 +57,19 @@ def convexify(weights: StageWeights, floor: float) -> StageWeights:
     top = np.concatenate([weights.Q, weights.S], axis=2)
     bottom = np.concatenate([np.swapaxes(weights.S, 1, 2), weights.R], axis=2)
     stacked = np.concatenate([top, bottom], axis=1)
-    stacked = 0.5 * (stacked + np.swapaxes(stacked, 1, 2))
-    clipped = np.ascontiguousarray(stacked)
+    clipped = np.ascontiguousarray(0.5 * (stacked + np.swapaxes(stacked, 1, 2)))
     low = np.nonzero(_kernels.below_floor(clipped, floor))[0]  # only these stages change
-    values, vectors = np.linalg.eigh(clipped[low])
-    clipped[low] = (vectors * np.maximum(values, floor)[:, None, :]) @ np.swapaxes(vectors, 1, 2)
+    if groups:
+        outside = np.ones(clipped.shape[1:], dtype=bool)
+        for group in groups:
+            outside[np.ix_(group, group)] = False
+        separable = ~np.any(clipped[low][:, outside] != 0.0, axis=1)
+        for group in groups:
+            stages = low[separable]
+            block = np.ix_(stages, group, group)
+            clipped[block] = _clip(clipped[block], floor)
+        low = low[~separable]
+    clipped[low] = _clip(clipped[low], floor)
     p_values, p_vectors = np.linalg.eigh(0.5 * (weights.P_N + weights.P_N.T))
     p_clipped = (p_vectors * np.maximum(p_values, floor)) @ p_vectors.T
     return StageWeights(
@@ -63,6 +78,15 @@ def convexify(weights: StageWeights, floor: float) -> StageWeights:
         np.ascontiguousarray(clipped[:, n_x:, n_x:]),
         p_clipped,
     )
+
+
+def _clip(matrices: FloatArray, floor: float) -> FloatArray:
+    """``V max(Λ, floor) Vᵀ`` of each symmetric matrix."""
+    values, vectors = np.linalg.eigh(matrices)
+    clipped: FloatArray = (vectors * np.maximum(values, floor)[:, None, :]) @ np.swapaxes(
+        vectors, 1, 2
+    )
+    return clipped
 
 
 @dataclass(frozen=True)
@@ -143,6 +167,7 @@ def solve_lq_direction(
     quasi_weights: Callable[[], StageWeights] | None = None,
     steepest_weights: StageWeights | None = None,
     eigenvalue_floor: float = 1e-8,
+    groups: tuple[IntArray, ...] = (),
 ) -> LqDirection:
     """Search direction by the discrete Riccati recursion with cross term (§6.3).
 
@@ -163,6 +188,8 @@ def solve_lq_direction(
         Last-resort positive-definite model.
     eigenvalue_floor : float
         Eigenvalue clip of the convexified model.
+    groups : tuple of ndarray
+        Independent subsystems' indices of ``(x, u)`` (see :func:`convexify`).
 
     Returns
     -------
@@ -179,7 +206,7 @@ def solve_lq_direction(
         return direction
     base = quasi_weights() if quasi_weights is not None else weights
     direction = _try_direction(
-        linearization, convexify(base, eigenvalue_floor), DirectionType.CONVEXIFIED
+        linearization, convexify(base, eigenvalue_floor, groups), DirectionType.CONVEXIFIED
     )
     if direction is not None:
         return direction

@@ -28,12 +28,18 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
-from auvplan._typing import FloatArray
+from auvplan._typing import FloatArray, IntArray
 from auvplan.errors import InputError
 from auvplan.optimization._casadi import check_stages
 from auvplan.optimization.block_kernels import BlockKernels, block_kernels
 
-__all__ = ["BlockDiscreteModel", "StageBlock", "check_tiling", "stack_blocks"]
+__all__ = [
+    "BlockDiscreteModel",
+    "StageBlock",
+    "check_tiling",
+    "coordinate_groups",
+    "stack_blocks",
+]
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,6 +87,19 @@ def check_tiling(blocks: Sequence[StageBlock], sizes: tuple[int, int, int]) -> N
         edges = [start for start, _ in rows] + [size]
         if edges[0] != 0 or any(stop != edges[i + 1] for i, (_, stop) in enumerate(rows)):
             raise InputError(f"the blocks' {attribute} do not tile the {size} stacked rows")
+
+
+def coordinate_groups(blocks: Sequence[StageBlock], n_x: int) -> tuple[IntArray, ...]:
+    """Each block's rows of ``z = (x, u)`` (its states, then ``n_x`` + its inputs)."""
+    return tuple(
+        np.concatenate(
+            [
+                np.arange(b.states.start, b.states.stop),
+                n_x + np.arange(b.inputs.start, b.inputs.stop),
+            ]
+        )
+        for b in blocks
+    )
 
 
 def stack_blocks(

@@ -20,6 +20,7 @@ from auvplan.optimization.model import ProntoModel
 from auvplan.optimization.options import FallbackModel, ProntoOptions
 from auvplan.optimization.problem import Trajectory, TrajectoryProblem
 from auvplan.optimization.projection import regulator_gains
+from auvplan.optimization.separable import coordinate_groups
 from auvplan.optimization.stages import (
     Linearization,
     StageWeights,
@@ -148,5 +149,6 @@ def compute_direction(
         quasi_weights=quasi,
         steepest_weights=steepest_weights(model.problem),
         eigenvalue_floor=options.eigenvalue_floor,
+        groups=coordinate_groups(model.problem.blocks, model.problem.n_states),
     )
     return local, direction
