@@ -162,7 +162,7 @@ class BlockKernels:
         self, x: FloatArray, u: FloatArray, p: FloatArray, w: FloatArray, h: float, n_substeps: int
     ) -> list[_Forward]:
         """The forward sweeps of every chunk (reused when the arguments repeat)."""
-        digest = hashlib.blake2b(np.float64(h).tobytes() + bytes([n_substeps % 256]))
+        digest = hashlib.blake2b(np.array([h, n_substeps, CHUNK], dtype=np.float64).tobytes())
         for array in (x, u, p, w):
             digest.update(np.ascontiguousarray(array).tobytes())
         key = digest.digest()
