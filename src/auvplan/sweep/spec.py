@@ -232,8 +232,10 @@ def lookup(document: Mapping[str, Any], key: str) -> Any:
     node: Any = document
     for name, index in _key_parts(key):
         node = node[name]
-        if isinstance(node, list):
-            node = node[0 if index is None else index]
+        if index is not None:
+            node = node[index]
+        elif isinstance(node, list) and node and isinstance(node[0], dict):  # array of tables
+            node = node[0]
     return node
 
 

@@ -1,11 +1,11 @@
 """The record of each run and the sweep's table (``sweep.csv``, ``sweep.json``).
 
 Every finished run's folder holds, next to the normal ``plan`` output, ``sweep_run.json``:
-the run's id, varied values, seed, digest (:class:`~auvplan.sweep.spec.SweepRun`), wall time
-and peak memory. A run is *finished* when its folder holds ``summary.json`` and a
-``sweep_run.json`` with the digest the sweep expects; :func:`read_run_folder` then rebuilds
-its :class:`RunRecord` from the two files, exactly as for a run that just ended, so a resumed
-sweep's table equals a fresh one's.
+the run's id, varied values, seed, digest (:class:`~auvplan.sweep.spec.SweepRun`), wall time,
+peak memory and the worker process (host, pid). A run is *finished* when its folder holds
+``summary.json`` and a ``sweep_run.json`` with the digest the sweep expects;
+:func:`read_run_folder` then rebuilds its :class:`RunRecord` from the two files, exactly as
+for a run that just ended, so a resumed sweep's table equals a fresh one's.
 
 Columns of ``sweep.csv``, one row per run in grid order: ``run_id``, one column per varied key
 (its dotted name), ``seed``, ``status`` (the plan verdict ``CONVERGED`` /
@@ -28,6 +28,8 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import socket
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -94,7 +96,7 @@ class RunRecord:
 def run_record_document(
     run: SweepRun, *, wall_s: float, peak_rss_mb: float | None, messages: Sequence[str]
 ) -> dict[str, Any]:
-    """The content of a finished run's ``sweep_run.json``."""
+    """The content of a finished run's ``sweep_run.json`` (written by the worker that ran it)."""
     return {
         "auvplan_version": __version__,
         "run_id": run.run_id,
@@ -103,6 +105,7 @@ def run_record_document(
         "digest": run.digest,
         "wall_s": wall_s,
         "peak_rss_mb": peak_rss_mb,
+        "worker": {"host": socket.gethostname(), "pid": os.getpid()},
         "messages": list(messages),
     }
 
@@ -235,8 +238,9 @@ def write_sweep_files(
 ) -> list[Path]:
     """Write ``sweep.csv`` (the frame) and ``sweep.json`` (spec, sections and rows) atomically.
 
-    Returns the two paths.
+    ``directory`` is created if needed. Returns the two paths.
     """
+    directory.mkdir(parents=True, exist_ok=True)
     table, document = directory / "sweep.csv", directory / "sweep.json"
     with staged_output_file(table) as staging:
         frame.to_csv(staging, index=False)
