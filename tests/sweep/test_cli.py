@@ -23,7 +23,9 @@ def test_second_invocation_skips_finished_runs(
     tiny_mission: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out = tmp_path / "sweep"
-    assert _sweep(tiny_mission, out, "--vary", "planner.edge_model=paper,crossed", "--seeds", "3") == 0
+    assert (
+        _sweep(tiny_mission, out, "--vary", "planner.edge_model=paper,crossed", "--seeds", "3") == 0
+    )
     first = pd.read_csv(out / "sweep.csv")
     assert first["run_id"].tolist() == [
         "planner.edge_model=paper__seed=3",
@@ -40,7 +42,8 @@ def test_second_invocation_skips_finished_runs(
     assert "4 runs (2 ran, 2 skipped as finished before, 0 failed)" in capsys.readouterr().out
     assert {path: path.stat().st_mtime_ns for path in summaries} == summaries  # not rewritten
     document = json.loads((out / "sweep.json").read_text())
-    assert document["counts"]["skipped"] == 2 and document["spec"]["seeds"] == [3, 4]
+    assert document["counts"]["skipped"] == 2
+    assert document["spec"]["seeds"] == [3, 4]
     second = pd.read_csv(out / "sweep.csv")
     assert len(second) == 4
     pd.testing.assert_frame_equal(second.iloc[[0, 2]].reset_index(drop=True), first)
@@ -54,9 +57,11 @@ def test_failed_runs_are_rows_and_all_failed_exits_3(
     vary = f"vehicle[0].start={GOOD_START},{LAND_START}"
     assert _sweep(tiny_mission, out, "-q", "--vary", vary) == 0
     table = pd.read_csv(out / "sweep.csv", keep_default_na=False)
-    assert table.loc[0, "status"] == "PREPLANNED" and table.loc[0, "reason"] == ""
+    assert table.loc[0, "status"] == "PREPLANNED"
+    assert table.loc[0, "reason"] == ""
     assert table.loc[1, "status"] in {"InputError", "InfeasibleError"}
-    assert "blue" in table.loc[1, "reason"] and table.loc[1, "folder"] == ""
+    assert "blue" in table.loc[1, "reason"]
+    assert table.loc[1, "folder"] == ""
     assert len(list((out / "runs").iterdir())) == 1
 
     out_bad = tmp_path / "all_bad"
@@ -84,12 +89,16 @@ def test_user_errors_exit_2_with_one_line(
     out = tmp_path / "sweep"
     assert _sweep(tiny_mission, out, *options) == 2
     lines = capsys.readouterr().err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("auvplan: error: ") and fragment in lines[0]
+    assert len(lines) == 1
+    assert lines[0].startswith("auvplan: error: ")
+    assert fragment in lines[0]
     assert not out.exists()
 
 
 def test_scenarios_need_seeds(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["sweep", "scenarios", "-o", str(tmp_path / "s"), "--vary", "weights.terrain=1"]) == 2
+    assert (
+        main(["sweep", "scenarios", "-o", str(tmp_path / "s"), "--vary", "weights.terrain=1"]) == 2
+    )
     assert "needs --seeds" in capsys.readouterr().err
 
 
@@ -103,7 +112,9 @@ def test_missing_dask_names_the_extra(
 
     find_spec = importlib.util.find_spec
     monkeypatch.setattr(
-        importlib.util, "find_spec", lambda name, *a: None if name == "distributed" else find_spec(name, *a)
+        importlib.util,
+        "find_spec",
+        lambda name, *a: None if name == "distributed" else find_spec(name, *a),
     )
     assert _sweep(tiny_mission, tmp_path / "s", "--vary", "weights.terrain=1") == 2
     assert "pip install 'auvplan[sweep]'" in capsys.readouterr().err

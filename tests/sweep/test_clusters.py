@@ -40,7 +40,10 @@ def scheduler_address(tmp_path: Path) -> Iterator[str]:
         pytest.skip(f"dask command not found at {DASK}")
     port = _free_port()
     address = f"tcp://127.0.0.1:{port}"
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")])}
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")]),
+    }
     logs = [(tmp_path / f"dask_{name}.log").open("w") for name in ("scheduler", "w1", "w2")]
     commands = [
         [str(DASK), "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
@@ -91,13 +94,15 @@ def test_sweep_on_a_separately_started_scheduler(
     table = pd.read_csv(out / "sweep.csv")
     assert len(table) == 4
     assert (table["status"] == "CONVERGED").all(), table[["run_id", "status", "reason"]]
-    assert (table["energy_J"] > 0).all() and table["terrain_information"].between(0, 1).all()
+    assert (table["energy_J"] > 0).all()
+    assert table["terrain_information"].between(0, 1).all()
     _energy_grows_with_weight(table)
     workers = {
         json.loads((Path(folder) / "sweep_run.json").read_text())["worker"]["pid"]
         for folder in table["folder"]
     }
-    assert os.getpid() not in workers and len(workers) == 2  # both workers ran, not this process
+    assert os.getpid() not in workers
+    assert len(workers) == 2
     assert (out / "pareto.png").stat().st_size > 10_000
 
 
@@ -115,7 +120,8 @@ def test_twenty_runs_on_a_local_cluster(
     assert code == 0
     assert "20 runs (20 ran, 0 skipped as finished before, 0 failed)" in capsys.readouterr().out
     table = pd.read_csv(out / "sweep.csv")
-    assert len(table) == 20 and (table["status"] == "CONVERGED").all()
+    assert len(table) == 20
+    assert (table["status"] == "CONVERGED").all()
     assert table["peak_rss_mb"].gt(50).all()
     # a mission file's seed only labels the run: both seeds give the same plan
     by_seed = table.pivot_table(
@@ -124,7 +130,7 @@ def test_twenty_runs_on_a_local_cluster(
     pd.testing.assert_series_equal(by_seed[0], by_seed[1], check_names=False, rtol=1e-9)
     _energy_grows_with_weight(table)
     document = json.loads((out / "sweep.json").read_text())
+    assert 0 < document["wall_time_s"] <= wall
     assert len(document["pareto"]) == 10  # 5 weights x 2 edge models, seeds averaged
     assert any(point["on_front"] for point in document["pareto"])
     assert (out / "pareto.png").stat().st_size > 10_000
-    print(f"20-run sweep on a 2-worker LocalCluster: {wall:.1f} s", file=sys.stderr)

@@ -54,7 +54,8 @@ def test_points_average_mission_seeds_and_rank_converged_only() -> None:
     frame = sweep_frame(records, ["weights.terrain"])
     view = pareto_view(frame, ["weights.terrain"], seeds_are_missions=False)
     assert view is not None
-    assert view.objective == "terrain_information" and view.maximize
+    assert view.objective == "terrain_information"
+    assert view.maximize
     points = view.points.set_index("label")
     assert points.loc[0.0, "energy_J"] == pytest.approx(101.0)
     assert points.loc[0.0, "n_runs"] == 2
@@ -70,7 +71,8 @@ def test_filled_tan_column_switches_objective_and_scenarios_group_by_seed() -> N
     frame[TAN_COLUMN] = [20.0, 12.0, 25.0, 25.0]
     view = pareto_view(frame, ["weights.terrain"], seeds_are_missions=True)
     assert view is not None
-    assert view.objective == TAN_COLUMN and not view.maximize
+    assert view.objective == TAN_COLUMN
+    assert not view.maximize
     assert sorted(set(view.points["group"])) == ["seed=0", "seed=1"]
     fronts = view.points.groupby("group")["on_front"].sum().to_dict()
     assert fronts == {"seed=0": 2, "seed=1": 1}  # seed 1: weight 1 costs more, no better
@@ -78,6 +80,8 @@ def test_filled_tan_column_switches_objective_and_scenarios_group_by_seed() -> N
 
 
 def test_no_points_without_energy() -> None:
-    frame = sweep_frame([RunRecord("a", {"weights.terrain": 1.0}, None, "PREPLANNED")], ["weights.terrain"])
+    frame = sweep_frame(
+        [RunRecord("a", {"weights.terrain": 1.0}, None, "PREPLANNED")], ["weights.terrain"]
+    )
     assert pareto_view(frame, ["weights.terrain"], seeds_are_missions=False) is None
     assert isinstance(frame, pd.DataFrame)

@@ -31,8 +31,12 @@ def test_run_writes_its_folder_and_reads_back(tiny_mission: Path, tmp_path: Path
     run, other = _runs(tiny_mission, "planner.edge_model=paper,crossed")
     folder = tmp_path / "runs" / run.run_id
     record = execute_run(run, folder, PREPLAN)
-    assert record.status == "PREPLANNED" and not record.failed and record.reason == ""
-    assert record.folder == folder and record.wall_s is not None and record.wall_s > 0
+    assert record.status == "PREPLANNED"
+    assert not record.failed
+    assert record.reason == ""
+    assert record.folder == folder
+    assert record.wall_s is not None
+    assert record.wall_s > 0
     assert {"summary.json", "mission.toml", "maps.nc", RUN_RECORD_FILE} <= {
         path.name for path in folder.iterdir()
     }
@@ -40,7 +44,8 @@ def test_run_writes_its_folder_and_reads_back(tiny_mission: Path, tmp_path: Path
     assert read_run_folder(folder, run) == record
     assert read_run_folder(folder, other) is None  # another run's digest: not finished
     full = _runs(tiny_mission, "planner.edge_model=paper", stage="full")[0]
-    assert full.run_id == run.run_id and read_run_folder(folder, full) is None  # other stage
+    assert full.run_id == run.run_id
+    assert read_run_folder(folder, full) is None
     (folder / "summary.json").unlink()
     assert read_run_folder(folder, run) is None
 
@@ -49,16 +54,18 @@ def test_failed_run_is_a_record_and_writes_nothing(tiny_mission: Path, tmp_path:
     (run,) = _runs(tiny_mission, "vehicle[0].start.north=280.0", "vehicle[0].start.east=20.0")
     folder = tmp_path / "runs" / run.run_id
     record = execute_run(run, folder, PREPLAN)  # the start is on land
-    assert record.failed and record.folder is None
+    assert record.failed
+    assert record.folder is None
     assert record.status in {"InputError", "InfeasibleError"}
-    assert "blue" in record.reason and "\n" not in record.reason
+    assert "blue" in record.reason
+    assert "\n" not in record.reason
     assert not (tmp_path / "runs").exists() or not any((tmp_path / "runs").iterdir())
 
 
 def test_unexpected_exception_is_a_bug_record(
     tiny_mission: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import auvplan.mission.pipeline as pipeline
+    from auvplan.mission import pipeline
 
     def broken(*args: object, **kwargs: object) -> None:
         raise ZeroDivisionError("boom")
@@ -86,5 +93,5 @@ def test_table_columns_and_navigation_hook(tiny_mission: Path, tmp_path: Path) -
     assert filled["tan_rmse_m"].isna().tolist() == [True, False]
     assert filled.loc[1, "tan_rmse_m"] == 7.5
     (records[0].folder / "navigation.json").write_text('{"plans": {}}')
-    with pytest.raises(DataFormatError, match="plans.terrain_aware.rmse_m"):
+    with pytest.raises(DataFormatError, match=r"plans\.terrain_aware\.rmse_m"):
         add_run_columns(frame, navigation_columns)

@@ -1,4 +1,4 @@
-"""``auvplan sweep MISSION -o DIR --vary KEY=v1,v2,... [--seeds A..B]``: parameter sweeps on dask."""
+"""``auvplan sweep MISSION -o DIR --vary KEY=v1,v2,... [--seeds A..B]``: sweeps on dask."""
 
 from __future__ import annotations
 
@@ -137,13 +137,16 @@ def _run(args: argparse.Namespace, runs: Any) -> Any:
         )  # fmt: skip
 
 
-def _finish(
-    args: argparse.Namespace, axes: Any, records: Any, seeds: Any, wall_s: float
-) -> int:
+def _finish(args: argparse.Namespace, axes: Any, records: Any, seeds: Any, wall_s: float) -> int:
     """Write sweep.csv/json and pareto.png, print the one-line summary, return the exit code."""
     from auvplan.io.output import staged_output_file
-    from auvplan.sweep import add_run_columns, navigation_columns, pareto_view, sweep_frame
-    from auvplan.sweep import write_sweep_files
+    from auvplan.sweep import (
+        add_run_columns,
+        navigation_columns,
+        pareto_view,
+        sweep_frame,
+        write_sweep_files,
+    )
 
     keys = [axis.key for axis in axes]
     frame = add_run_columns(sweep_frame(records, keys), navigation_columns)

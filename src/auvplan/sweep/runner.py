@@ -18,6 +18,7 @@ dask is imported only when a sweep runs; without it, the error names the extra t
 from __future__ import annotations
 
 import contextlib
+import importlib
 import importlib.util
 import logging
 import re
@@ -126,17 +127,22 @@ def run_sweep(
         if finished is not None:
             records[run.run_id] = replace(finished, skipped=True)
     pending = [run for run in runs if run.run_id not in records]
-    counts = {"total": len(runs), "skipped": len(records), "finished": 0, "failed": 0}
+    report = progress or (lambda _event: None)
     if not pending:
-        if progress is not None:
-            progress(SweepProgress(**counts, running=0))
+        report(SweepProgress(len(runs), len(records), 0, 0, 0))
         return [records[run.run_id] for run in runs]
     for run in pending:
         _remove_stale_staging(run_folder(directory, run))
     with _dask_client(scheduler, n_workers) as (client, as_completed, killed_worker):
-        threads = sum(client.nthreads().values()) or 1
-        if progress is not None:
-            progress(SweepProgress(**counts, running=min(threads, len(pending))))
+
+        def event(finished: int, failed: int, record: RunRecord | None = None) -> SweepProgress:
+            threads = sum(client.nthreads().values()) or 1
+            running = min(threads, len(pending) - finished)
+            return SweepProgress(
+                len(runs), len(runs) - len(pending), finished, failed, running, record
+            )
+
+        report(event(0, 0))
         batch = uuid.uuid4().hex[:8]  # keys unique on a shared scheduler
         futures = {
             client.submit(
@@ -145,7 +151,8 @@ def run_sweep(
             ): run
             for index, run in enumerate(pending)
         }  # fmt: skip
-        for future in as_completed(futures):
+        n_failed = 0
+        for n_finished, future in enumerate(as_completed(futures), start=1):
             run = futures[future]
             try:
                 record = future.result()
@@ -154,15 +161,11 @@ def run_sweep(
                     run.run_id, run.values, run.seed, WORKER_DIED,
                     "its worker process died (a crash, or killed for memory)",
                 )  # fmt: skip
-            except Exception as error:  # the cluster lost the task: a row, not the sweep's end
+            except Exception as error:  # noqa: BLE001 (the cluster lost the task: a row)
                 record = _failure(run, error)
             records[run.run_id] = record
-            counts["finished"] += 1
-            counts["failed"] += record.failed
-            if progress is not None:
-                outstanding = len(pending) - counts["finished"]
-                threads = sum(client.nthreads().values()) or 1
-                progress(SweepProgress(**counts, running=min(threads, outstanding), record=record))
+            n_failed += record.failed
+            report(event(n_finished, n_failed, record))
     return [records[run.run_id] for run in runs]
 
 
@@ -196,7 +199,7 @@ def execute_run(run: SweepRun, folder: Path, options: RunOptions) -> RunRecord:
                     messages=messages,
                 )
                 write_json(document, staging / RUN_RECORD_FILE)
-        except Exception as error:
+        except Exception as error:  # noqa: BLE001 (any failure is the run's row)
             return _failure(run, error, wall_s=time.perf_counter() - started)
     record = read_run_folder(folder, run)
     if record is None:
@@ -236,34 +239,34 @@ def require_dask() -> None:
 def _dask_client(scheduler: str | None, n_workers: int | None) -> Iterator[tuple[Any, Any, Any]]:
     """``(client, as_completed, KilledWorker)`` of the cluster; closed (and stopped) after."""
     require_dask()
-    import dask
-    from distributed import Client, LocalCluster, as_completed
-    from distributed.scheduler import KilledWorker
-
+    dask = importlib.import_module("dask")
+    distributed = importlib.import_module("distributed")
+    as_completed = distributed.as_completed
+    killed_worker = distributed.scheduler.KilledWorker
     if scheduler is not None:
         try:
-            client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+            client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT_S)
         except (OSError, TimeoutError, ValueError) as error:
             message = " ".join(str(error).split())[:200]
             raise InputError(f"--scheduler {scheduler}: cannot connect ({message})") from None
         with client:
-            yield client, as_completed, KilledWorker
+            yield client, as_completed, killed_worker
         return
     # A run that kills its worker is not tried again on another one; the in-process
     # scheduler and nannies log only errors (the user's terminal shows the progress).
     with (
         _logger_level("distributed", logging.ERROR),
         dask.config.set({"distributed.scheduler.allowed-failures": 0}),
-        LocalCluster(
+        distributed.LocalCluster(
             n_workers=n_workers,
             threads_per_worker=1,
             processes=True,
             dashboard_address=None,
             silence_logs=logging.ERROR,
         ) as cluster,
-        Client(cluster) as client,
+        distributed.Client(cluster) as client,
     ):
-        yield client, as_completed, KilledWorker
+        yield client, as_completed, killed_worker
 
 
 @contextlib.contextmanager

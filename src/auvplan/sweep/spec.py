@@ -100,7 +100,9 @@ def parse_vary(text: str) -> tuple[str, list[Any]]:
     key, equals, listing = text.partition("=")
     key = key.strip()
     if not equals or not key:
-        raise InputError(f"--vary {text!r}: expected KEY=VALUE,VALUE,... (e.g. weights.terrain=0,1)")
+        raise InputError(
+            f"--vary {text!r}: expected KEY=VALUE,VALUE,... (e.g. weights.terrain=0,1)"
+        )
     _key_parts(key)
     tokens = _split_top_level(listing)
     if any(not token.strip() for token in tokens):
@@ -298,15 +300,18 @@ def _set(document: dict[str, Any], key: str, value: Any, label: str) -> None:
                 continue
             child = node.setdefault(name, {} if index is None else [])
             if isinstance(child, list):
-                if index is not None and index >= len(child):
+                if index is None:
+                    following.extend(child)
+                    continue
+                if index >= len(child):
                     raise InputError(
                         f"--vary {key}: {label} has {len(child)} [[{name}]] tables, "
                         f"no index {index}"
                     )
                 if last:
-                    child[index] = copy.deepcopy(value)  # index is set: see the check above
-                    continue
-                following.extend(child if index is None else [child[index]])
+                    child[index] = copy.deepcopy(value)
+                else:
+                    following.append(child[index])
             elif index is not None:
                 raise InputError(f"--vary {key}: {name} is not an array of tables ({label})")
             else:

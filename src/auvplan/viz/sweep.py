@@ -60,9 +60,7 @@ def plot_pareto(view: ParetoView, *, title: str = "") -> Figure:
                     f"{label:g}" if isinstance(label, float) else str(label), (x, y),
                     textcoords="offset points", xytext=(5, 4), fontsize=8,
                 )  # fmt: skip
-    axes.set_xlabel(
-        "fleet energy above the group's least [%]" if relative else "fleet energy [kJ]"
-    )
+    axes.set_xlabel("fleet energy above the group's least [%]" if relative else "fleet energy [kJ]")
     axes.set_ylabel(_AXIS_LABELS.get(view.objective, view.objective))
     axes.grid(alpha=0.3)
     shown = view.label_key or "run"
