@@ -30,6 +30,7 @@ FORBIDDEN = {
     },
     "mission": {"cli", "viz", "scenarios"},
     "scenarios": {"optimization", "mission", "cli", "viz"},
+    "sweep": {"cli", "viz"},
     "viz": {"cli"},
 }
 

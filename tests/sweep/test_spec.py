@@ -112,6 +112,10 @@ def test_key_given_twice(tiny_mission: Path) -> None:
 def test_run_identifier_is_safe_and_unique() -> None:
     assert run_identifier({}, None) == "run"
     assert run_identifier({"maps.block": [2, 2]}, None) == "maps.block=2-2"
+    start = {"north": 10.0, "east": 400.0}
+    assert run_identifier({"vehicle[0].start": start}, 0) == (
+        "vehicle0.start=north-10.0-east-400.0__seed=0"
+    )
     odd = [run_identifier({"terrain.file": name}, 1) for name in ("a/b.nc", "a_b.nc", "a b.nc")]
     assert len(set(odd)) == 3
     assert all(SAFE_ID.match(identifier) for identifier in odd)

@@ -222,7 +222,7 @@ def _progress(total: int, *, quiet: bool) -> Iterator[Callable[[Any], None] | No
         TextColumn("sweep"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[counts]}"),
         TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(), console=console,
     ) as bar:  # fmt: skip
-        task = bar.add_task("sweep", total=total, counts="")
+        task = bar.add_task("sweep", total=total, counts="starting the cluster")
 
         def update(event: Any) -> None:
             if event.record is None:  # the start: runs finished before count as done

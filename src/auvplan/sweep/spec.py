@@ -349,6 +349,8 @@ def _value_text(value: Any) -> str:
         return "true" if value else "false"
     if isinstance(value, list | tuple):
         return "-".join(_value_text(item) for item in value)
+    if isinstance(value, dict):
+        return "-".join(f"{_SAFE.sub('_', key)}-{_value_text(item)}" for key, item in value.items())
     if isinstance(value, float):
         return repr(value)
     return _SAFE.sub("_", str(value))

@@ -255,8 +255,8 @@ def write_sweep_files(
 
 
 def _cell(value: Any) -> Any:
-    """A varied value as a table cell (arrays as their TOML-like text)."""
-    return str(list(value)) if isinstance(value, list | tuple) else value
+    """A varied value as a table cell (arrays and tables as JSON text)."""
+    return json.dumps(value, default=str) if isinstance(value, list | tuple | dict) else value
 
 
 def _json_cell(value: Any) -> Any:
