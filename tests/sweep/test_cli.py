@@ -118,3 +118,19 @@ def test_missing_dask_names_the_extra(
     )
     assert _sweep(tiny_mission, tmp_path / "s", "--vary", "weights.terrain=1") == 2
     assert "pip install 'auvplan[sweep]'" in capsys.readouterr().err
+
+
+@pytest.mark.usefixtures("inprocess_cluster")
+def test_scenario_family_seeds_are_missions(tmp_path: Path) -> None:
+    out = tmp_path / "family"
+    options = ["--seeds", "2,3", "--vary", "weights.terrain=0", "--data-dir", str(tmp_path / "no")]
+    assert main(["-q", "sweep", "scenarios", "-o", str(out), "--stage", "preplan", *options]) == 0
+    table = pd.read_csv(out / "sweep.csv")
+    assert table["seed"].tolist() == [2, 3]
+    assert (table["status"] == "PREPLANNED").all()
+    for seed, folder in zip(table["seed"], table["folder"], strict=True):
+        mission = out / "scenarios" / f"seed_{seed:04d}" / "mission.toml"
+        summary = json.loads((Path(folder) / "summary.json").read_text())
+        assert summary["inputs"]["mission"]["path"] == str(mission.resolve())
+    assert len({json.loads((Path(f) / "summary.json").read_text())["terrain"]["name"]
+                for f in table["folder"]}) == 2  # fmt: skip

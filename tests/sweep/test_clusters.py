@@ -19,6 +19,8 @@ import pandas as pd
 import pytest
 
 from auvplan.cli.main import main
+from auvplan.sweep import RunOptions, build_runs, mission_file_base, run_sweep
+from auvplan.sweep.runner import WORKER_DIED
 
 pytestmark = pytest.mark.slow
 
@@ -134,3 +136,26 @@ def test_twenty_runs_on_a_local_cluster(
     assert len(document["pareto"]) == 10  # 5 weights x 2 edge models, seeds averaged
     assert any(point["on_front"] for point in document["pareto"])
     assert (out / "pareto.png").stat().st_size > 10_000
+
+
+def _die_for_weight_one(result: object, folder: Path) -> list[Path]:
+    """A figure writer that kills its worker process for the run of weight 1 (a hard crash)."""
+    if "weights.terrain=1.0" in folder.name:
+        os._exit(70)
+    return []
+
+
+def test_a_run_that_kills_its_worker_is_a_row(tiny_mission: Path, tmp_path: Path) -> None:
+    cloudpickle = pytest.importorskip("cloudpickle")
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])  # workers need not import us
+    base = mission_file_base(tiny_mission)
+    _, runs = build_runs(["weights.terrain=0,1"], [None], lambda _seed: base, stage="preplan")
+    options = RunOptions(stage="preplan", write_figures=_die_for_weight_one)
+    try:
+        records = run_sweep(runs, tmp_path / "sweep", options=options, n_workers=1)
+    finally:
+        cloudpickle.unregister_pickle_by_value(sys.modules[__name__])
+    assert [record.status for record in records] == ["PREPLANNED", WORKER_DIED]
+    assert records[1].failed
+    assert records[1].folder is None
+    assert [path.name for path in (tmp_path / "sweep" / "runs").iterdir()] == [runs[0].run_id]

@@ -157,6 +157,7 @@ def run_sweep(
             try:
                 record = future.result()
             except killed_worker:
+                _remove_stale_staging(run_folder(directory, run))
                 record = RunRecord(
                     run.run_id, run.values, run.seed, WORKER_DIED,
                     "its worker process died (a crash, or killed for memory)",
