@@ -77,6 +77,7 @@ def test_failed_runs_are_rows_and_all_failed_exits_3(
         (["--vary", "weights.terrain=1,-1"], "--vary weights.terrain=-1: weights.terrain"),
         (["--vary", "weights.terrain=1", "--seeds", "2..1"], "--seeds"),
         ([], "nothing to sweep"),
+        (["--vary", "weights.terrain=1", "--workers", "0"], "--workers must be at least 1"),
     ],
 )
 def test_user_errors_exit_2_with_one_line(

@@ -5,25 +5,20 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from collections.abc import Callable, Iterator
+from collections import Counter
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from auvplan.cli.plan import EXIT_NOT_CONVERGED, STAGES
 
+if TYPE_CHECKING:  # the command line imports the sweep package only when it runs
+    from auvplan.scenarios import Scenario
+    from auvplan.sweep import MissionBase, RunRecord, SweepProgress, SweepRun, VaryAxis
+
 #: ``MISSION`` naming the public scenario family instead of a file.
 SCENARIOS = "scenarios"
-
-
-def _workers(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"--workers must be a positive integer, got {text!r}")
-    return value
 
 
 def register(subparsers: argparse._SubParsersAction[Any]) -> None:
@@ -70,7 +65,7 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
     )
     cluster.add_argument(
         "--workers",
-        type=_workers,
+        type=int,
         metavar="N",
         help="worker processes of the local cluster (default: the number of cores)",
     )
@@ -95,6 +90,8 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("sweeping 'scenarios' needs --seeds (e.g. --seeds 0..49)")
     if not args.vary and args.seeds is None:
         raise InputError("nothing to sweep: give --vary KEY=V1,V2,... and/or --seeds")
+    if args.workers is not None and args.workers < 1:
+        raise InputError(f"--workers must be at least 1, got {args.workers}")
     require_dask()
     seeds: tuple[int | None, ...] = (None,) if args.seeds is None else parse_seeds(args.seeds)
     base_of, scenario_files = _bases(args, seeds, scenarios=scenarios)
@@ -108,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _bases(
     args: argparse.Namespace, seeds: tuple[int | None, ...], *, scenarios: bool
-) -> tuple[Callable[[int | None], Any], list[tuple[Any, Any]]]:
+) -> tuple[Callable[[int | None], MissionBase], list[tuple[MissionBase, Scenario]]]:
     """The base mission of each seed and the scenario files to write before the runs."""
     from auvplan.sweep import mission_file_base, scenario_bases
 
@@ -119,7 +116,7 @@ def _bases(
     return (lambda seed: bases[seed][0]), list(bases.values())
 
 
-def _run(args: argparse.Namespace, runs: Any) -> Any:
+def _run(args: argparse.Namespace, runs: Sequence[SweepRun]) -> list[RunRecord]:
     from auvplan.sweep import RunOptions, run_sweep
 
     write_figures = None
@@ -137,7 +134,13 @@ def _run(args: argparse.Namespace, runs: Any) -> Any:
         )  # fmt: skip
 
 
-def _finish(args: argparse.Namespace, axes: Any, records: Any, seeds: Any, wall_s: float) -> int:
+def _finish(
+    args: argparse.Namespace,
+    axes: Sequence[VaryAxis],
+    records: Sequence[RunRecord],
+    seeds: tuple[int | None, ...],
+    wall_s: float,
+) -> int:
     """Write sweep.csv/json and pareto.png, print the one-line summary, return the exit code."""
     from auvplan.io.output import staged_output_file
     from auvplan.sweep import (
@@ -185,21 +188,19 @@ def _finish(args: argparse.Namespace, axes: Any, records: Any, seeds: Any, wall_
     return 0
 
 
-def _counts(records: Any) -> dict[str, Any]:
-    statuses: dict[str, int] = {}
-    for record in records:
-        statuses[record.status] = statuses.get(record.status, 0) + 1
+def _counts(records: Sequence[RunRecord]) -> dict[str, Any]:
+    statuses = Counter(record.status for record in records).most_common()
     return {
         "runs": len(records),
         "ran": sum(not record.skipped for record in records),
         "skipped": sum(record.skipped for record in records),
         "failed": sum(record.failed for record in records),
-        "status": dict(sorted(statuses.items(), key=lambda item: -item[1])),
+        "status": dict(statuses),
     }
 
 
 @contextmanager
-def _progress(total: int, *, quiet: bool) -> Iterator[Callable[[Any], None] | None]:
+def _progress(total: int, *, quiet: bool) -> Iterator[Callable[[SweepProgress], None] | None]:
     """A rich progress bar on a terminal, one line per ended run otherwise, nothing if quiet."""
     if quiet:
         yield None
@@ -224,7 +225,7 @@ def _progress(total: int, *, quiet: bool) -> Iterator[Callable[[Any], None] | No
     ) as bar:  # fmt: skip
         task = bar.add_task("sweep", total=total, counts="starting the cluster")
 
-        def update(event: Any) -> None:
+        def update(event: SweepProgress) -> None:
             if event.record is None:  # the start: runs finished before count as done
                 bar.update(task, total=total - event.skipped)
             elif event.record.failed:
@@ -240,7 +241,7 @@ def _progress(total: int, *, quiet: bool) -> Iterator[Callable[[Any], None] | No
         yield update
 
 
-def _plain_line(event: Any) -> None:
+def _plain_line(event: SweepProgress) -> None:
     if event.record is None:
         print(
             f"sweep: {event.total} runs, {event.skipped} finished before, "
@@ -252,7 +253,7 @@ def _plain_line(event: Any) -> None:
     print(f"[{done}/{event.total}] {_describe(event.record)}", flush=True)
 
 
-def _describe(record: Any) -> str:
+def _describe(record: RunRecord) -> str:
     wall = "" if record.wall_s is None else f" {record.wall_s:.1f} s"
     reason = f": {record.reason}" if record.reason else ""
     return f"{record.run_id}: {record.status}{wall}{reason}"
