@@ -62,6 +62,7 @@ def test_points_average_mission_seeds_and_rank_converged_only() -> None:
     assert points["on_front"].to_dict() == {0.0: True, 1.0: True, 3.0: False, 9.0: False}
     figure = plot_pareto(view)
     assert isinstance(figure, Figure)
+    assert figure.axes[0].get_xlabel() == "fleet energy [kJ]"
     assert sum(len(c.get_offsets()) for c in figure.axes[0].collections) == 4
 
 
@@ -76,7 +77,9 @@ def test_filled_tan_column_switches_objective_and_scenarios_group_by_seed() -> N
     assert sorted(set(view.points["group"])) == ["seed=0", "seed=1"]
     fronts = view.points.groupby("group")["on_front"].sum().to_dict()
     assert fronts == {"seed=0": 2, "seed=1": 1}  # seed 1: weight 1 costs more, no better
-    plot_pareto(view)
+    axes = plot_pareto(view).axes[0]
+    assert "[%]" in axes.get_xlabel()  # different missions: energy relative to each one's least
+    assert axes.get_ylabel().startswith("TAN position RMSE [m]")
 
 
 def test_no_points_without_energy() -> None:

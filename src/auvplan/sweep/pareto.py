@@ -33,13 +33,16 @@ class ParetoView:
 
     ``points`` has the columns ``group`` (text naming the other varied values, ``""`` for a
     single group), ``label`` (the value of ``label_key``), ``energy_J``, the ``objective``
-    column, ``n_runs`` (runs averaged), ``converged`` and ``on_front``.
+    column, ``n_runs`` (runs averaged), ``converged`` and ``on_front``. ``same_mission`` is
+    False when groups are different missions (the scenario family), whose energies do not
+    compare.
     """
 
     points: pd.DataFrame
     label_key: str | None
     objective: str
     maximize: bool
+    same_mission: bool
 
 
 def non_dominated(energy: FloatArray, objective: FloatArray, *, maximize: bool) -> BoolArray:
@@ -115,7 +118,7 @@ def pareto_view(
             maximize=maximize,
         )
         points.loc[members.index[front], "on_front"] = True
-    return ParetoView(points, label_key, objective, maximize)
+    return ParetoView(points, label_key, objective, maximize, not seeds_are_missions)
 
 
 __all__ = ["ParetoView", "non_dominated", "pareto_view"]

@@ -20,9 +20,9 @@ _AXIS_LABELS: Final = {
 def plot_pareto(view: ParetoView, *, title: str = "") -> Figure:
     """Energy against navigation per sweep point, each group's non-dominated front drawn.
 
-    With one group the energy is in kJ; with several (other swept keys, or the scenario
-    family's missions) each group's energy is shown in percent above that group's least, so
-    missions of different size share the axis. Converged plans are filled markers, others
+    Energy is in kJ; when the groups are different missions (the scenario family), each
+    group's energy is in percent above that group's least instead, so missions of different
+    size share the axis. Converged plans are filled markers, others
     hollow; each point is annotated with its label value (``weights.terrain``).
 
     Parameters
@@ -34,7 +34,7 @@ def plot_pareto(view: ParetoView, *, title: str = "") -> Figure:
     """
     points = view.points
     groups = list(dict.fromkeys(points["group"]))
-    relative = len(groups) > 1
+    relative = not view.same_mission and len(groups) > 1
     figure = Figure(figsize=(7.5, 5.0), layout="constrained")
     axes = figure.add_subplot()
     annotate = len(points) <= MAX_LABELLED_POINTS and view.label_key is not None
@@ -45,7 +45,7 @@ def plot_pareto(view: ParetoView, *, title: str = "") -> Figure:
         objective = members[view.objective].to_numpy(float)
         color = f"C{index % 10}"
         converged = members["converged"].to_numpy(bool)
-        legend = group if relative and len(groups) <= MAX_LABELLED_GROUPS else None
+        legend = group if 1 < len(groups) <= MAX_LABELLED_GROUPS else None
         axes.scatter(energy[converged], objective[converged], color=color, zorder=3, label=legend)
         axes.scatter(
             energy[~converged], objective[~converged], facecolors="none", edgecolors=color,
