@@ -40,6 +40,7 @@ FORBIDDEN = {
         "io",
     },
     "scenarios": {"optimization", "mission", "cli", "viz"},
+    "sweep": {"cli", "viz"},
     "viz": {"cli"},
 }
 

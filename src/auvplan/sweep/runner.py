@@ -1,0 +1,342 @@
+"""Running a sweep's runs in parallel on :mod:`dask.distributed`.
+
+By default a :class:`~distributed.LocalCluster` of worker *processes* (one thread each) runs
+the missions, so a run that crashes its process (or is killed for memory) takes down only its
+worker: the nanny starts a new one, and the run becomes a row with status ``worker died``.
+The same runs go to an existing cluster given by its scheduler address; its workers must
+import auvplan and see ``DIR`` at the same path.
+
+Each run (:func:`execute_run`, in a worker) plans its mission and writes the normal ``plan``
+output into ``DIR/runs/<run-id>/`` all-or-nothing (:func:`auvplan.io.output.staged_output_dir`),
+with ``sweep_run.json`` (:mod:`auvplan.sweep.table`). A run whose folder already holds the
+finished run is not submitted again (resumable sweeps); a run that raises writes no folder
+and is tried again by the next invocation.
+
+dask is imported only when a sweep runs; without it, the error names the extra to install.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib
+import importlib.util
+import logging
+import re
+import shutil
+import threading
+import time
+import traceback
+import uuid
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, Final
+
+from auvplan.errors import AuvplanError, InputError
+from auvplan.sweep.spec import SweepRun
+from auvplan.sweep.table import RUN_RECORD_FILE, RunRecord, read_run_folder, run_record_document
+
+#: Folder of the run folders inside the sweep's output folder.
+RUNS_FOLDER: Final = "runs"
+#: Status of a run whose worker process died (crash, out of memory).
+WORKER_DIED: Final = "worker died"
+#: Seconds to wait for a ``--scheduler`` to answer.
+CONNECT_TIMEOUT_S: Final = 10.0
+INSTALL_HINT: Final = "pip install 'auvplan[sweep]'"
+
+logger = logging.getLogger(__name__)
+
+#: Writes a run's figures into its staging folder: ``(MissionResult, folder) -> paths``.
+FigureWriter = Callable[[Any, Path], list[Path]]
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """How each run is made.
+
+    ``stage`` is the last pipeline stage (``preplan``, ``deconflict``, ``full``);
+    ``write_figures`` (e.g. :func:`auvplan.viz.report.save_mission_figures`, a module-level
+    function so that it pickles by reference) adds figures to each run folder; ``quiet_logs``
+    keeps the runs' log records out of the worker's stderr (they are still collected into
+    each record's ``messages``).
+    """
+
+    stage: str = "full"
+    write_figures: FigureWriter | None = None
+    quiet_logs: bool = True
+
+
+@dataclass(frozen=True)
+class SweepProgress:
+    """Counts after a run ended (``record``) or at the start (``record`` is ``None``).
+
+    ``total`` counts every run of the grid, ``skipped`` those finished by an earlier
+    invocation, ``finished`` those ended now (``failed`` of them without a plan), ``running``
+    an estimate (the cluster's threads, at most the runs not yet ended).
+    """
+
+    total: int
+    skipped: int
+    finished: int
+    failed: int
+    running: int
+    record: RunRecord | None = None
+
+
+def run_folder(directory: Path, run: SweepRun) -> Path:
+    """``directory/runs/<run-id>``: where ``run`` writes its output."""
+    return directory / RUNS_FOLDER / run.run_id
+
+
+def run_sweep(
+    runs: Sequence[SweepRun],
+    directory: Path,
+    *,
+    options: RunOptions = RunOptions(),
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    progress: Callable[[SweepProgress], None] | None = None,
+) -> list[RunRecord]:
+    """Run every unfinished run of ``runs`` on dask; the records in the order of ``runs``.
+
+    Parameters
+    ----------
+    runs : sequence of SweepRun
+        From :func:`auvplan.sweep.spec.build_runs`.
+    directory : Path
+        The sweep's output folder; run folders go to ``directory/runs/``.
+    options : RunOptions
+        Stage, figures, logging of each run.
+    scheduler : str, optional
+        Address of a running dask scheduler (``tcp://host:8786``); default: a LocalCluster.
+    n_workers : int, optional
+        Worker processes of the LocalCluster (default: the CPU count).
+    progress : callable, optional
+        Called with a :class:`SweepProgress` at the start and after every run.
+
+    Raises
+    ------
+    InputError
+        If dask.distributed is not installed (the message names the extra), or the scheduler
+        cannot be reached.
+    """
+    directory = Path(directory).resolve()
+    records: dict[str, RunRecord] = {}
+    for run in runs:
+        finished = read_run_folder(run_folder(directory, run), run)
+        if finished is not None:
+            records[run.run_id] = replace(finished, skipped=True)
+    pending = [run for run in runs if run.run_id not in records]
+    report = progress or (lambda _event: None)
+    if not pending:
+        report(SweepProgress(len(runs), len(records), 0, 0, 0))
+        return [records[run.run_id] for run in runs]
+    for run in pending:
+        _remove_stale_staging(run_folder(directory, run))
+    with _dask_client(scheduler, n_workers) as (client, as_completed, killed_worker):
+
+        def event(finished: int, failed: int, record: RunRecord | None = None) -> SweepProgress:
+            threads = sum(client.nthreads().values()) or 1
+            running = min(threads, len(pending) - finished)
+            return SweepProgress(
+                len(runs), len(runs) - len(pending), finished, failed, running, record
+            )
+
+        report(event(0, 0))
+        batch = uuid.uuid4().hex[:8]  # keys unique on a shared scheduler
+        futures = {
+            client.submit(
+                execute_run, run, run_folder(directory, run), options,
+                key=f"auvplan-run-{batch}-{index}", pure=False,
+            ): run
+            for index, run in enumerate(pending)
+        }  # fmt: skip
+        n_failed = 0
+        for n_finished, future in enumerate(as_completed(futures), start=1):
+            run = futures[future]
+            try:
+                record = future.result()
+            except killed_worker:
+                _remove_stale_staging(run_folder(directory, run))
+                record = RunRecord(
+                    run.run_id, run.values, run.seed, WORKER_DIED,
+                    "its worker process died (a crash, or killed for memory)",
+                )  # fmt: skip
+            except Exception as error:  # noqa: BLE001 (the cluster lost the task: a row)
+                record = _failure(run, error)
+            records[run.run_id] = record
+            n_failed += record.failed
+            report(event(n_finished, n_failed, record))
+    return [records[run.run_id] for run in runs]
+
+
+def execute_run(run: SweepRun, folder: Path, options: RunOptions) -> RunRecord:
+    """Plan ``run``'s mission and write its folder; runs in a dask worker (or anywhere).
+
+    Every exception becomes a failed :class:`RunRecord` (status: the exception's class, reason:
+    its one-line message; an exception that is not an :class:`~auvplan.errors.AuvplanError` is
+    a bug and its reason says where it was raised), so one run never ends the sweep.
+    """
+    from auvplan.io.output import staged_output_dir
+    from auvplan.io.results import write_json
+    from auvplan.mission.config import parse_mission
+    from auvplan.mission.outputs import write_mission_files
+    from auvplan.mission.pipeline import Stage, run_mission
+
+    started = time.perf_counter()
+    with _collected_warnings(quiet=options.quiet_logs) as messages:
+        is_peak_reset = _reset_peak_memory()
+        try:
+            config = parse_mission(run.document, base_dir=run.base_dir, source=run.source)
+            result = run_mission(config, stage=Stage(options.stage))
+            with staged_output_dir(folder) as staging:
+                write_mission_files(result, staging)
+                if options.write_figures is not None:
+                    options.write_figures(result, staging)
+                document = run_record_document(
+                    run,
+                    wall_s=time.perf_counter() - started,
+                    peak_rss_mb=_peak_memory_mb() if is_peak_reset else None,
+                    messages=messages,
+                )
+                write_json(document, staging / RUN_RECORD_FILE)
+        except Exception as error:  # noqa: BLE001 (any failure is the run's row)
+            return _failure(run, error, wall_s=time.perf_counter() - started)
+    record = read_run_folder(folder, run)
+    if record is None:
+        raise InputError(f"run {run.run_id}: its folder {folder} cannot be read back")
+    return record
+
+
+def _failure(run: SweepRun, error: BaseException, *, wall_s: float | None = None) -> RunRecord:
+    """The record of a run that raised ``error``."""
+    reason = " ".join(str(error).split()) or type(error).__name__
+    if not isinstance(error, AuvplanError):
+        frame = traceback.extract_tb(error.__traceback__)[-1:] if error.__traceback__ else []
+        where = f" at {Path(frame[0].filename).name}:{frame[0].lineno}" if frame else ""
+        reason = f"{reason} (unexpected{where}: a bug, please report it)"
+    return RunRecord(run.run_id, run.values, run.seed, type(error).__name__, reason, wall_s=wall_s)
+
+
+def _remove_stale_staging(folder: Path) -> None:
+    """Delete staging folders a killed run left next to ``folder`` (``.<id>.*.partial``)."""
+    if folder.parent.is_dir():
+        for stale in folder.parent.glob(f".{folder.name}.*.partial"):
+            shutil.rmtree(stale, ignore_errors=True)
+
+
+def require_dask() -> None:
+    """Raise InputError naming the extra to install unless dask.distributed can be imported.
+
+    Cheap (nothing is imported): lets the command line fail before any work.
+    """
+    if importlib.util.find_spec("dask") is None or importlib.util.find_spec("distributed") is None:
+        raise InputError(
+            f"auvplan sweep needs dask.distributed, which is not installed: {INSTALL_HINT}"
+        )
+
+
+@contextlib.contextmanager
+def _dask_client(scheduler: str | None, n_workers: int | None) -> Iterator[tuple[Any, Any, Any]]:
+    """``(client, as_completed, KilledWorker)`` of the cluster; closed (and stopped) after."""
+    require_dask()
+    dask = importlib.import_module("dask")
+    distributed = importlib.import_module("distributed")
+    as_completed = distributed.as_completed
+    killed_worker = distributed.scheduler.KilledWorker
+    if scheduler is not None:
+        try:
+            client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+        except (OSError, TimeoutError, ValueError) as error:
+            message = " ".join(str(error).split())[:200]
+            raise InputError(f"--scheduler {scheduler}: cannot connect ({message})") from None
+        with client:
+            yield client, as_completed, killed_worker
+        return
+    # A run that kills its worker is not tried again on another one; the in-process
+    # scheduler and nannies log only errors (the user's terminal shows the progress).
+    with (
+        _logger_level("distributed", logging.ERROR),
+        dask.config.set({"distributed.scheduler.allowed-failures": 0}),
+        distributed.LocalCluster(
+            n_workers=n_workers,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        yield client, as_completed, killed_worker
+
+
+@contextlib.contextmanager
+def _logger_level(name: str, level: int) -> Iterator[None]:
+    named = logging.getLogger(name)
+    previous = named.level
+    named.setLevel(level)
+    try:
+        yield
+    finally:
+        named.setLevel(previous)
+
+
+class _ThreadRecords(logging.Handler):
+    """Collects the text of WARNING+ records logged by the current thread."""
+
+    def __init__(self, messages: list[str]) -> None:
+        super().__init__(logging.WARNING)
+        self.messages = messages
+        self.thread = threading.get_ident()
+
+    def emit(self, record: logging.LogRecord) -> None:
+        if record.thread == self.thread:
+            self.messages.append(" ".join(record.getMessage().split()))
+
+
+@contextlib.contextmanager
+def _collected_warnings(*, quiet: bool) -> Iterator[list[str]]:
+    """The warnings auvplan logs in this thread during the block; with ``quiet`` only there."""
+    messages: list[str] = []
+    package = logging.getLogger("auvplan")
+    handler = _ThreadRecords(messages)
+    propagate = package.propagate
+    package.addHandler(handler)
+    if quiet:  # our own single-threaded workers: their stderr is the user's terminal
+        package.propagate = False
+    try:
+        yield messages
+    finally:
+        package.removeHandler(handler)
+        package.propagate = propagate
+
+
+def _reset_peak_memory() -> bool:
+    """Reset this process's peak resident memory (Linux ``clear_refs``); False if not possible."""
+    try:
+        Path("/proc/self/clear_refs").write_text("5", encoding="ascii")
+    except OSError:
+        return False
+    return True
+
+
+def _peak_memory_mb() -> float | None:
+    """Peak resident memory [MiB] of this process since :func:`_reset_peak_memory` (VmHWM)."""
+    try:
+        status = Path("/proc/self/status").read_text(encoding="ascii")
+    except OSError:
+        return None
+    match = re.search(r"^VmHWM:\s+(\d+) kB", status, re.MULTILINE)
+    return None if match is None else int(match[1]) / 1024.0
+
+
+__all__ = [
+    "RUNS_FOLDER",
+    "WORKER_DIED",
+    "RunOptions",
+    "SweepProgress",
+    "execute_run",
+    "require_dask",
+    "run_folder",
+    "run_sweep",
+]

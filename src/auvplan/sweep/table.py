@@ -1,0 +1,281 @@
+"""The record of each run and the sweep's table (``sweep.csv``, ``sweep.json``).
+
+Every finished run's folder holds, next to the normal ``plan`` output, ``sweep_run.json``:
+the run's id, varied values, seed, digest (:class:`~auvplan.sweep.spec.SweepRun`), wall time,
+peak memory and the worker process (host, pid). A run is *finished* when its folder holds
+``summary.json`` and a ``sweep_run.json`` with the digest the sweep expects;
+:func:`read_run_folder` then rebuilds its :class:`RunRecord` from the two files, exactly as
+for a run that just ended, so a resumed sweep's table equals a fresh one's.
+
+Columns of ``sweep.csv``, one row per run in grid order: ``run_id``, one column per varied key
+(its dotted name), ``seed``, ``status`` (the plan verdict ``CONVERGED`` /
+``CONSTRAINT_VIOLATED`` / ``NOT_CONVERGED`` / ``FAILED`` from ``summary.json``, ``PREPLANNED``
+or ``DECONFLICTED`` for ``--stage``, or for a run that raised, its error class such as
+``InfeasibleError`` or ``worker died``), ``reason`` (one line, empty for a converged plan),
+``energy_J`` (fleet total), ``terrain_information`` (mean over vehicles of each one's mean
+terrain information), ``n_iter``, ``wall_s``, ``peak_rss_mb`` (empty where the platform cannot
+tell), ``tan_rmse_m``, ``energy_J.<vehicle>`` per vehicle, and ``folder``.
+
+**Adding columns per run** (the hook for later evaluations): :func:`add_run_columns` calls a
+function ``columns(folder) -> {column: value}`` on every run folder and fills (or adds) those
+columns. :func:`navigation_columns` is the one the sweep always applies: it reads
+``navigation.json`` (written by ``auvplan evaluate RUN_FOLDER``) and fills ``tan_rmse_m``
+(``plans.terrain_aware.rmse_m``), so evaluating the run folders and running the same
+``auvplan sweep`` command again (every run is skipped) refreshes the table and the figure.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import socket
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Final
+
+import pandas as pd
+
+from auvplan import __version__
+from auvplan.errors import DataFormatError
+from auvplan.io.output import staged_output_file
+from auvplan.io.results import write_json
+from auvplan.io.text import read_json
+from auvplan.sweep.spec import SweepRun
+
+#: The sweep's own record in each run folder.
+RUN_RECORD_FILE: Final = "sweep_run.json"
+SUMMARY_FILE: Final = "summary.json"
+#: The navigation evaluation's file in a run folder (``auvplan evaluate``).
+NAVIGATION_FILE: Final = "navigation.json"
+TAN_COLUMN: Final = "tan_rmse_m"
+#: Status of runs stopped by ``--stage`` before the optimiser.
+STAGE_STATUS: Final = {"preplan": "PREPLANNED", "deconflict": "DECONFLICTED"}
+#: Status of a plan whose optimiser produced nothing (summary.json) — a failed run.
+PLAN_FAILED: Final = "FAILED"
+#: Numeric result columns, in table order (after the varied keys, seed, status and reason).
+RESULT_COLUMNS: Final = (
+    "energy_J", "terrain_information", "n_iter", "wall_s", "peak_rss_mb", TAN_COLUMN,
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class RunRecord:
+    """The outcome of one run: what :data:`sweep.csv <auvplan.sweep.table>` shows of it.
+
+    ``energy`` [J] is the fleet total, ``terrain_information`` [-] the mean over vehicles,
+    ``wall_s`` [s] the run's wall time, ``peak_rss_mb`` [MiB] its process's peak resident
+    memory; each is ``None`` when the run has none (failed, or stopped by ``--stage``).
+    ``folder`` is the run's output folder (``None`` when it failed before writing one);
+    ``skipped`` tells a run finished by an earlier invocation; ``messages`` are the warnings
+    the run logged.
+    """
+
+    run_id: str
+    values: Mapping[str, Any]
+    seed: int | None
+    status: str
+    reason: str = ""
+    energy: float | None = None
+    terrain_information: float | None = None
+    n_iter: int | None = None
+    wall_s: float | None = None
+    peak_rss_mb: float | None = None
+    vehicle_energy: Mapping[str, float] = field(default_factory=dict)
+    folder: Path | None = None
+    skipped: bool = False
+    messages: tuple[str, ...] = ()
+
+    @property
+    def failed(self) -> bool:
+        """True when the run produced no plan output (it raised, or the optimiser failed)."""
+        return self.folder is None or self.status == PLAN_FAILED
+
+
+def run_record_document(
+    run: SweepRun, *, wall_s: float, peak_rss_mb: float | None, messages: Sequence[str]
+) -> dict[str, Any]:
+    """The content of a finished run's ``sweep_run.json`` (written by the worker that ran it)."""
+    return {
+        "auvplan_version": __version__,
+        "run_id": run.run_id,
+        "values": dict(run.values),
+        "seed": run.seed,
+        "digest": run.digest,
+        "wall_s": wall_s,
+        "peak_rss_mb": peak_rss_mb,
+        "worker": {"host": socket.gethostname(), "pid": os.getpid()},
+        "messages": list(messages),
+    }
+
+
+def read_run_folder(folder: Path, run: SweepRun) -> RunRecord | None:
+    """The record of ``run`` if ``folder`` holds it finished, else ``None`` (to be run).
+
+    Finished means ``summary.json`` and ``sweep_run.json`` are readable and the digest
+    matches ``run`` (same mission, values and stage).
+    """
+    try:
+        record = read_json(folder / RUN_RECORD_FILE, what="sweep run record")
+        summary = read_json(folder / SUMMARY_FILE, what="summary file")
+    except DataFormatError:
+        return None
+    if not isinstance(record, dict) or record.get("digest") != run.digest:
+        return None
+    try:
+        return _record_from(run, folder, record, summary)
+    except (KeyError, TypeError, ValueError):  # a summary of another layout: run again
+        return None
+
+
+def _record_from(
+    run: SweepRun, folder: Path, record: dict[str, Any], summary: dict[str, Any]
+) -> RunRecord:
+    optimization = summary.get("optimization")
+    common = {
+        "folder": folder,
+        "wall_s": float(record["wall_s"]),
+        "peak_rss_mb": record["peak_rss_mb"],
+        "messages": tuple(record["messages"]),
+    }
+    if optimization is None:
+        return RunRecord(run.run_id, run.values, run.seed, STAGE_STATUS[summary["stage"]], **common)
+    status = str(optimization["plan_status"])
+    reason = "" if status == "CONVERGED" else " ".join(str(optimization["verdict"]).split())
+    vehicles = optimization.get("vehicles", {})
+    energy = {name: float(vehicle["energy_J"]) for name, vehicle in vehicles.items()}
+    information = [float(vehicle["mean_terrain_information"]) for vehicle in vehicles.values()]
+    return RunRecord(
+        run.run_id,
+        run.values,
+        run.seed,
+        status,
+        reason,
+        energy=float(optimization["total_energy_J"]) if energy else None,
+        terrain_information=sum(information) / len(information) if information else None,
+        n_iter=optimization.get("n_iter"),
+        vehicle_energy=energy,
+        **common,
+    )
+
+
+def sweep_frame(records: Sequence[RunRecord], keys: Sequence[str]) -> pd.DataFrame:
+    """The table of ``records`` (module notes: columns), one row per run in the given order."""
+    rows = []
+    for record in records:
+        row: dict[str, Any] = {"run_id": record.run_id}
+        row.update({key: _cell(record.values[key]) for key in keys})
+        row.update(seed=record.seed, status=record.status, reason=record.reason)
+        row.update(
+            energy_J=record.energy,
+            terrain_information=record.terrain_information,
+            n_iter=record.n_iter,
+            wall_s=record.wall_s,
+            peak_rss_mb=record.peak_rss_mb,
+        )
+        row[TAN_COLUMN] = math.nan
+        row.update({f"energy_J.{name}": value for name, value in record.vehicle_energy.items()})
+        row["folder"] = "" if record.folder is None else str(record.folder)
+        rows.append(row)
+    columns = ["run_id", *keys, "seed", "status", "reason", *RESULT_COLUMNS]
+    frame = pd.DataFrame(rows, columns=None if rows else columns)
+    vehicle_columns = [column for column in frame.columns if column not in {*columns, "folder"}]
+    frame = frame.reindex(columns=[*columns, *vehicle_columns, "folder"])
+    frame["seed"] = frame["seed"].astype("Int64")
+    frame["n_iter"] = frame["n_iter"].astype("Int64")
+    return frame
+
+
+def add_run_columns(
+    frame: pd.DataFrame, columns: Callable[[Path], Mapping[str, float | str | None]]
+) -> pd.DataFrame:
+    """Fill columns per run folder: ``columns(folder)`` gives ``{column: value}`` for a run.
+
+    The hook later evaluations use to put their figures into the sweep's table. Rows without
+    a folder (failed runs) are left as they are; a column the function names for the first
+    time is added (empty elsewhere). Returns a new frame.
+
+    Examples
+    --------
+    >>> frame = pd.DataFrame({"run_id": ["a", "b"], "folder": ["/runs/a", ""]})
+    >>> add_run_columns(frame, lambda folder: {"name": folder.name})["name"].tolist()
+    ['a', nan]
+    """
+    frame = frame.copy()
+    for index, folder in frame["folder"].items():
+        if not folder:
+            continue
+        for column, value in columns(Path(folder)).items():
+            if column not in frame.columns:
+                frame[column] = pd.Series(dtype=object if isinstance(value, str) else float)
+            frame.loc[index, column] = value
+    return frame
+
+
+def navigation_columns(folder: Path) -> dict[str, float | None]:
+    """``tan_rmse_m`` from the run folder's ``navigation.json`` (none while it is absent).
+
+    Raises
+    ------
+    DataFormatError
+        If ``navigation.json`` exists but is unreadable or lacks
+        ``plans.terrain_aware.rmse_m``.
+    """
+    path = folder / NAVIGATION_FILE
+    if not path.is_file():
+        return {}
+    document = read_json(path, what="navigation file")
+    try:
+        rmse = document["plans"]["terrain_aware"]["rmse_m"]
+    except (KeyError, TypeError):
+        raise DataFormatError(f"{path}: no plans.terrain_aware.rmse_m") from None
+    return {TAN_COLUMN: None if rmse is None else float(rmse)}
+
+
+def write_sweep_files(
+    frame: pd.DataFrame, directory: Path, *, spec: Mapping[str, Any], **sections: Any
+) -> list[Path]:
+    """Write ``sweep.csv`` (the frame) and ``sweep.json`` (spec, sections and rows) atomically.
+
+    ``directory`` is created if needed. Returns the two paths.
+    """
+    directory.mkdir(parents=True, exist_ok=True)
+    table, document = directory / "sweep.csv", directory / "sweep.json"
+    with staged_output_file(table) as staging:
+        frame.to_csv(staging, index=False)
+    rows = [
+        {key: _json_cell(value) for key, value in row.items()}
+        for row in frame.to_dict(orient="records")
+    ]
+    content = {"auvplan_version": __version__, "spec": spec, **sections, "runs": rows}
+    with staged_output_file(document) as staging:  # dates, paths, pandas NA as text
+        write_json(json.loads(json.dumps(content, default=str)), staging)
+    return [table, document]
+
+
+def _cell(value: Any) -> Any:
+    """A varied value as a table cell (arrays and tables as JSON text)."""
+    return json.dumps(value, default=str) if isinstance(value, list | tuple | dict) else value
+
+
+def _json_cell(value: Any) -> Any:
+    """A table cell as a JSON value: missing as ``None``, other non-JSON types as text."""
+    if value is None or value is pd.NA or (isinstance(value, float) and math.isnan(value)):
+        return None
+    if isinstance(value, bool | int | float | str):
+        return value
+    return value.item() if hasattr(value, "item") else str(value)
+
+
+__all__ = [
+    "RUN_RECORD_FILE",
+    "TAN_COLUMN",
+    "RunRecord",
+    "add_run_columns",
+    "navigation_columns",
+    "read_run_folder",
+    "run_record_document",
+    "sweep_frame",
+    "write_sweep_files",
+]

@@ -1,0 +1,137 @@
+"""``auvplan sweep`` end to end on a tiny mission (``--stage preplan``, in-process dask workers)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from auvplan.cli.main import main
+
+GOOD_START = "{ north = 10.0, east = 200.0, heading_deg = 0.0 }"
+LAND_START = "{ north = 280.0, east = 20.0 }"
+
+
+def _sweep(mission: Path, out: Path, *options: str) -> int:
+    return main(["sweep", str(mission), "-o", str(out), "--stage", "preplan", *options])
+
+
+@pytest.mark.usefixtures("inprocess_cluster")
+def test_second_invocation_skips_finished_runs(
+    tiny_mission: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "sweep"
+    assert (
+        _sweep(tiny_mission, out, "--vary", "planner.edge_model=paper,crossed", "--seeds", "3") == 0
+    )
+    first = pd.read_csv(out / "sweep.csv")
+    assert first["run_id"].tolist() == [
+        "planner.edge_model=paper__seed=3",
+        "planner.edge_model=crossed__seed=3",
+    ]
+    assert first["status"].tolist() == ["PREPLANNED", "PREPLANNED"]
+    assert first["seed"].tolist() == [3, 3]
+    summaries = {path: path.stat().st_mtime_ns for path in out.glob("runs/*/summary.json")}
+    assert len(summaries) == 2
+    capsys.readouterr()
+
+    options = ("--vary", "planner.edge_model=paper,crossed", "--seeds", "3,4")
+    assert _sweep(tiny_mission, out, *options) == 0
+    assert "4 runs (2 ran, 2 skipped as finished before, 0 failed)" in capsys.readouterr().out
+    assert {path: path.stat().st_mtime_ns for path in summaries} == summaries  # not rewritten
+    document = json.loads((out / "sweep.json").read_text())
+    assert document["counts"]["skipped"] == 2
+    assert document["spec"]["seeds"] == [3, 4]
+    second = pd.read_csv(out / "sweep.csv")
+    assert len(second) == 4
+    pd.testing.assert_frame_equal(second.iloc[[0, 2]].reset_index(drop=True), first)
+
+
+@pytest.mark.usefixtures("inprocess_cluster")
+def test_failed_runs_are_rows_and_all_failed_exits_3(
+    tiny_mission: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "sweep"
+    vary = f"vehicle[0].start={GOOD_START},{LAND_START}"
+    assert _sweep(tiny_mission, out, "-q", "--vary", vary) == 0
+    table = pd.read_csv(out / "sweep.csv", keep_default_na=False)
+    assert table.loc[0, "status"] == "PREPLANNED"
+    assert table.loc[0, "reason"] == ""
+    assert table.loc[1, "status"] in {"InputError", "InfeasibleError"}
+    assert "blue" in table.loc[1, "reason"]
+    assert table.loc[1, "folder"] == ""
+    assert len(list((out / "runs").iterdir())) == 1
+
+    out_bad = tmp_path / "all_bad"
+    assert _sweep(tiny_mission, out_bad, "-q", "--vary", f"vehicle[0].start={LAND_START}") == 3
+    assert "every run of the sweep failed" in capsys.readouterr().err
+    assert len(pd.read_csv(out_bad / "sweep.csv")) == 1
+
+
+@pytest.mark.parametrize(
+    ("options", "fragment"),
+    [
+        (["--vary", "weights.terain=1"], "unknown key 'weights.terain'"),
+        (["--vary", "weights.terrain=1,-1"], "--vary weights.terrain=-1: weights.terrain"),
+        (["--vary", "weights.terrain=1", "--seeds", "2..1"], "--seeds"),
+        ([], "nothing to sweep"),
+        (["--vary", "weights.terrain=1", "--workers", "0"], "--workers must be at least 1"),
+    ],
+)
+def test_user_errors_exit_2_with_one_line(
+    tiny_mission: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    options: list[str],
+    fragment: str,
+) -> None:
+    out = tmp_path / "sweep"
+    assert _sweep(tiny_mission, out, *options) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1
+    assert lines[0].startswith("auvplan: error: ")
+    assert fragment in lines[0]
+    assert not out.exists()
+
+
+def test_scenarios_need_seeds(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert (
+        main(["sweep", "scenarios", "-o", str(tmp_path / "s"), "--vary", "weights.terrain=1"]) == 2
+    )
+    assert "needs --seeds" in capsys.readouterr().err
+
+
+def test_missing_dask_names_the_extra(
+    tiny_mission: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import importlib.util
+
+    find_spec = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util,
+        "find_spec",
+        lambda name, *a: None if name == "distributed" else find_spec(name, *a),
+    )
+    assert _sweep(tiny_mission, tmp_path / "s", "--vary", "weights.terrain=1") == 2
+    assert "pip install 'auvplan[sweep]'" in capsys.readouterr().err
+
+
+@pytest.mark.usefixtures("inprocess_cluster")
+def test_scenario_family_seeds_are_missions(tmp_path: Path) -> None:
+    out = tmp_path / "family"
+    options = ["--seeds", "2,3", "--vary", "weights.terrain=0", "--data-dir", str(tmp_path / "no")]
+    assert main(["-q", "sweep", "scenarios", "-o", str(out), "--stage", "preplan", *options]) == 0
+    table = pd.read_csv(out / "sweep.csv")
+    assert table["seed"].tolist() == [2, 3]
+    assert (table["status"] == "PREPLANNED").all()
+    for seed, folder in zip(table["seed"], table["folder"], strict=True):
+        mission = out / "scenarios" / f"seed_{seed:04d}" / "mission.toml"
+        summary = json.loads((Path(folder) / "summary.json").read_text())
+        assert summary["inputs"]["mission"]["path"] == str(mission.resolve())
+    assert len({json.loads((Path(f) / "summary.json").read_text())["terrain"]["name"]
+                for f in table["folder"]}) == 2  # fmt: skip
