@@ -29,6 +29,8 @@ from auvplan.vehicle.dynamics import BODY_STATE_NAMES, VehicleModel
 
 #: Position of the first actuator state in every state vector.
 FIRST_ACTUATOR: int = len(BODY_STATE_NAMES)
+#: Shares and arms below this are rounding (e.g. ``cos 90°`` = 6e-17) [-, m].
+_NEGLIGIBLE: float = 1e-9
 
 
 @dataclass(frozen=True)
@@ -68,17 +70,19 @@ def actuator_roles(model: VehicleModel) -> ActuatorRoles:
     ([1.0, 1.0], [75.0, -75.0], True)
     """
     thrusters, surfaces = model.vehicle.thrusters, model.vehicle.surfaces
-    throttle = [1.0 if thruster.surge_share > 0.0 else 0.0 for thruster in thrusters]
+    throttle = [1.0 if thruster.surge_share > _NEGLIGIBLE else 0.0 for thruster in thrusters]
     if not any(throttle):
         raise InputError(f"vehicle {model.vehicle.name!r} has no thruster pushing forward")
     thrust_steering = not surfaces
     steering = [
         math.copysign(thruster.n_max, thruster.yaw_arm)
-        if thrust_steering and thruster.yaw_arm != 0.0
+        if thrust_steering and abs(thruster.yaw_arm) > _NEGLIGIBLE
         else 0.0
         for thruster in thrusters
     ] + [
-        math.copysign(surface.delta_max, surface.yaw_arm) if surface.yaw_arm != 0.0 else 0.0
+        math.copysign(surface.delta_max, surface.yaw_arm)
+        if abs(surface.yaw_arm) > _NEGLIGIBLE
+        else 0.0
         for surface in surfaces
     ]
     limits = [thruster.n_max for thruster, on in zip(thrusters, throttle, strict=True) if on]

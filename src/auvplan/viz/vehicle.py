@@ -67,7 +67,7 @@ def plot_vehicle_validation(
     if turn_speed is None or turn_rate is None:
         speed = optimal_cruise_speed(model).speed
         turn = tightest_turn(model, speed)
-        label = f"full steering at cruise u = {speed:.2f} m/s"
+        label = f"u = {speed:.2f} m/s (cruise), full steering"
     else:
         turn = steady_turn(model, turn_speed, turn_rate)
         label = f"u = {turn_speed} m/s, r = {turn_rate} rad/s"
@@ -86,7 +86,7 @@ def _plot_propeller(axes: Axes, propeller: Propeller, orders: Sequence[int]) -> 
         axes.plot(advance, efficiency, color="k", ls="--", label="$\\eta_0 = J K_T/(2\\pi K_Q)$")
         axes.axvline(propeller.J_max, color="0.7", lw=0.8)
         axes.set_xlabel("advance ratio J [-]")
-        axes.set_title(f"{propeller.name}: open-water curves (linear in J)")
+        axes.set_title(f"{propeller.name}: $K_T$, $K_Q$ linear in J", fontsize=10)
         axes.grid(alpha=0.3)
         axes.legend(fontsize=8)
         return
@@ -168,8 +168,8 @@ def _plot_turn(axes: Axes, model: VehicleModel, turn: SteadyTurn, label: str) ->
     axes.set_xlabel("east [m]")
     axes.set_ylabel("north [m]")
     axes.set_title(
-        f"turning circle R = {turn.radius:.2f} m ({label})\n{actuators}, P = {turn.power:.0f} W",
-        fontsize=10,
+        f"turning circle R = {turn.radius:.2f} m, {label}\n{actuators}, P = {turn.power:.0f} W",
+        fontsize=9,
     )
     axes.legend(fontsize=8)
     axes.grid(alpha=0.3)
