@@ -66,6 +66,8 @@ def test_file_holds_fossens_numbers(model: VehicleModel) -> None:
     assert rudder.delta_max == pytest.approx(fossen.DELTA_MAX)
     assert model.state_names == ("north", "east", "psi", "u", "v", "r", "n_prop", "delta_rudder")
     assert model.input_names == ("c_prop", "c_rudder")
+    assert (model.thruster_states, model.surface_states) == (("n_prop",), ("delta_rudder",))
+    assert model.state_units == ("m", "m", "rad", "m/s", "m/s", "rad/s", "rev/s", "rad")
     assert model.state_limits == (
         ("n_prop", pytest.approx(25.4167, rel=1e-4)),
         ("delta_rudder", pytest.approx(math.radians(15))),

@@ -114,6 +114,11 @@ class ThrusterParams:
         return math.cos(self.axis)
 
     @property
+    def sway_share(self) -> float:
+        """``sin α``: share of the thrust along the body y axis [-]."""
+        return math.sin(self.axis)
+
+    @property
     def yaw_arm(self) -> float:
         """``x sin α - y cos α``: yaw moment per newton of thrust [m]."""
         return self.x * math.sin(self.axis) - self.y * math.cos(self.axis)

@@ -41,13 +41,15 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
-from auvplan.vehicle.actuators import (
-    ActuatedVehicleParams,
-    ControlSurfaceParams,
-    ThrusterParams,
-    actuated_vehicle,
+from auvplan.vehicle._forces import (
+    advance_speed,
+    crossflow_force,
+    hull_damping,
+    surface_force,
+    thruster_force,
 )
-from auvplan.vehicle.params import HullParams, PropellerParams, VehicleParams
+from auvplan.vehicle.actuators import ActuatedVehicleParams, actuated_vehicle
+from auvplan.vehicle.params import PropellerParams, VehicleParams
 from auvplan.vehicle.propulsion import (
     motor_current_expression,
     motor_power_expression,
@@ -116,6 +118,32 @@ class VehicleModel:
         return self.state_names.index(name)
 
     @property
+    def thruster_states(self) -> tuple[str, ...]:
+        """Names of the propeller-speed states ``n_<thruster>``, in state order [-]."""
+        return tuple(thruster.state_name for thruster in self.vehicle.thrusters)
+
+    @property
+    def surface_states(self) -> tuple[str, ...]:
+        """Names of the control-surface deflection states ``delta_<surface>`` [-]."""
+        return tuple(surface.state_name for surface in self.vehicle.surfaces)
+
+    @property
+    def state_units(self) -> tuple[str, ...]:
+        """Units of the states, in order.
+
+        Examples
+        --------
+        >>> from auvplan.io.vehicles import load_vehicle
+        >>> build_vehicle_model(load_vehicle("remus100")).state_units[6:]
+        ('rev/s', 'rad')
+        """
+        return (
+            *STATE_UNITS[: len(BODY_STATE_NAMES)],
+            *("rev/s" for _ in self.vehicle.thrusters),
+            *("rad" for _ in self.vehicle.surfaces),
+        )
+
+    @property
     def state_limits(self) -> tuple[tuple[str, float], ...]:
         """States with a symmetric bound ``|x| <= limit``, in state order.
 
@@ -125,69 +153,6 @@ class VehicleModel:
             [(thruster.state_name, thruster.n_max) for thruster in self.vehicle.thrusters]
             + [(surface.state_name, surface.delta_max) for surface in self.vehicle.surfaces]
         )
-
-
-def _smooth_abs(value: ca.SX, eps: float) -> ca.SX:
-    return ca.sqrt(value**2 + eps**2)
-
-
-def _hull_damping(hull: HullParams, vehicle: ActuatedVehicleParams, nu: ca.SX) -> ca.SX:
-    """Diagonal of ``D(ν) + D_n(ν)`` [kg/s, kg/s, kg m²/s]."""
-    u, v, r = nu[0], nu[1], nu[2]
-    fade: ca.SX | float = 1.0
-    if hull.linear_damping_fade > 0.0:
-        speed = ca.sqrt(u**2 + v**2 + vehicle.eps_abs_speed**2)
-        fade = ca.exp(-hull.linear_damping_fade * speed)
-    return ca.vertcat(
-        -hull.X_u * fade - hull.X_uu * _smooth_abs(u, vehicle.eps_abs_speed),
-        -hull.Y_v * fade - hull.Y_vv * _smooth_abs(v, vehicle.eps_abs_speed),
-        -hull.N_r - hull.N_rr * _smooth_abs(r, vehicle.eps_abs_rate),
-    )
-
-
-def _crossflow_force(hull: HullParams, eps_speed: float, nu: ca.SX) -> ca.SX:
-    """Strip-theory cross-flow ``(0, Y, N)`` (:class:`auvplan.vehicle.params.CrossFlowParams`)."""
-    strips = hull.crossflow
-    if strips is None:
-        return ca.SX.zeros(3)
-    scale = -0.5 * hull.rho * strips.height * strips.drag_coefficient
-    scale *= strips.length / strips.strips
-    sway, moment = ca.SX(0.0), ca.SX(0.0)
-    for station in strips.stations:
-        local = nu[1] + float(station) * nu[2]
-        drag = _smooth_abs(local, eps_speed) * local
-        sway += drag
-        moment += float(station) * drag
-    return ca.vertcat(0.0, scale * sway, scale * moment)
-
-
-def _thruster_force(
-    thruster: ThrusterParams, thrust: ca.SX
-) -> tuple[ca.SX | float, ca.SX | float, ca.SX | float]:
-    """``(X, Y, N)`` of one thruster's thrust on the hull [N, N, N m]."""
-    force = (1.0 - thruster.thrust_deduction) * thrust
-    return (
-        thruster.surge_share * force,
-        np.sin(thruster.axis) * force,
-        thruster.yaw_arm * force,
-    )
-
-
-def _advance_speed(thruster: ThrusterParams, nu: ca.SX) -> ca.SX:
-    """``v_a = (1 - w)(cα (u - y r) + sα (v + x r))`` [m/s]."""
-    u, v, r = nu[0], nu[1], nu[2]
-    axial = thruster.surge_share * (u - thruster.y * r)
-    if thruster.axis != 0.0:
-        axial += np.sin(thruster.axis) * (v + thruster.x * r)
-    return (1.0 - thruster.wake_fraction) * axial
-
-
-def _surface_force(surface: ControlSurfaceParams, rho: float, nu: ca.SX, delta: ca.SX) -> ca.SX:
-    """``(X, Y, N)`` of a control surface: lift ``-q C_Lδ δ``, drag ``-q C_Dδ δ²`` [N, N, N m]."""
-    pressure = 0.5 * rho * (nu[0] ** 2 + nu[1] ** 2) * surface.area
-    lift = -pressure * surface.lift_slope * delta
-    drag = -pressure * surface.drag_slope * delta**2
-    return ca.vertcat(drag, lift, surface.x * lift - surface.y * drag)
 
 
 def _propeller_order(vehicle: ActuatedVehicleParams, order: int | None) -> tuple[int, ...]:
@@ -247,7 +212,7 @@ def build_vehicle_model(
     thrusts, torques = [], []
     for thruster, n, order in zip(thrusters, speeds, orders, strict=True):
         thrust, torque = thrust_torque_expression(
-            _advance_speed(thruster, nu),
+            advance_speed(thruster, nu),
             n,
             thruster.propeller,
             hull.rho,
@@ -257,11 +222,11 @@ def build_vehicle_model(
         )
         thrusts.append(thrust)
         torques.append(torque)
-    forces = [_thruster_force(t, thrust) for t, thrust in zip(thrusters, thrusts, strict=True)]
+    forces = [thruster_force(t, thrust) for t, thrust in zip(thrusters, thrusts, strict=True)]
     tau = ca.vertcat(*(sum(component[k] for component in forces) for k in range(3)))
     for surface, delta in zip(surfaces, deflections, strict=True):
-        tau += _surface_force(surface, hull.rho, nu, delta)
-    tau += _crossflow_force(hull, vehicle.eps_abs_speed, nu)
+        tau += surface_force(surface, hull.rho, nu, delta)
+    tau += crossflow_force(hull, vehicle.eps_abs_speed, nu)
 
     m_u, m_v = hull.coriolis_masses
     u, v = nu[0], nu[1]
@@ -270,7 +235,7 @@ def build_vehicle_model(
         ca.horzcat(0.0, 0.0, m_u * u),
         ca.horzcat(m_v * v, -m_u * u, 0.0),
     )
-    damping = _hull_damping(hull, vehicle, nu)
+    damping = hull_damping(hull, vehicle, nu)
     nu_dot = (tau - ca.mtimes(coriolis, nu) - damping * nu) / ca.vertcat(
         hull.m_u, hull.m_v, hull.m_r
     )

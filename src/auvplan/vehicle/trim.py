@@ -10,17 +10,25 @@ for any actuator layout.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass
 from functools import cache
-from typing import NamedTuple
 
-import casadi as ca
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar, root
+from scipy.optimize import brentq, minimize_scalar
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InfeasibleError, InputError, SolverError
+from auvplan.vehicle._steady import (
+    BollardPull,
+    CruiseOptimum,
+    SteadyMotion,
+    SteadyTurn,
+    SurgeTrim,
+    TurnTrim,
+    VehicleCharacteristics,
+    nu_dot,
+    solve_equilibrium,
+    steady_power,
+)
 from auvplan.vehicle.dynamics import VehicleModel
 from auvplan.vehicle.operating import (
     FIRST_ACTUATOR,
@@ -31,122 +39,7 @@ from auvplan.vehicle.operating import (
     steer_fraction,
 )
 
-_NU = slice(3, 6)
 _MIN_CRUISE_SPEED = 0.05  # m/s, lower end of the cruise-speed search
-
-
-class SurgeTrim(NamedTuple):
-    """Straight-line trim: every forward-pushing propeller at ``n``."""
-
-    n: float
-    """Propeller speed (the throttle) [rev/s]; may exceed ``n_max`` above the top speed."""
-    power: float
-    """Electrical power including the hotel load [W]."""
-
-
-class TurnTrim(NamedTuple):
-    """Steady turn of a twin-thruster vehicle at a given surge speed and yaw rate."""
-
-    n_ps: float
-    """Port propeller speed [rev/s]."""
-    n_sb: float
-    """Starboard propeller speed [rev/s]."""
-    v: float
-    """Steady sway speed [m/s]."""
-    power: float
-    """Electrical power including the hotel load [W]."""
-
-
-class SteadyMotion(NamedTuple):
-    """Steady body velocities for fixed propeller speeds."""
-
-    u: float
-    """Surge speed [m/s]."""
-    v: float
-    """Sway speed [m/s]."""
-    r: float
-    """Yaw rate [rad/s]."""
-
-
-class SteadyTurn(NamedTuple):
-    """A steady turn: the full state (at the origin, heading north) and its power."""
-
-    state: FloatArray
-    """State ``(0, 0, 0, u, v, r, actuators…)``, shape ``(n_x,)``."""
-    power: float
-    """Electrical power including the hotel load [W]."""
-
-    @property
-    def radius(self) -> float:
-        """Radius of the circle ``sqrt(u² + v²)/|r|`` [m]."""
-        u, v, r = self.state[_NU]
-        return float(math.hypot(u, v) / abs(r))
-
-
-class BollardPull(NamedTuple):
-    """Thrust and torque of one propeller at ``n_max`` with the vehicle held at rest."""
-
-    thrust: float
-    """Thrust per propeller (the first forward-pushing one) [N]."""
-    torque: float
-    """Shaft torque per propeller [N m]."""
-    power: float
-    """Electrical power of the vehicle, forward motors at ``n_max`` plus hotel load [W]."""
-
-
-class CruiseOptimum(NamedTuple):
-    """Energy-optimal straight-line cruise."""
-
-    speed: float
-    """Surge speed minimising energy per metre [m/s]."""
-    energy_per_metre: float
-    """``P(u)/u`` at that speed [J/m]."""
-
-
-def _nu_dot(model: VehicleModel, state: FloatArray) -> FloatArray:
-    return np.asarray(model.dynamics(state, np.zeros(model.n_u)), dtype=np.float64).ravel()[_NU]
-
-
-def _power(model: VehicleModel, state: FloatArray) -> float:
-    return float(model.power(state, np.zeros(model.n_u)))
-
-
-@cache
-def _jacobian(model: VehicleModel) -> ca.Function:
-    x = ca.SX.sym("x", model.n_x)
-    xdot = model.dynamics(x, ca.SX.zeros(model.n_u))
-    return ca.Function("f_x", [x], [ca.jacobian(xdot, x)])
-
-
-def _solve_equilibrium(
-    model: VehicleModel,
-    state_of: Callable[[FloatArray], FloatArray],
-    guesses: Sequence[Sequence[float]],
-    what: str,
-) -> FloatArray:
-    """Unknowns ``z`` (3 of them) with ``ν̇(state_of(z)) = 0``, from the first guess that works.
-
-    ``state_of`` is affine in ``z``, so its Jacobian is read off exactly from unit steps and
-    the Newton system uses the exact ``∂f/∂x``.
-    """
-    origin = state_of(np.zeros(3))
-    columns = np.column_stack([state_of(np.eye(3)[k]) - origin for k in range(3)])
-    jacobian = _jacobian(model)
-
-    def residual(z: FloatArray) -> FloatArray:
-        return _nu_dot(model, state_of(z))
-
-    def residual_jacobian(z: FloatArray) -> FloatArray:
-        full = np.asarray(jacobian(state_of(z)), dtype=np.float64)
-        return np.asarray(full[_NU] @ columns, dtype=np.float64)
-
-    message = ""
-    for guess in guesses:
-        solution = root(residual, np.asarray(guess, float), jac=residual_jacobian, tol=1e-12)
-        if solution.success and np.max(np.abs(residual(solution.x))) <= 1e-8:
-            return np.asarray(solution.x, dtype=np.float64)
-        message = str(solution.message)
-    raise SolverError(f"{what} did not converge: {message}")
 
 
 def trim_surge(model: VehicleModel, speed: float) -> SurgeTrim:
@@ -182,10 +75,10 @@ def trim_surge(model: VehicleModel, speed: float) -> SurgeTrim:
     if not math.isfinite(speed):
         raise InputError(f"speed must be finite, got {speed!r}")
     if speed == 0.0:
-        return SurgeTrim(0.0, _power(model, operating_state(model)))
+        return SurgeTrim(0.0, steady_power(model, operating_state(model)))
 
     def surge_acceleration(n: float) -> float:
-        return float(_nu_dot(model, operating_state(model, u=speed, throttle=n))[0])
+        return float(nu_dot(model, operating_state(model, u=speed, throttle=n))[0])
 
     limit = 4.0 * actuator_roles(model).throttle_max * math.copysign(1.0, speed)
     if surge_acceleration(limit) * surge_acceleration(0.0) > 0.0:
@@ -193,7 +86,7 @@ def trim_surge(model: VehicleModel, speed: float) -> SurgeTrim:
             f"no propeller speed within ±{abs(limit):.0f} rev/s holds surge speed {speed} m/s"
         )
     n = float(brentq(surge_acceleration, 0.0, limit, xtol=1e-10, rtol=1e-12))
-    return SurgeTrim(n, _power(model, operating_state(model, u=speed, throttle=n)))
+    return SurgeTrim(n, steady_power(model, operating_state(model, u=speed, throttle=n)))
 
 
 def steady_motion(model: VehicleModel, *actuators: float) -> SteadyMotion:
@@ -250,7 +143,7 @@ def steady_motion(model: VehicleModel, *actuators: float) -> SteadyMotion:
     ]
     u, v, r = (
         float(value)
-        for value in _solve_equilibrium(
+        for value in solve_equilibrium(
             model, state_of, guesses, f"steady motion for actuators {settings.tolist()}"
         )
     )
@@ -300,11 +193,11 @@ def steady_turn(model: VehicleModel, speed: float, yaw_rate: float) -> SteadyTur
     turn = math.copysign(1.0, yaw_rate) if yaw_rate != 0.0 else 1.0
     first = yaw_rate / max_yaw_rate(model)
     guesses = [(throttle, s0, 0.0) for s0 in (first, *(k * turn for k in (0.05, 0.2, 0.5, 1.0)))]
-    solution = _solve_equilibrium(
+    solution = solve_equilibrium(
         model, state_of, guesses, f"steady turn at u = {speed} m/s, r = {yaw_rate} rad/s"
     )
     state = state_of(solution)
-    return SteadyTurn(state, _power(model, state))
+    return SteadyTurn(state, steady_power(model, state))
 
 
 def trim_turn(model: VehicleModel, speed: float, yaw_rate: float) -> TurnTrim:
@@ -354,7 +247,7 @@ def tightest_turn(model: VehicleModel, speed: float) -> SteadyTurn:
     >>> from auvplan.io.vehicles import load_vehicle
     >>> from auvplan.vehicle.dynamics import build_vehicle_model
     >>> round(tightest_turn(build_vehicle_model(load_vehicle("medusa")), 0.5).radius, 2)
-    0.6
+    0.65
     """
     roles = _check_steering(model)
 
@@ -364,11 +257,9 @@ def tightest_turn(model: VehicleModel, speed: float) -> SteadyTurn:
 
     throttle = trim_surge(model, speed).n
     guesses = [(throttle, 0.0, r0) for r0 in (0.1, 0.3, 0.6, 1.0, 2.0)]
-    solution = _solve_equilibrium(
-        model, state_of, guesses, f"full-steering turn at u = {speed} m/s"
-    )
+    solution = solve_equilibrium(model, state_of, guesses, f"full-steering turn at u = {speed} m/s")
     state = state_of(solution)
-    return SteadyTurn(state, _power(model, state))
+    return SteadyTurn(state, steady_power(model, state))
 
 
 def _check_steering(model: VehicleModel) -> ActuatorRoles:
@@ -392,7 +283,7 @@ def top_speed(model: VehicleModel) -> float:
     n_max = actuator_roles(model).throttle_max
 
     def surge_acceleration(u: float) -> float:
-        return float(_nu_dot(model, operating_state(model, u=u, throttle=n_max))[0])
+        return float(nu_dot(model, operating_state(model, u=u, throttle=n_max))[0])
 
     upper = 1.0
     while surge_acceleration(upper) > 0.0:
@@ -418,7 +309,7 @@ def bollard(model: VehicleModel) -> BollardPull:
     outputs = [float(value) for value in model.thrust_torque(state)]
     first = int(np.argmax(roles.throttle))
     n_thrusters = len(model.vehicle.thrusters)
-    return BollardPull(outputs[first], outputs[n_thrusters + first], _power(model, state))
+    return BollardPull(outputs[first], outputs[n_thrusters + first], steady_power(model, state))
 
 
 @cache
@@ -492,57 +383,6 @@ def optimal_cruise_speed(model: VehicleModel) -> CruiseOptimum:
     )
     speed = float(result.x)
     return CruiseOptimum(speed, energy_per_metre(model, speed))
-
-
-@dataclass(frozen=True)
-class VehicleCharacteristics:
-    """Headline numbers of a vehicle type (what ``auvplan vehicle`` prints)."""
-
-    name: str
-    """Vehicle type."""
-    propeller_order: int
-    """Harmonics of the propeller series used [-]."""
-    n_max: float
-    """Maximum speed of the forward-pushing propellers [rev/s]."""
-    bollard_thrust: float
-    """Thrust per propeller at ``n_max``, vehicle at rest [N]."""
-    bollard_torque: float
-    """Torque per propeller at ``n_max``, vehicle at rest [N m]."""
-    bollard_power: float
-    """Electrical power at bollard, all forward motors plus hotel load [W]."""
-    top_speed: float
-    """Straight-line speed at ``n_max`` [m/s]."""
-    cruise_speed: float
-    """Energy-optimal cruise speed [m/s]."""
-    cruise_energy_per_metre: float
-    """Energy per metre at the cruise speed [J/m]."""
-    hotel_power: float
-    """Hotel load included in every power [W]."""
-    power_at_0_5: float
-    """Steady electrical power at 0.5 m/s (with hotel load) [W]."""
-    power_at_1_0: float
-    """Steady electrical power at 1.0 m/s (with hotel load) [W]."""
-    n_at_0_5: float
-    """Propeller speed at 0.5 m/s [rev/s]."""
-    n_at_1_0: float
-    """Propeller speed at 1.0 m/s [rev/s]."""
-    max_yaw_rate: float
-    """Steady yaw rate at full steering (:func:`max_yaw_rate`) [rad/s]."""
-    turning_radius: float
-    """Radius of the steady turn at full steering at the cruise speed [m]."""
-
-    def to_dict(self) -> dict[str, float | int | str]:
-        """Plain dictionary (JSON-ready), SI units as documented per field.
-
-        Examples
-        --------
-        >>> from auvplan.io.vehicles import load_vehicle
-        >>> from auvplan.vehicle.dynamics import build_vehicle_model
-        >>> table = vehicle_characteristics(build_vehicle_model(load_vehicle("medusa"))).to_dict()
-        >>> table["name"], round(float(table["top_speed"]), 2)
-        ('medusa', 1.48)
-        """
-        return dict(asdict(self))
 
 
 def vehicle_characteristics(model: VehicleModel) -> VehicleCharacteristics:
