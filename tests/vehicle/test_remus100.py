@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import _remus_oracle as fossen
 import numpy as np
@@ -208,3 +209,13 @@ def test_cli_reports_within_five_percent_of_the_source(capsys: pytest.CaptureFix
     bollard = 1026 * 0.14**4 * 0.4566 * (1525 / 60) ** 2  # rho D^4 K_T0 n^2, n = 1525 rpm
     assert table["bollard_thrust"] == pytest.approx(bollard, rel=1e-4)
     assert 0.5 < table["cruise_speed"] < 1.5
+
+
+def test_cli_text_and_validation_figure(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    figure = tmp_path / "remus100.png"
+    assert main(["vehicle", "remus100", "--figure", str(figure)]) == 0
+    out = capsys.readouterr().out
+    assert "K_T and K_Q linear in J" in out
+    assert "turning radius" in out
+    assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert figure.stat().st_size > 10_000

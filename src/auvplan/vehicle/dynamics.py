@@ -302,16 +302,16 @@ def vessel_dynamics(states: FloatArray, inputs: FloatArray, model: VehicleModel)
 
     Parameters
     ----------
-    states : ndarray of shape (n_t, 8)
+    states : ndarray of shape (n_t, n_x)
         States (SI units, rev/s for the propellers).
-    inputs : ndarray of shape (n_t, 2)
+    inputs : ndarray of shape (n_t, n_u)
         Inputs ``c`` [-].
     model : VehicleModel
         Model from :func:`build_vehicle_model`.
 
     Returns
     -------
-    ndarray of shape (n_t, 8)
+    ndarray of shape (n_t, n_x)
         State derivatives.
 
     Raises
@@ -337,9 +337,9 @@ def electrical_power(states: FloatArray, inputs: FloatArray, model: VehicleModel
 
     Parameters
     ----------
-    states : ndarray of shape (n_t, 8)
+    states : ndarray of shape (n_t, n_x)
         States.
-    inputs : ndarray of shape (n_t, 2)
+    inputs : ndarray of shape (n_t, n_u)
         Inputs (the power does not depend on them; kept for the optimiser's signature).
     model : VehicleModel
         Model.
@@ -373,9 +373,9 @@ def energy(time: FloatArray, states: FloatArray, inputs: FloatArray, model: Vehi
     ----------
     time : ndarray of shape (n_t,)
         Strictly increasing times [s].
-    states : ndarray of shape (n_t, 8)
+    states : ndarray of shape (n_t, n_x)
         States.
-    inputs : ndarray of shape (n_t, 2)
+    inputs : ndarray of shape (n_t, n_u)
         Inputs.
     model : VehicleModel
         Model.
