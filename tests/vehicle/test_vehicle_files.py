@@ -30,7 +30,7 @@ def test_packaged_data_is_importable_resource() -> None:
     root = resources.files("auvplan").joinpath("data")
     assert root.joinpath("vehicles", "medusa.toml").is_file()
     assert root.joinpath("propellers", "wageningen_b4-70_pd1.4.csv").is_file()
-    assert packaged_vehicle_types() == ("medusa",)
+    assert packaged_vehicle_types() == ("medusa", "remus100")
     assert packaged_propeller_tables() == ("wageningen_b4-70_pd1.4",)
 
 

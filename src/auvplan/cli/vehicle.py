@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from auvplan.vehicle.params import Propeller
     from auvplan.vehicle.trim import VehicleCharacteristics
 
 #: Units of the JSON fields (SI; propeller speeds in rev/s).
@@ -24,6 +25,7 @@ UNITS = {
     "n_at_0_5": "rev/s",
     "n_at_1_0": "rev/s",
     "max_yaw_rate": "rad/s",
+    "turning_radius": "m",
 }
 
 
@@ -31,11 +33,12 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
     """Add the ``vehicle`` verb to the command line."""
     parser = subparsers.add_parser(
         "vehicle",
-        help="report a vehicle type's characteristics (bollard pull, speeds, power)",
-        description="Load a vehicle type (packaged name such as 'medusa', or a vehicle TOML "
-        "file) and report bollard thrust and torque at maximum propeller speed, top speed, "
-        "energy-optimal cruise speed and its energy per metre, steady electrical power at "
-        "0.5 and 1.0 m/s, and maximum steady yaw rate.",
+        help="report a vehicle type's characteristics (bollard pull, speeds, power, turns)",
+        description="Load a vehicle type (packaged name such as 'medusa' or 'remus100', or a "
+        "vehicle TOML file) and report bollard thrust and torque at maximum propeller speed, "
+        "top speed, energy-optimal cruise speed and its energy per metre, steady electrical "
+        "power at 0.5 and 1.0 m/s, maximum steady yaw rate, and the turning radius at full "
+        "steering at the cruise speed.",
     )
     parser.add_argument(
         "vehicle",
@@ -84,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
         document = {"characteristics": table.to_dict(), "units": UNITS}
         print(json.dumps(document, indent=2))
     elif not args.quiet:
-        _print_table(table)
+        _print_table(table, model.vehicle.propeller)
     if args.figure is not None and not args.quiet and not args.json:
         print(f"wrote                      {args.figure}")
     return 0
@@ -107,14 +110,21 @@ def _check_figure_path(path: Path) -> None:
         )
 
 
-def _print_table(table: VehicleCharacteristics) -> None:
-    print(f"vehicle                    {table.name} (propeller order {table.propeller_order})")
+def _print_table(table: VehicleCharacteristics, propeller: Propeller) -> None:
+    from auvplan.vehicle.params import PropellerParams
+
+    series = (
+        f"propeller order {table.propeller_order}"
+        if isinstance(propeller, PropellerParams)
+        else f"propeller {propeller.name}, K_T and K_Q linear in J"
+    )
+    print(f"vehicle                    {table.name} ({series})")
     print(
         f"{f'bollard at {table.n_max:.1f} rev/s':<27}thrust {table.bollard_thrust:.2f} N, "
         f"torque {table.bollard_torque:.3f} N m per propeller; "
         f"electrical power {table.bollard_power:.0f} W"
     )
-    print(f"top speed                  {table.top_speed:.3f} m/s (both propellers at n_max)")
+    print(f"top speed                  {table.top_speed:.3f} m/s (propellers at n_max)")
     print(
         f"energy-optimal cruise      {table.cruise_speed:.3f} m/s, "
         f"{table.cruise_energy_per_metre:.1f} J/m"
@@ -127,4 +137,8 @@ def _print_table(table: VehicleCharacteristics) -> None:
             f"{f'steady power at {speed:.1f} m/s':<27}{power:.1f} W "
             f"(hotel {table.hotel_power:.0f} W; n = {n:.1f} rev/s)"
         )
-    print(f"max steady yaw rate        {table.max_yaw_rate:.3f} rad/s (turning on the spot)")
+    print(f"max steady yaw rate        {table.max_yaw_rate:.3f} rad/s (full steering)")
+    print(
+        f"turning radius             {table.turning_radius:.2f} m "
+        f"(full steering at the cruise speed {table.cruise_speed:.2f} m/s)"
+    )

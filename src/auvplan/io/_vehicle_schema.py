@@ -8,6 +8,7 @@ canonical SI unit, and checks it against the key's range; every message names th
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Final
@@ -41,7 +42,12 @@ UNITS: Final[dict[str, dict[str, float]]] = {
     "A": {"A": 1.0},
     "W": {"W": 1.0},
     "m/s": {"m/s": 1.0},
-    "rad/s": {"rad/s": 1.0},
+    "rad/s": {"rad/s": 1.0, "deg/s": math.pi / 180.0},
+    "rad": {"rad": 1.0, "deg": math.pi / 180.0},
+    "m^2": {"m^2": 1.0, "m2": 1.0, "cm^2": 1e-4},
+    "1/rad": {"1/rad": 1.0},
+    "1/rad^2": {"1/rad^2": 1.0, "1/rad2": 1.0},
+    "s/m": {"s/m": 1.0},
 }
 
 
@@ -70,6 +76,13 @@ HULL: Final = {
     "N_rr": Range("kg m^2", -1e12, 0.0),
     "rho": Range("kg/m^3", 950.0, 1100.0),
 }
+HULL_OPTIONAL: Final = {"linear_damping_fade": Range("s/m", 0.0, 100.0)}
+HULL_DEFAULTS: Final = {"linear_damping_fade": 0.0}
+CROSSFLOW: Final = {
+    "length": Range("m", 0.01, 1e3),
+    "height": Range("m", 1e-3, 1e2),
+    "drag_coefficient": Range("1", 0.05, 5.0),
+}
 PROPULSION: Final = {
     "l": Range("m", 0.005, 50.0),
     "n_max": Range("rev/s", 0.5, 1000.0),
@@ -79,6 +92,33 @@ PROPELLER: Final = {
     "diameter": Range("m", 0.005, 15.0),
     "c_T": Range("1", 0.1, 10.0),
     "c_Q": Range("1", 0.1, 10.0),
+}
+LINEAR_PROPELLER: Final = {
+    "diameter": Range("m", 0.005, 15.0),
+    "K_T0": Range("1", 1e-3, 2.0),
+    "K_Q0": Range("1", 1e-4, 0.5),
+    "J_max": Range("1", 0.01, 3.0),
+    "K_T_at_J_max": Range("1", -2.0, 2.0),
+    "K_Q_at_J_max": Range("1", 1e-5, 0.5),
+}
+THRUSTER: Final = {
+    "x": Range("m", -1e3, 1e3),
+    "y": Range("m", -1e3, 1e3),
+    "axis": Range("rad", -math.pi, math.pi),
+    "n_max": Range("rev/s", 0.5, 1000.0),
+    "w_c": Range("rev/s^2", 0.01, 1e5),
+    "wake_fraction": Range("1", 0.0, 0.9),
+    "thrust_deduction": Range("1", 0.0, 0.9),
+}
+THRUSTER_DEFAULTS: Final = {"wake_fraction": 0.0, "thrust_deduction": 0.0}
+SURFACE: Final = {
+    "x": Range("m", -1e3, 1e3),
+    "y": Range("m", -1e3, 1e3),
+    "area": Range("m^2", 1e-6, 1e3),
+    "lift_slope": Range("1/rad", 1e-3, 10.0),
+    "drag_slope": Range("1/rad^2", 0.0, 10.0),
+    "delta_max": Range("rad", 1e-3, math.pi / 2),
+    "rate_max": Range("rad/s", 1e-3, 1e3),
 }
 MOTOR: Final = {
     "R_a": Range("ohm", 0.0, 1e3),
@@ -186,6 +226,54 @@ def vector(section: Mapping[str, object], key: str, where: str, expected: Range)
     if isinstance(value, float):
         raise DataFormatError(f"'{where}.{key}' must be a list of numbers")
     return value
+
+
+def integer(
+    section: Mapping[str, object], key: str, where: str, low: int, high: int, default: int | None
+) -> int | None:
+    """An optional integer ``where.key`` in ``[low, high]`` (``default`` when absent)."""
+    value = section.get(key, default)
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise DataFormatError(f"'{where}.{key}' must be an integer, got {value!r}")
+    if not low <= value <= high:
+        raise InputError(f"{where}.{key} must be in [{low}, {high}], got {value}")
+    return value
+
+
+def text(section: Mapping[str, object], key: str, where: str, default: str | None = None) -> str:
+    """The string ``where.key`` (``default`` when absent and not None)."""
+    value = section.get(key, default)
+    if not isinstance(value, str) or not value:
+        raise DataFormatError(f"missing key '{where}.{key}' (a non-empty string) in vehicle file")
+    return value
+
+
+def flag(section: Mapping[str, object], key: str, where: str, default: bool) -> bool:
+    """The boolean ``where.key`` (``default`` when absent)."""
+    value = section.get(key, default)
+    if not isinstance(value, bool):
+        raise DataFormatError(f"'{where}.{key}' must be true or false, got {value!r}")
+    return value
+
+
+def reject_unknown(section: Mapping[str, object], where: str, allowed: set[str]) -> None:
+    """Refuse keys the schema does not know (a typo would otherwise be silently ignored)."""
+    unknown = sorted(set(section) - allowed)
+    if unknown:
+        known = ", ".join(sorted(allowed))
+        raise DataFormatError(
+            f"unknown key '{where}.{unknown[0]}' in vehicle file (known: {known})"
+        )
+
+
+def tables(document: Mapping[str, object], key: str) -> list[Mapping[str, object]]:
+    """The array of tables ``[[key]]`` (empty when absent)."""
+    entries = document.get(key, [])
+    if not isinstance(entries, list) or not all(isinstance(e, Mapping) for e in entries):
+        raise DataFormatError(f"'{key}' must be an array of tables [[{key}]] in vehicle file")
+    return entries
 
 
 def section(document: Mapping[str, object], key: str, where: str = "") -> Mapping[str, object]:

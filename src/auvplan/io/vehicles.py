@@ -1,10 +1,13 @@
-"""Vehicle files: TOML parameter sets (one file per vehicle type) and propeller tables.
+"""Vehicle files: TOML parameter sets, one file per vehicle type.
 
-A vehicle is named either by a packaged type (``"medusa"``) or by the path of a TOML file::
+A vehicle is named either by a packaged type (``"medusa"``, ``"remus100"``) or by the path of
+a TOML file. Its actuators are given either by the twin-thruster shorthand (MEDUSA)::
 
     name = "medusa"
-    [hull]        m, I_z, X_udot, Y_vdot, N_rdot, X_u, Y_v, N_r, X_uu, Y_vv, N_rr, rho
-    [propulsion]  l, n_max, w_c
+    [hull]        m, I_z, X_udot, Y_vdot, N_rdot, X_u, Y_v, N_r, X_uu, Y_vv, N_rr, rho,
+                  linear_damping_fade (optional), added_mass_coriolis (optional bool),
+                  [hull.crossflow] length, height, drag_coefficient, strips (optional)
+    [propulsion]  l, n_max, w_c                  (two identical thrusters at y = -/+ l)
     [propeller]   table = "<packaged name>" | "<csv path relative to this file>",
                   diameter, c_T, c_Q, order (optional integer)
     [motor]       R_a, K_e, V_bus, I_0 (optional), current_model (optional),
@@ -12,53 +15,74 @@ A vehicle is named either by a packaged type (``"medusa"``) or by the path of a 
     [power]       hotel
     [smoothing]   inflow, abs_speed, abs_rate, sign_n (all optional)
 
+or by a list of actuators (any layout; :mod:`auvplan.vehicle.actuators`)::
+
+    [[thruster]]          name, x, y, axis, n_max, w_c, wake_fraction, thrust_deduction
+                          (the last two optional)
+    [thruster.propeller]  model = "four_quadrant" (as [propeller] above) or "linear":
+                          diameter, K_T0, K_Q0, J_max, K_T_at_J_max, K_Q_at_J_max
+    [thruster.motor]      as [motor] above
+    [[control_surface]]   name, x, y, area, lift_slope, drag_slope, delta_max, rate_max
+
 Every number is a table ``{ value = ..., unit = "..." }``; its unit and physical range are
-checked (:mod:`auvplan.io._vehicle_schema`). A propeller table is a CSV with ``#``
-comment lines, a header ``k,A_T,B_T,A_Q,B_Q`` and one row per harmonic ``k = 0..K``.
+checked (:mod:`auvplan.io._vehicle_schema`). Four-quadrant propeller tables are read by
+:mod:`auvplan.io._propeller_tables`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from importlib import resources
 from importlib.resources.abc import Traversable
 from pathlib import Path
-from typing import Final
-
-import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError, InputError
+from auvplan.io._propeller_tables import (
+    PROPELLER_COLUMNS,
+    data_dir,
+    load_propeller_table,
+    packaged_propeller_tables,
+)
 from auvplan.io._vehicle_schema import (
+    CROSSFLOW,
     CURRENT_CURVE,
     HOTEL,
     HULL,
+    HULL_DEFAULTS,
+    HULL_OPTIONAL,
+    LINEAR_PROPELLER,
     MOTOR,
     PROPELLER,
     PROPULSION,
     SMOOTHING,
     SMOOTHING_DEFAULTS,
+    SURFACE,
+    THRUSTER,
+    THRUSTER_DEFAULTS,
+    flag,
+    integer,
+    reject_unknown,
     scalar,
     scalars,
     section,
+    tables,
+    text,
     vector,
 )
-from auvplan.io.text import read_text, read_toml
+from auvplan.io.text import read_toml
+from auvplan.vehicle.actuators import (
+    ActuatedVehicleParams,
+    ControlSurfaceParams,
+    ThrusterParams,
+)
 from auvplan.vehicle.params import (
+    CrossFlowParams,
     HullParams,
+    LinearPropellerParams,
     MotorParams,
-    PropellerParams,
+    Propeller,
     VehicleParams,
 )
-
-PROPELLER_COLUMNS: Final = ("k", "A_T", "B_T", "A_Q", "B_Q")
-
-#: Largest magnitude of a Fourier coefficient of C_T* or C_Q* (published series stay below 2).
-_MAX_PROPELLER_COEFFICIENT: Final = 10.0
-
-
-def _data_dir(kind: str) -> Traversable:
-    return resources.files("auvplan").joinpath("data", kind)
 
 
 def packaged_vehicle_types() -> tuple[str, ...]:
@@ -72,7 +96,7 @@ def packaged_vehicle_types() -> tuple[str, ...]:
     return tuple(
         sorted(
             entry.name.removesuffix(".toml")
-            for entry in _data_dir("vehicles").iterdir()
+            for entry in data_dir("vehicles").iterdir()
             if entry.name.endswith(".toml")
         )
     )
@@ -87,161 +111,69 @@ def vehicle_file(type_or_path: str) -> Path | Traversable:
     ('medusa.toml', PosixPath('boats/mine.toml'))
     """
     if type_or_path in packaged_vehicle_types():
-        return _data_dir("vehicles").joinpath(f"{type_or_path}.toml")
+        return data_dir("vehicles").joinpath(f"{type_or_path}.toml")
     return Path(type_or_path)
 
 
-def packaged_propeller_tables() -> tuple[str, ...]:
-    """Names of the propeller tables shipped with auvplan.
-
-    Examples
-    --------
-    >>> packaged_propeller_tables()
-    ('wageningen_b4-70_pd1.4',)
-    """
-    return tuple(
-        sorted(
-            entry.name.removesuffix(".csv")
-            for entry in _data_dir("propellers").iterdir()
-            if entry.name.endswith(".csv")
-        )
-    )
-
-
-def _parse_propeller_table(text: str, origin: str) -> tuple[FloatArray, FloatArray]:
-    rows = [
-        line.strip()
-        for line in text.splitlines()
-        if line.strip() and not line.lstrip().startswith("#")
-    ]
-    if not rows or tuple(c.strip() for c in rows[0].split(",")) != PROPELLER_COLUMNS:
-        raise DataFormatError(
-            f"propeller table {origin}: header must be {','.join(PROPELLER_COLUMNS)}"
-        )
-    try:
-        table = np.array([[float(v) for v in row.split(",")] for row in rows[1:]], dtype=float)
-    except ValueError as error:
-        raise DataFormatError(f"propeller table {origin}: {error}") from None
-    if table.ndim != 2 or table.shape[1] != len(PROPELLER_COLUMNS) or table.shape[0] < 2:
-        raise DataFormatError(f"propeller table {origin}: needs rows k,A_T,B_T,A_Q,B_Q for k=0..K")
-    if not np.array_equal(table[:, 0], np.arange(table.shape[0])):
-        raise DataFormatError(f"propeller table {origin}: k must run 0, 1, 2, ... without gaps")
-    if not np.all(np.isfinite(table)):
-        raise DataFormatError(f"propeller table {origin}: non-finite coefficient")
-    if np.max(np.abs(table[:, 1:])) > _MAX_PROPELLER_COEFFICIENT:
-        raise DataFormatError(
-            f"propeller table {origin}: coefficient {np.max(np.abs(table[:, 1:])):g} beyond "
-            f"±{_MAX_PROPELLER_COEFFICIENT:g} (C_T*, C_Q* are of order 1)"
-        )
-    return table[:, 0], table[:, 1:]
-
-
-def load_propeller_table(
-    table: str | Path,
-    *,
-    diameter: float,
-    c_T: float = 1.0,
-    c_Q: float = 1.0,
-    order: int | None = None,
-    base_dir: Path | None = None,
-) -> PropellerParams:
-    """Read a four-quadrant propeller table (packaged name or CSV path).
-
-    Parameters
-    ----------
-    table : str or Path
-        A packaged table name (see :func:`packaged_propeller_tables`) or a CSV path.
-    diameter : float
-        Propeller diameter [m].
-    c_T, c_Q : float
-        Thrust and torque correction factors [-].
-    order : int, optional
-        Harmonics used by default (``None``: all).
-    base_dir : Path, optional
-        Directory that relative paths are resolved against.
-
-    Returns
-    -------
-    PropellerParams
-
-    Raises
-    ------
-    InputError
-        If the table is neither packaged nor an existing file.
-    DataFormatError
-        If the file does not have the expected layout.
-
-    Examples
-    --------
-    >>> load_propeller_table("wageningen_b4-70_pd1.4", diameter=0.057).max_order
-    30
-    """
-    name = str(table)
-    if name in packaged_propeller_tables():
-        text = read_text(_data_dir("propellers").joinpath(f"{name}.csv"), what="propeller table")
-        source = f"packaged table {name}"
-    else:
-        path = Path(table)
-        if not path.is_absolute() and base_dir is not None:
-            path = base_dir / path
-        if not path.is_file():
-            raise InputError(
-                f"propeller table {name!r} is neither packaged "
-                f"({', '.join(packaged_propeller_tables())}) nor an existing file"
-            )
-        text = read_text(path, what="propeller table")
-        name = path.stem
-        source = str(path)
-    _, coefficients = _parse_propeller_table(text, name)
-    comments = [line[1:].strip() for line in text.splitlines() if line.startswith("#")]
-    citation = " ".join(comments[:5]) if comments else source
-    return PropellerParams(
-        name=name,
-        source=citation,
-        diameter=diameter,
-        c_T=c_T,
-        c_Q=c_Q,
-        A_T=coefficients[:, 0],
-        B_T=coefficients[:, 1],
-        A_Q=coefficients[:, 2],
-        B_Q=coefficients[:, 3],
-        order=order,
-    )
-
-
-def _parse_vehicle(document: Mapping[str, object], base_dir: Path | None) -> VehicleParams:
-    name = document.get("name")
-    if not isinstance(name, str) or not name:
-        raise DataFormatError("missing key 'name' (a non-empty string) in vehicle file")
+def _parse_hull(document: Mapping[str, object]) -> HullParams:
     hull_section = section(document, "hull")
-    hull = HullParams(**scalars(hull_section, "hull", HULL))
-    propulsion = section(document, "propulsion")
-    propeller_section = section(document, "propeller")
+    crossflow: CrossFlowParams | None = None
+    if "crossflow" in hull_section:
+        strips_section = section(hull_section, "crossflow", "hull")
+        reject_unknown(strips_section, "hull.crossflow", {*CROSSFLOW, "strips"})
+        strips = integer(strips_section, "strips", "hull.crossflow", 1, 1000, None)
+        if strips is None:
+            raise DataFormatError(
+                "missing key 'hull.crossflow.strips' (an integer) in vehicle file"
+            )
+        crossflow = CrossFlowParams(
+            **scalars(strips_section, "hull.crossflow", CROSSFLOW), strips=strips
+        )
+    return HullParams(
+        **scalars(hull_section, "hull", HULL),
+        **scalars(hull_section, "hull", HULL_OPTIONAL, HULL_DEFAULTS),
+        added_mass_coriolis=flag(hull_section, "added_mass_coriolis", "hull", True),
+        crossflow=crossflow,
+    )
+
+
+def _parse_propeller(
+    propeller_section: Mapping[str, object], where: str, base_dir: Path | None
+) -> Propeller:
+    model = text(propeller_section, "model", where, "four_quadrant")
+    if model == "linear":
+        coefficients = scalars(propeller_section, where, LINEAR_PROPELLER)
+        return LinearPropellerParams(
+            name=text(propeller_section, "name", where, "linear"),
+            source=text(propeller_section, "source", where, "vehicle file"),
+            **coefficients,
+        )
+    if model != "four_quadrant":
+        raise DataFormatError(f"'{where}.model' must be 'four_quadrant' or 'linear', got {model!r}")
     table = propeller_section.get("table")
     if not isinstance(table, str):
-        raise DataFormatError("missing key 'propeller.table' (packaged name or CSV path)")
-    order = propeller_section.get("order")
-    if order is not None and (not isinstance(order, int) or isinstance(order, bool)):
-        raise DataFormatError(f"'propeller.order' must be an integer, got {order!r}")
-    scaling = scalars(propeller_section, "propeller", PROPELLER)
-    propeller = load_propeller_table(
+        raise DataFormatError(f"missing key '{where}.table' (packaged name or CSV path)")
+    scaling = scalars(propeller_section, where, PROPELLER)
+    return load_propeller_table(
         table,
         diameter=scaling["diameter"],
         c_T=scaling["c_T"],
         c_Q=scaling["c_Q"],
-        order=order,
+        order=integer(propeller_section, "order", where, -(2**31), 2**31, None),
         base_dir=base_dir,
     )
-    motor_section = section(document, "motor")
+
+
+def _parse_motor(motor_section: Mapping[str, object], where: str) -> MotorParams:
     current_model = motor_section.get("current_model", "torque")
     curve_n: FloatArray | None = None
     curve_amps: FloatArray | None = None
     if "current_curve" in motor_section:
-        curve = section(motor_section, "current_curve", "motor")
-        curve_n = vector(curve, "n", "motor.current_curve", CURRENT_CURVE["n"])
-        curve_amps = vector(curve, "current", "motor.current_curve", CURRENT_CURVE["current"])
-    electrics = scalars(motor_section, "motor", MOTOR, {"I_0": 0.0})
-    motor = MotorParams(
+        curve = section(motor_section, "current_curve", where)
+        curve_n = vector(curve, "n", f"{where}.current_curve", CURRENT_CURVE["n"])
+        curve_amps = vector(curve, "current", f"{where}.current_curve", CURRENT_CURVE["current"])
+    electrics = scalars(motor_section, where, MOTOR, {"I_0": 0.0})
+    return MotorParams(
         R_a=electrics["R_a"],
         K_e=electrics["K_e"],
         V_bus=electrics["V_bus"],
@@ -250,30 +182,81 @@ def _parse_vehicle(document: Mapping[str, object], base_dir: Path | None) -> Veh
         current_curve_n=curve_n,
         current_curve_amps=curve_amps,
     )
+
+
+def _parse_thruster(
+    entry: Mapping[str, object], where: str, base_dir: Path | None
+) -> ThrusterParams:
+    reject_unknown(entry, where, {*THRUSTER, "name", "propeller", "motor"})
+    return ThrusterParams(
+        name=text(entry, "name", where),
+        propeller=_parse_propeller(
+            section(entry, "propeller", where), f"{where}.propeller", base_dir
+        ),
+        motor=_parse_motor(section(entry, "motor", where), f"{where}.motor"),
+        **scalars(entry, where, THRUSTER, THRUSTER_DEFAULTS),
+    )
+
+
+def _parse_surface(entry: Mapping[str, object], where: str) -> ControlSurfaceParams:
+    reject_unknown(entry, where, {*SURFACE, "name"})
+    return ControlSurfaceParams(name=text(entry, "name", where), **scalars(entry, where, SURFACE))
+
+
+def _parse_vehicle(
+    document: Mapping[str, object], base_dir: Path | None
+) -> VehicleParams | ActuatedVehicleParams:
+    name = document.get("name")
+    if not isinstance(name, str) or not name:
+        raise DataFormatError("missing key 'name' (a non-empty string) in vehicle file")
+    hull = _parse_hull(document)
     smoothing_section = document.get("smoothing", {})
     if not isinstance(smoothing_section, Mapping):
         raise DataFormatError("'smoothing' must be a table")
     smoothing = scalars(smoothing_section, "smoothing", SMOOTHING, SMOOTHING_DEFAULTS)
-    limits = scalars(propulsion, "propulsion", PROPULSION)
     description = document.get("description", "")
-    return VehicleParams(
-        name=name,
-        hull=hull,
-        propeller=propeller,
-        motor=motor,
-        l=limits["l"],
-        hotel_power=scalar(section(document, "power"), "hotel", "power", HOTEL),
-        n_max=limits["n_max"],
-        w_c=limits["w_c"],
-        eps_inflow=smoothing["inflow"],
-        eps_abs_speed=smoothing["abs_speed"],
-        eps_abs_rate=smoothing["abs_rate"],
-        eps_sign_n=smoothing["sign_n"],
-        description=description if isinstance(description, str) else "",
+    common = {
+        "name": name,
+        "hull": hull,
+        "hotel_power": scalar(section(document, "power"), "hotel", "power", HOTEL),
+        "eps_inflow": smoothing["inflow"],
+        "eps_abs_speed": smoothing["abs_speed"],
+        "eps_abs_rate": smoothing["abs_rate"],
+        "eps_sign_n": smoothing["sign_n"],
+        "description": description if isinstance(description, str) else "",
+    }
+    thrusters = tables(document, "thruster")
+    if not thrusters:  # the twin-thruster shorthand
+        if "control_surface" in document:
+            raise DataFormatError("[[control_surface]] needs [[thruster]] tables in vehicle file")
+        limits = scalars(section(document, "propulsion"), "propulsion", PROPULSION)
+        return VehicleParams(
+            propeller=_parse_propeller(section(document, "propeller"), "propeller", base_dir),
+            motor=_parse_motor(section(document, "motor"), "motor"),
+            l=limits["l"],
+            n_max=limits["n_max"],
+            w_c=limits["w_c"],
+            **common,  # type: ignore[arg-type]  # the types of common are checked above
+        )
+    for shorthand in ("propulsion", "propeller", "motor"):
+        if shorthand in document:
+            raise DataFormatError(
+                f"'[{shorthand}]' belongs to the twin-thruster shorthand; with [[thruster]] "
+                "tables give it inside each thruster"
+            )
+    return ActuatedVehicleParams(
+        thrusters=tuple(
+            _parse_thruster(entry, f"thruster[{k}]", base_dir) for k, entry in enumerate(thrusters)
+        ),
+        surfaces=tuple(
+            _parse_surface(entry, f"control_surface[{k}]")
+            for k, entry in enumerate(tables(document, "control_surface"))
+        ),
+        **common,  # type: ignore[arg-type]  # the types of common are checked above
     )
 
 
-def load_vehicle(type_or_path: str | Path) -> VehicleParams:
+def load_vehicle(type_or_path: str | Path) -> VehicleParams | ActuatedVehicleParams:
     """Load a vehicle type: a packaged name (``"medusa"``) or the path of a TOML file.
 
     Parameters
@@ -283,8 +266,9 @@ def load_vehicle(type_or_path: str | Path) -> VehicleParams:
 
     Returns
     -------
-    VehicleParams
-        Validated parameters in SI units (propeller speeds in rev/s).
+    VehicleParams or ActuatedVehicleParams
+        Validated parameters in SI units (propeller speeds in rev/s): the twin-thruster
+        shorthand or the actuator list, as the file gives them.
 
     Raises
     ------

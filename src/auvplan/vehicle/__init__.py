@@ -1,18 +1,27 @@
-"""Vehicle models: MEDUSA 3-DOF dynamics, four-quadrant propellers, DC motors, simulation, trim.
+"""Vehicle models: planar 3-DOF dynamics, actuators, propellers, motors, simulation, trim.
+
+A vehicle is a hull and a list of actuators: thrusters (four-quadrant or linear propellers
+driven by DC motors) and control surfaces.
 
 Typical use::
 
     from auvplan.io.vehicles import load_vehicle
     from auvplan.vehicle import build_vehicle_model, rk4_simulate, trim_surge
 
-    model = build_vehicle_model(load_vehicle("medusa"))
-    model.dynamics(x, c)      # casadi.Function f(x[8], c[2]) -> xdot[8]
+    model = build_vehicle_model(load_vehicle("medusa"))   # or "remus100", or a vehicle file
+    model.dynamics(x, c)      # casadi.Function f(x[n_x], c[n_u]) -> xdot[n_x]
     model.power(x, c)         # electrical power incl. hotel load [W]
     n, power = trim_surge(model, 1.0)
 """
 
 from __future__ import annotations
 
+from auvplan.vehicle.actuators import (
+    ActuatedVehicleParams,
+    ControlSurfaceParams,
+    ThrusterParams,
+    actuated_vehicle,
+)
 from auvplan.vehicle.approximation import (
     ApproximationError,
     SmoothingEffect,
@@ -36,7 +45,15 @@ from auvplan.vehicle.limits import (
     minimum_useful_speed,
     regulator_floor,
 )
-from auvplan.vehicle.params import HullParams, MotorParams, PropellerParams, VehicleParams
+from auvplan.vehicle.operating import ActuatorRoles, actuator_roles, operating_state
+from auvplan.vehicle.params import (
+    CrossFlowParams,
+    HullParams,
+    LinearPropellerParams,
+    MotorParams,
+    PropellerParams,
+    VehicleParams,
+)
 from auvplan.vehicle.propulsion import (
     open_water_thrust_torque,
     thrust_coefficient,
@@ -60,6 +77,7 @@ from auvplan.vehicle.trim import (
     BollardPull,
     CruiseOptimum,
     SteadyMotion,
+    SteadyTurn,
     SurgeTrim,
     TurnTrim,
     VehicleCharacteristics,
@@ -68,6 +86,8 @@ from auvplan.vehicle.trim import (
     max_yaw_rate,
     optimal_cruise_speed,
     steady_motion,
+    steady_turn,
+    tightest_turn,
     top_speed,
     trim_surge,
     trim_turn,
@@ -80,21 +100,30 @@ __all__ = [
     "N_STATES",
     "STATE_NAMES",
     "STATE_UNITS",
+    "ActuatedVehicleParams",
+    "ActuatorRoles",
     "AdaptiveSimulation",
     "ApproximationError",
     "BollardPull",
+    "ControlSurfaceParams",
+    "CrossFlowParams",
     "CruiseOptimum",
     "HullParams",
+    "LinearPropellerParams",
     "MotorParams",
     "PropellerParams",
     "SimulationStatus",
     "SmoothingEffect",
     "SteadyMotion",
+    "SteadyTurn",
     "SurgeTrim",
+    "ThrusterParams",
     "TurnTrim",
     "VehicleCharacteristics",
     "VehicleModel",
     "VehicleParams",
+    "actuated_vehicle",
+    "actuator_roles",
     "approximation_error_table",
     "bollard",
     "build_vehicle_model",
@@ -107,6 +136,7 @@ __all__ = [
     "max_yaw_rate",
     "minimum_useful_speed",
     "open_water_thrust_torque",
+    "operating_state",
     "optimal_cruise_speed",
     "positions",
     "reference_states",
@@ -117,8 +147,10 @@ __all__ = [
     "smoothing_effect",
     "stable_rk4_step",
     "steady_motion",
+    "steady_turn",
     "surge_trim_table",
     "thrust_coefficient",
+    "tightest_turn",
     "top_speed",
     "torque_coefficient",
     "trim_surge",

@@ -20,8 +20,11 @@ from typing import Final
 
 import numpy as np
 
+from auvplan.errors import InputError
+from auvplan.vehicle.actuators import ActuatedVehicleParams
 from auvplan.vehicle.dynamics import VehicleModel, build_vehicle_model
-from auvplan.vehicle.params import VehicleParams
+from auvplan.vehicle.operating import actuator_roles, operating_state
+from auvplan.vehicle.params import PropellerParams, VehicleParams
 from auvplan.vehicle.propulsion import thrust_coefficient, torque_coefficient
 from auvplan.vehicle.trim import bollard, trim_surge
 
@@ -71,18 +74,21 @@ class SmoothingEffect:
 
 
 def _propulsion_power(model: VehicleModel, speed: float) -> float:
-    return trim_surge(model, speed).power - model.params.hotel_power
+    return trim_surge(model, speed).power - model.vehicle.hotel_power
 
 
 def approximation_error_table(
-    params: VehicleParams, orders: Sequence[int] = DEFAULT_ORDERS, *, n_beta: int = 7200
+    params: VehicleParams | ActuatedVehicleParams,
+    orders: Sequence[int] = DEFAULT_ORDERS,
+    *,
+    n_beta: int = 7200,
 ) -> tuple[ApproximationError, ...]:
     """Tabulate the error of truncated propeller series against the full series.
 
     Parameters
     ----------
-    params : VehicleParams
-        Vehicle (its propeller table is the reference at full order).
+    params : VehicleParams or ActuatedVehicleParams
+        Vehicle (its first propeller's four-quadrant table is the reference at full order).
     orders : sequence of int
         Orders ``K`` to tabulate.
     n_beta : int
@@ -93,6 +99,11 @@ def approximation_error_table(
     tuple of ApproximationError
         One row per order.
 
+    Raises
+    ------
+    InputError
+        If the first propeller has no four-quadrant series.
+
     Examples
     --------
     >>> from auvplan.io.vehicles import load_vehicle
@@ -101,6 +112,8 @@ def approximation_error_table(
     (0.093, 0.253)
     """
     propeller = params.propeller
+    if not isinstance(propeller, PropellerParams):
+        raise InputError(f"propeller {propeller.name!r} has no four-quadrant series to truncate")
     beta = np.linspace(-np.pi, np.pi, n_beta, endpoint=False)
     full_order = propeller.max_order
     reference_t = thrust_coefficient(beta, propeller, order=full_order)
@@ -132,7 +145,7 @@ def approximation_error_table(
     return tuple(rows)
 
 
-def smoothing_effect(params: VehicleParams) -> tuple[SmoothingEffect, ...]:
+def smoothing_effect(params: VehicleParams | ActuatedVehicleParams) -> tuple[SmoothingEffect, ...]:
     """Relative effect of the smoothing constants at bollard and at the cruise speeds.
 
     Compares the model built from ``params`` with the same model whose four smoothing
@@ -160,13 +173,14 @@ def smoothing_effect(params: VehicleParams) -> tuple[SmoothingEffect, ...]:
     )
     smooth_model = build_vehicle_model(params)
     sharp_model = build_vehicle_model(sharp)
-    n_max = params.n_max
-    bollard_state = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, n_max, n_max])
+    bollard_state = operating_state(
+        smooth_model, throttle=actuator_roles(smooth_model).throttle_max
+    )
     rows = [_effect_at("bollard", bollard_state, smooth_model, sharp_model)]
     for speed in CRUISE_SPEEDS:
         # same state (the sharp model's trim) for thrust/torque; each model's own trim for power
         n = trim_surge(sharp_model, speed).n
-        state = np.array([0.0, 0.0, 0.0, speed, 0.0, 0.0, n, n])
+        state = operating_state(smooth_model, u=speed, throttle=n)
         row = _effect_at(f"cruise {speed} m/s", state, smooth_model, sharp_model)
         power = _propulsion_power(smooth_model, speed) / _propulsion_power(sharp_model, speed)
         rows.append(dataclasses.replace(row, power=power - 1.0))
@@ -176,10 +190,13 @@ def smoothing_effect(params: VehicleParams) -> tuple[SmoothingEffect, ...]:
 def _effect_at(
     condition: str, state: np.ndarray, smooth: VehicleModel, sharp: VehicleModel
 ) -> SmoothingEffect:
-    t_smooth, _, q_smooth, _ = (float(v) for v in smooth.thrust_torque(state))
-    t_sharp, _, q_sharp, _ = (float(v) for v in sharp.thrust_torque(state))
+    first_torque = len(smooth.vehicle.thrusters)  # outputs: thrusts, then torques
+    smooth_out = [float(v) for v in smooth.thrust_torque(state)]
+    sharp_out = [float(v) for v in sharp.thrust_torque(state)]
+    t_smooth, q_smooth = smooth_out[0], smooth_out[first_torque]
+    t_sharp, q_sharp = sharp_out[0], sharp_out[first_torque]
     zero = np.zeros(smooth.n_u)
-    hotel = smooth.params.hotel_power
+    hotel = smooth.vehicle.hotel_power
     p_smooth = float(smooth.power(state, zero)) - hotel
     p_sharp = float(sharp.power(state, zero)) - hotel
     return SmoothingEffect(

@@ -1,26 +1,33 @@
-"""Planar 3-DOF MEDUSA dynamics as CasADi functions (exact derivatives of any order).
+"""Planar 3-DOF vehicle dynamics as CasADi functions (exact derivatives of any order).
 
-State ``x = (north, east, ψ, u, v, r, n_ps, n_sb)`` [m, m, rad, m/s, m/s, rad/s, rev/s, rev/s],
-input ``c = (c_ps, c_sb)`` [-]::
+State ``x = (north, east, ψ, u, v, r, n_<thruster>…, delta_<surface>…)`` [m, m, rad, m/s,
+m/s, rad/s, rev/s…, rad…], input ``c = (c_<thruster>…, c_<surface>…)`` [-], the actuators in
+the order of :class:`auvplan.vehicle.actuators.ActuatedVehicleParams`::
 
     η̇ = R(ψ) ν,                 R(ψ) = [[cψ, -sψ, 0], [sψ, cψ, 0], [0, 0, 1]]
-    M ν̇ + C(ν) ν + (D + D_n(ν)) ν = τ
+    M ν̇ + C(ν) ν + (D(ν) + D_n(ν)) ν = τ_thrusters + τ_surfaces + τ_crossflow
     M = M_RB + M_A = diag(m - X_u̇, m - Y_v̇, I_z - N_ṙ)
-    C(ν) = C_RB(ν) + C_A(ν) = [[0, 0, -m_v v], [0, 0, m_u u], [m_v v, -m_u u, 0]]
-    D = -diag(X_u, Y_v, N_r),   D_n = -diag(X_|u|u |u|_ε, Y_|v|v |v|_ε, N_|r|r |r|_ε)
-    τ = (T_ps + T_sb, 0, l (T_ps - T_sb))    (port surplus turns the bow to starboard, r > 0)
-    v_a,ps = u + l r,  v_a,sb = u - l r     (thrusters at y = ∓l)
-    ṅ = w_c tanh(c)
+    C(ν) = [[0, 0, -m_v v], [0, 0, m_u u], [m_v v, -m_u u, 0]]   (C_RB + C_A; m_u = m_v = m
+                                                                  when C_A is left out)
+    D = -diag(X_u f, Y_v f, N_r),  f = exp(-κ U),  U = sqrt(u² + v² + ε²)
+    D_n = -diag(X_|u|u |u|_ε, Y_|v|v |v|_ε, N_|r|r |r|_ε)
+    thruster i at (x, y), axis α:  v_a = (1 - w) (cα (u - y r) + sα (v + x r)),
+                                   τ_i = (1 - t) T_i (cα, sα, x sα - y cα)
+    surface j at (x, y):           q = ½ρ(u² + v²)A,  Y = -q C_Lδ δ,  X = -q C_Dδ δ²,
+                                   τ_j = (X, Y, x Y - y X)
+    ṅ_i = w_c,i tanh(c_i),  δ̇_j = w_δ,j tanh(c_j)
 
-``|s|_ε = sqrt(s² + ε²)`` replaces ``|s|`` and the propellers use the smooth four-quadrant form
-of :mod:`auvplan.vehicle.propulsion`, so ``f`` is C^∞ everywhere, including at rest.
+For the twin-thruster MEDUSA layout (``y = ∓l``) this is ``τ = (T_ps + T_sb, 0, l (T_ps -
+T_sb))`` with ``v_a,ps = u + l r``, ``v_a,sb = u - l r``: port surplus turns the bow to
+starboard (r > 0). ``|s|_ε = sqrt(s² + ε²)`` replaces ``|s|`` and the propellers use the smooth
+forms of :mod:`auvplan.vehicle.propulsion`, so ``f`` is C^∞ everywhere, including at rest.
 
 Electrical power (SPEC §4): ``P = Σ_i R_a I_i² + K_e ω_i I_i + P_b``, ``ω_i = 2π n_i``.
 
 References
 ----------
 .. [1] T. I. Fossen, *Handbook of Marine Craft Hydrodynamics and Motion Control*, 2nd ed.,
-   Wiley 2021, eqs. 2.40, 6.43-6.46, 6.60.
+   Wiley 2021, eqs. 2.40, 6.43-6.46, 6.60, ch. 9.
 .. [2] A. J. Häusler et al., OCEANS 2013, Sec. II-B (eqs. 1-8), II-C.
 """
 
@@ -34,19 +41,29 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
-from auvplan.vehicle.params import VehicleParams
+from auvplan.vehicle._forces import (
+    advance_speed,
+    crossflow_force,
+    hull_damping,
+    surface_force,
+    thruster_force,
+)
+from auvplan.vehicle.actuators import ActuatedVehicleParams, actuated_vehicle
+from auvplan.vehicle.params import PropellerParams, VehicleParams
 from auvplan.vehicle.propulsion import (
     motor_current_expression,
     motor_power_expression,
     resolve_order,
-    smooth_thrust_torque_expression,
+    thrust_torque_expression,
 )
 
-#: Names of the 8 states, in order.
-STATE_NAMES: Final = ("north", "east", "psi", "u", "v", "r", "n_ps", "n_sb")
-#: Units of the 8 states, in order.
+#: Names of the pose and body-velocity states every vehicle starts with, in order.
+BODY_STATE_NAMES: Final = ("north", "east", "psi", "u", "v", "r")
+#: Names of the 8 states of the twin-thruster (MEDUSA) layout, in order.
+STATE_NAMES: Final = (*BODY_STATE_NAMES, "n_ps", "n_sb")
+#: Units of the 8 states of the twin-thruster layout, in order.
 STATE_UNITS: Final = ("m", "m", "rad", "m/s", "m/s", "rad/s", "rev/s", "rev/s")
-#: Names of the 2 inputs, in order (dimensionless propeller-acceleration commands).
+#: Names of the 2 inputs of the twin-thruster layout (dimensionless propeller commands).
 INPUT_NAMES: Final = ("c_ps", "c_sb")
 N_STATES: Final = 8
 N_INPUTS: Final = 2
@@ -60,21 +77,23 @@ class VehicleModel:
     graphs (RK4 steps, fleets) and differentiated to any order.
     """
 
-    params: VehicleParams
-    """The parameter set the functions were built from."""
+    params: VehicleParams | ActuatedVehicleParams
+    """The parameter set the functions were built from (as loaded)."""
+    vehicle: ActuatedVehicleParams
+    """The same vehicle as a hull and a list of actuators (the twin shorthand expanded)."""
     propeller_order: int
-    """Harmonics of ``C_T*``, ``C_Q*`` used [-]."""
+    """Harmonics of the four-quadrant ``C_T*``, ``C_Q*`` used (0 without such propellers) [-]."""
     dynamics: ca.Function
-    """``f(x[8], c[2]) -> xdot[8]``, named ``"f"``."""
+    """``f(x[n_x], c[n_u]) -> xdot[n_x]``, named ``"f"``."""
     power: ca.Function
-    """``P(x[8], c[2]) -> P`` electrical power of both motors plus hotel load [W]."""
+    """``P(x, c) -> P`` electrical power of all motors plus hotel load [W]."""
     thrust_torque: ca.Function
-    """``(x[8]) -> (T_ps, T_sb, Q_ps, Q_sb)`` [N, N, N m, N m]."""
+    """``(x) -> (T_<thruster>…, Q_<thruster>…)`` [N…, N m…]."""
     current: ca.Function
-    """``(x[8]) -> (I_ps, I_sb)`` motor currents [A]."""
-    state_names: tuple[str, ...] = STATE_NAMES
-    """Names of the states, in order (the first three are the pose ``north, east, psi``)."""
-    input_names: tuple[str, ...] = INPUT_NAMES
+    """``(x) -> (I_<thruster>…)`` motor currents [A]."""
+    state_names: tuple[str, ...]
+    """Names of the states, in order (the first six are ``north, east, psi, u, v, r``)."""
+    input_names: tuple[str, ...]
     """Names of the inputs, in order."""
 
     @property
@@ -99,28 +118,60 @@ class VehicleModel:
         return self.state_names.index(name)
 
     @property
+    def thruster_states(self) -> tuple[str, ...]:
+        """Names of the propeller-speed states ``n_<thruster>``, in state order [-]."""
+        return tuple(thruster.state_name for thruster in self.vehicle.thrusters)
+
+    @property
+    def surface_states(self) -> tuple[str, ...]:
+        """Names of the control-surface deflection states ``delta_<surface>`` [-]."""
+        return tuple(surface.state_name for surface in self.vehicle.surfaces)
+
+    @property
+    def state_units(self) -> tuple[str, ...]:
+        """Units of the states, in order.
+
+        Examples
+        --------
+        >>> from auvplan.io.vehicles import load_vehicle
+        >>> build_vehicle_model(load_vehicle("remus100")).state_units[6:]
+        ('rev/s', 'rad')
+        """
+        return (
+            *STATE_UNITS[: len(BODY_STATE_NAMES)],
+            *("rev/s" for _ in self.vehicle.thrusters),
+            *("rad" for _ in self.vehicle.surfaces),
+        )
+
+    @property
     def state_limits(self) -> tuple[tuple[str, float], ...]:
-        """States with a symmetric bound ``|x| <= limit``: the propeller speeds [rev/s]."""
-        return (("n_ps", self.params.n_max), ("n_sb", self.params.n_max))
+        """States with a symmetric bound ``|x| <= limit``, in state order.
+
+        Propeller speeds [rev/s] and control-surface deflections [rad].
+        """
+        return tuple(
+            [(thruster.state_name, thruster.n_max) for thruster in self.vehicle.thrusters]
+            + [(surface.state_name, surface.delta_max) for surface in self.vehicle.surfaces]
+        )
 
 
-def _smooth_abs(value: ca.SX, eps: float) -> ca.SX:
-    return ca.sqrt(value**2 + eps**2)
+def _propeller_order(vehicle: ActuatedVehicleParams, order: int | None) -> tuple[int, ...]:
+    return tuple(resolve_order(thruster.propeller, order) for thruster in vehicle.thrusters)
 
 
 def build_vehicle_model(
-    params: VehicleParams, *, propeller_order: int | None = None
+    params: VehicleParams | ActuatedVehicleParams, *, propeller_order: int | None = None
 ) -> VehicleModel:
     """Build the CasADi dynamics, power and thrust functions of one vehicle.
 
     Parameters
     ----------
-    params : VehicleParams
-        Vehicle type.
+    params : VehicleParams or ActuatedVehicleParams
+        Vehicle type (the twin shorthand or any actuator layout).
     propeller_order : int, optional
-        Harmonics of the four-quadrant series; ``None`` uses ``params.propeller.order`` or
-        the full table (order 30 for the Roddy series). A small integer gives the low-order
-        (truncated, least-squares optimal) approximation.
+        Harmonics of the four-quadrant series; ``None`` uses ``propeller.order`` or the full
+        table (order 30 for the Roddy series). A small integer gives the low-order (truncated,
+        least-squares optimal) approximation. Propellers without harmonics accept only 0.
 
     Returns
     -------
@@ -139,71 +190,98 @@ def build_vehicle_model(
     >>> xdot.shape, round(float(xdot[0]), 6)
     ((8, 1), 1.0)
     """
-    order = resolve_order(params.propeller, propeller_order)
-    hull = params.hull
-    x = ca.SX.sym("x", N_STATES)
-    c = ca.SX.sym("c", N_INPUTS)
-    psi, u, v, r, n_ps, n_sb = x[2], x[3], x[4], x[5], x[6], x[7]
-
-    thrust_ps, torque_ps = smooth_thrust_torque_expression(
-        u + params.l * r,
-        n_ps,
-        params.propeller,
-        hull.rho,
-        order=order,
-        eps_inflow=params.eps_inflow,
+    vehicle = actuated_vehicle(params)
+    orders = _propeller_order(vehicle, propeller_order)
+    hull = vehicle.hull
+    thrusters, surfaces = vehicle.thrusters, vehicle.surfaces
+    state_names = (
+        *BODY_STATE_NAMES,
+        *(thruster.state_name for thruster in thrusters),
+        *(surface.state_name for surface in surfaces),
     )
-    thrust_sb, torque_sb = smooth_thrust_torque_expression(
-        u - params.l * r,
-        n_sb,
-        params.propeller,
-        hull.rho,
-        order=order,
-        eps_inflow=params.eps_inflow,
+    input_names = (
+        *(thruster.input_name for thruster in thrusters),
+        *(surface.input_name for surface in surfaces),
     )
-    tau = ca.vertcat(thrust_ps + thrust_sb, 0.0, params.l * (thrust_ps - thrust_sb))
+    x = ca.SX.sym("x", len(state_names))
+    c = ca.SX.sym("c", len(input_names))
+    psi, nu = x[2], x[3:6]
+    speeds = [x[6 + i] for i in range(len(thrusters))]
+    deflections = [x[6 + len(thrusters) + j] for j in range(len(surfaces))]
 
-    m_u, m_v, m_r = hull.m_u, hull.m_v, hull.m_r
-    nu = ca.vertcat(u, v, r)
+    thrusts, torques = [], []
+    for thruster, n, order in zip(thrusters, speeds, orders, strict=True):
+        thrust, torque = thrust_torque_expression(
+            advance_speed(thruster, nu),
+            n,
+            thruster.propeller,
+            hull.rho,
+            order=order,
+            eps_inflow=vehicle.eps_inflow,
+            eps_n=vehicle.eps_sign_n,
+        )
+        thrusts.append(thrust)
+        torques.append(torque)
+    forces = [thruster_force(t, thrust) for t, thrust in zip(thrusters, thrusts, strict=True)]
+    tau = ca.vertcat(*(sum(component[k] for component in forces) for k in range(3)))
+    for surface, delta in zip(surfaces, deflections, strict=True):
+        tau += surface_force(surface, hull.rho, nu, delta)
+    tau += crossflow_force(hull, vehicle.eps_abs_speed, nu)
+
+    m_u, m_v = hull.coriolis_masses
+    u, v = nu[0], nu[1]
     coriolis = ca.vertcat(
         ca.horzcat(0.0, 0.0, -m_v * v),
         ca.horzcat(0.0, 0.0, m_u * u),
         ca.horzcat(m_v * v, -m_u * u, 0.0),
     )
-    damping = ca.vertcat(
-        -hull.X_u - hull.X_uu * _smooth_abs(u, params.eps_abs_speed),
-        -hull.Y_v - hull.Y_vv * _smooth_abs(v, params.eps_abs_speed),
-        -hull.N_r - hull.N_rr * _smooth_abs(r, params.eps_abs_rate),
+    damping = hull_damping(hull, vehicle, nu)
+    nu_dot = (tau - ca.mtimes(coriolis, nu) - damping * nu) / ca.vertcat(
+        hull.m_u, hull.m_v, hull.m_r
     )
-    nu_dot = (tau - ca.mtimes(coriolis, nu) - damping * nu) / ca.vertcat(m_u, m_v, m_r)
-    eta_dot = ca.vertcat(u * ca.cos(psi) - v * ca.sin(psi), u * ca.sin(psi) + v * ca.cos(psi), r)
-    n_dot = params.w_c * ca.tanh(c)
-    xdot = ca.vertcat(eta_dot, nu_dot, n_dot)
+    eta_dot = ca.vertcat(
+        u * ca.cos(psi) - v * ca.sin(psi), u * ca.sin(psi) + v * ca.cos(psi), nu[2]
+    )
+    rates = [
+        actuator_rate * ca.tanh(c[k])
+        for k, actuator_rate in enumerate(
+            [t.w_c for t in thrusters] + [s.rate_max for s in surfaces]
+        )
+    ]
+    xdot = ca.vertcat(eta_dot, nu_dot, *rates)
 
-    current_ps = motor_current_expression(
-        torque_ps, n_ps, params.motor, eps_sign_n=params.eps_sign_n
+    currents = [
+        motor_current_expression(torque, n, thruster.motor, eps_sign_n=vehicle.eps_sign_n)
+        for thruster, torque, n in zip(thrusters, torques, speeds, strict=True)
+    ]
+    power = vehicle.hotel_power + sum(
+        motor_power_expression(current, n, thruster.motor)
+        for thruster, current, n in zip(thrusters, currents, speeds, strict=True)
     )
-    current_sb = motor_current_expression(
-        torque_sb, n_sb, params.motor, eps_sign_n=params.eps_sign_n
-    )
-    power = (
-        motor_power_expression(current_ps, n_ps, params.motor)
-        + motor_power_expression(current_sb, n_sb, params.motor)
-        + params.hotel_power
-    )
+    names = [thruster.name for thruster in thrusters]
     return VehicleModel(
         params=params,
-        propeller_order=order,
+        vehicle=vehicle,
+        propeller_order=next(
+            (
+                k
+                for t, k in zip(thrusters, orders, strict=True)
+                if isinstance(t.propeller, PropellerParams)
+            ),
+            0,
+        ),
         dynamics=ca.Function("f", [x, c], [xdot], ["x", "c"], ["xdot"]),
         power=ca.Function("power", [x, c], [power], ["x", "c"], ["P"]),
         thrust_torque=ca.Function(
             "thrust_torque",
             [x],
-            [thrust_ps, thrust_sb, torque_ps, torque_sb],
+            [*thrusts, *torques],
             ["x"],
-            ["T_ps", "T_sb", "Q_ps", "Q_sb"],
+            [*(f"T_{name}" for name in names), *(f"Q_{name}" for name in names)],
         ),
-        current=ca.Function("current", [x], [current_ps, current_sb], ["x"], ["I_ps", "I_sb"]),
+        current=ca.Function("current", [x], currents, ["x"], [f"I_{name}" for name in names]),
+        state_names=state_names,
+        input_names=input_names,
     )
 
 
@@ -224,16 +302,16 @@ def vessel_dynamics(states: FloatArray, inputs: FloatArray, model: VehicleModel)
 
     Parameters
     ----------
-    states : ndarray of shape (n_t, 8)
+    states : ndarray of shape (n_t, n_x)
         States (SI units, rev/s for the propellers).
-    inputs : ndarray of shape (n_t, 2)
+    inputs : ndarray of shape (n_t, n_u)
         Inputs ``c`` [-].
     model : VehicleModel
         Model from :func:`build_vehicle_model`.
 
     Returns
     -------
-    ndarray of shape (n_t, 8)
+    ndarray of shape (n_t, n_x)
         State derivatives.
 
     Raises
@@ -259,9 +337,9 @@ def electrical_power(states: FloatArray, inputs: FloatArray, model: VehicleModel
 
     Parameters
     ----------
-    states : ndarray of shape (n_t, 8)
+    states : ndarray of shape (n_t, n_x)
         States.
-    inputs : ndarray of shape (n_t, 2)
+    inputs : ndarray of shape (n_t, n_u)
         Inputs (the power does not depend on them; kept for the optimiser's signature).
     model : VehicleModel
         Model.
@@ -295,9 +373,9 @@ def energy(time: FloatArray, states: FloatArray, inputs: FloatArray, model: Vehi
     ----------
     time : ndarray of shape (n_t,)
         Strictly increasing times [s].
-    states : ndarray of shape (n_t, 8)
+    states : ndarray of shape (n_t, n_x)
         States.
-    inputs : ndarray of shape (n_t, 2)
+    inputs : ndarray of shape (n_t, n_u)
         Inputs.
     model : VehicleModel
         Model.

@@ -7,9 +7,9 @@ is flyable):
   most ``USEFUL_ENERGY_FACTOR`` times the optimum cruise's: below it the hotel load ``P_b/u``
   dominates and creeping costs more than waiting still; also the speed at which the propellers
   still have a controllable thrust derivative (``∂T/∂n ∝ |n|`` vanishes at rest);
-- **maximum surge acceleration** — ``ACCELERATION_SHARE`` of the bollard thrust of all
-  propellers over the surge mass ``m − X_u̇``, keeping the rest for steering and disturbance
-  rejection.
+- **maximum surge acceleration** — ``ACCELERATION_SHARE`` of the acceleration from rest with
+  every forward-pushing propeller at ``n_max`` (their bollard force over the surge mass
+  ``m − X_u̇``), keeping the rest for steering and disturbance rejection.
 """
 
 from __future__ import annotations
@@ -17,10 +17,12 @@ from __future__ import annotations
 from functools import cache
 from typing import Final
 
+import numpy as np
 from scipy.optimize import brentq
 
 from auvplan.vehicle.dynamics import VehicleModel
-from auvplan.vehicle.trim import bollard, energy_per_metre, optimal_cruise_speed, trim_surge
+from auvplan.vehicle.operating import actuator_roles, operating_state
+from auvplan.vehicle.trim import energy_per_metre, optimal_cruise_speed, trim_surge
 
 #: Energy per metre, relative to the optimum cruise, still counted as useful motion.
 USEFUL_ENERGY_FACTOR: Final = 2.0
@@ -54,8 +56,9 @@ def minimum_useful_speed(model: VehicleModel) -> float:
 def regulator_floor(model: VehicleModel) -> dict[str, float]:
     """Smallest state magnitudes the tracking regulator is designed at, by state name.
 
-    The propeller speeds are floored at the steady-surge trim of the minimum useful speed:
-    at rest ``∂T/∂n = 0`` and a regulator designed there would invert a vanishing coupling.
+    The speeds of the forward-pushing propellers are floored at the steady-surge trim of the
+    minimum useful speed: at rest ``∂T/∂n = 0`` and a regulator designed there would invert a
+    vanishing coupling. Other actuators are not floored.
 
     Examples
     --------
@@ -66,12 +69,21 @@ def regulator_floor(model: VehicleModel) -> dict[str, float]:
     (['n_ps', 'n_sb'], True)
     """
     propeller = trim_surge(model, minimum_useful_speed(model)).n
-    return {name: propeller for name, _ in model.state_limits}
+    thrusters = model.vehicle.thrusters
+    throttle = actuator_roles(model).throttle[: len(thrusters)]
+    return {
+        thruster.state_name: propeller
+        for thruster, driven in zip(thrusters, throttle, strict=True)
+        if driven
+    }
 
 
 @cache
 def max_surge_acceleration(model: VehicleModel) -> float:
-    """``ACCELERATION_SHARE`` × bollard thrust of both propellers / ``(m − X_u̇)`` [m/s²].
+    """``ACCELERATION_SHARE`` × surge acceleration from rest at full throttle [m/s²].
+
+    The acceleration is ``u̇`` of the model at rest with every forward-pushing propeller at
+    ``n_max``: their bollard force along x over ``m − X_u̇``.
 
     Examples
     --------
@@ -80,8 +92,9 @@ def max_surge_acceleration(model: VehicleModel) -> float:
     >>> 0.5 < max_surge_acceleration(build_vehicle_model(load_vehicle("medusa"))) < 5.0
     True
     """
-    n_propellers = len(model.state_limits)  # one limited speed state per propeller
-    return ACCELERATION_SHARE * n_propellers * bollard(model).thrust / model.params.hull.m_u
+    state = operating_state(model, throttle=actuator_roles(model).throttle_max)
+    xdot = np.asarray(model.dynamics(state, np.zeros(model.n_u)), dtype=np.float64).ravel()
+    return ACCELERATION_SHARE * float(xdot[model.index("u")])
 
 
 __all__ = [

@@ -1,8 +1,10 @@
-"""Typed, immutable parameter sets of a planar two-thruster vehicle (MEDUSA class).
+"""Typed, immutable parameter sets of a planar vehicle: hull, propellers, motors.
 
 A vehicle type is data (a TOML file read by :func:`auvplan.io.load_vehicle`); this module
 only holds the validated numbers. Every field states its unit; signs follow Fossen (2021):
-added-mass and damping derivatives are negative.
+added-mass and damping derivatives are negative. :class:`VehicleParams` is the twin-thruster
+shorthand (MEDUSA class); any other layout of thrusters and control surfaces is an
+:class:`auvplan.vehicle.actuators.ActuatedVehicleParams`.
 
 References
 ----------
@@ -16,7 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Final, Literal
+from typing import Final, Literal, Protocol
 
 import numpy as np
 
@@ -53,12 +55,49 @@ def _frozen_vector(name: str, values: FloatArray | list[float] | tuple[float, ..
 
 
 @dataclass(frozen=True)
+class CrossFlowParams:
+    """Cross-flow drag of a slender hull by strip theory (Fossen 2021, sec. 6.7).
+
+    ``Y = -½ρ H C_d Δx Σ_k |v + x_k r| (v + x_k r)``, ``N = -½ρ H C_d Δx Σ_k x_k |…| (…)``
+    over the stations ``x_k = -L/2 + k Δx``, ``k = 0..n``, ``Δx = L/n``: the ``n + 1``
+    stations of width ``Δx`` of Fossen's ``crossFlowDrag`` (the end stations count in full,
+    as in the calibration of the models that use it).
+    """
+
+    length: float
+    """Hull length ``L`` [m]."""
+    height: float
+    """Projected height (draft) ``H`` of the hull seen from the side [m]."""
+    drag_coefficient: float
+    """Two-dimensional cross-flow drag coefficient ``C_d`` (Hoerner's curve) [-]."""
+    strips: int
+    """Number of strips ``n`` (``n + 1`` stations) [-]."""
+
+    def __post_init__(self) -> None:
+        for name in ("length", "height", "drag_coefficient"):
+            _finite(f"crossflow.{name}", getattr(self, name), positive=True)
+        if isinstance(self.strips, bool) or not isinstance(self.strips, int) or self.strips < 1:
+            raise InputError(
+                f"vehicle parameter crossflow.strips must be an integer >= 1, got {self.strips!r}"
+            )
+
+    @property
+    def stations(self) -> FloatArray:
+        """Station positions ``x_k`` along the hull, shape ``(n + 1,)`` [m]."""
+        return np.asarray(
+            -0.5 * self.length + self.length / self.strips * np.arange(self.strips + 1),
+            dtype=np.float64,
+        )
+
+
+@dataclass(frozen=True)
 class HullParams:
     """Rigid-body, added-mass and damping coefficients of the planar (surge, sway, yaw) model.
 
     Fossen's notation: ``M = diag(m - X_udot, m - Y_vdot, I_z - N_rdot)``,
-    ``D = -diag(X_u, Y_v, N_r)``, ``D_n(ν) = -diag(X_uu |u|, Y_vv |v|, N_rr |r|)``.
-    The centre of gravity is at the body origin (``x_g = 0``).
+    ``D = -diag(X_u f(U), Y_v f(U), N_r)`` with ``f(U) = exp(-κ U)`` (``κ = 0``: constant),
+    ``D_n(ν) = -diag(X_uu |u|, Y_vv |v|, N_rr |r|)``, plus the optional strip-theory
+    cross-flow drag. The centre of gravity is at the body origin (``x_g = 0``).
     """
 
     m: float
@@ -85,10 +124,17 @@ class HullParams:
     """Quadratic yaw damping ``N_|r|r`` [kg m²] (≤ 0)."""
     rho: float
     """Water density [kg/m³]."""
+    linear_damping_fade: float = 0.0
+    """``κ`` of ``exp(-κ U)`` scaling ``X_u`` and ``Y_v`` with the speed ``U`` [s/m]."""
+    added_mass_coriolis: bool = True
+    """Whether ``C_A(ν)`` (with the Munk moment) is in the model; else ``C = C_RB`` [-]."""
+    crossflow: CrossFlowParams | None = None
+    """Strip-theory cross-flow drag, added to the diagonal damping [units per field]."""
 
     def __post_init__(self) -> None:
         for name in ("m", "I_z", "rho"):
             _finite(name, getattr(self, name), positive=True)
+        _finite("linear_damping_fade", self.linear_damping_fade, nonnegative=True)
         for name in ("X_udot", "Y_vdot", "N_rdot", "X_u", "Y_v", "N_r", "X_uu", "Y_vv", "N_rr"):
             value = getattr(self, name)
             _finite(name, value)
@@ -111,6 +157,13 @@ class HullParams:
     def m_r(self) -> float:
         """Yaw inertia ``I_z - N_rdot`` [kg m²]."""
         return self.I_z - self.N_rdot
+
+    @property
+    def coriolis_masses(self) -> tuple[float, float]:
+        """Surge and sway masses in ``C(ν)``: ``(m_u, m_v)``, or ``(m, m)`` without ``C_A`` [kg]."""
+        if self.added_mass_coriolis:
+            return self.m_u, self.m_v
+        return self.m, self.m
 
 
 @dataclass(frozen=True, eq=False)
@@ -176,6 +229,62 @@ class PropellerParams:
 
 
 @dataclass(frozen=True, eq=False)
+class LinearPropellerParams:
+    """Propeller whose open-water K_T, K_Q are linear in the advance ratio (Fossen 2021, 9.3).
+
+    ``K_T(J) = K_T0 + (K_T(J_max) - K_T0) J / J_max`` (``K_Q`` likewise), ``J = v_a/(nD)``,
+    so that ``T = ρ D⁴ (K_T0 n |n| + K_T' (v_a/D) |n|)`` and
+    ``Q = ρ D⁵ (K_Q0 n |n| + K_Q' (v_a/D) |n|)`` with the slopes ``K_T' = dK_T/dJ``.
+    """
+
+    name: str
+    """Short identifier of the propeller [-]."""
+    source: str
+    """Citation of the coefficients [-]."""
+    diameter: float
+    """Propeller diameter ``D`` [m]."""
+    K_T0: float
+    """Thrust coefficient at ``J = 0`` (bollard) [-]."""
+    K_Q0: float
+    """Torque coefficient at ``J = 0`` [-]."""
+    J_max: float
+    """Advance ratio of the second point of the linear fit [-]."""
+    K_T_at_J_max: float
+    """Thrust coefficient at ``J_max`` [-]."""
+    K_Q_at_J_max: float
+    """Torque coefficient at ``J_max`` [-]."""
+
+    def __post_init__(self) -> None:
+        for name in ("diameter", "K_T0", "K_Q0", "J_max", "K_Q_at_J_max"):
+            _finite(f"propeller.{name}", getattr(self, name), positive=True)
+        _finite("propeller.K_T_at_J_max", self.K_T_at_J_max)
+
+    @property
+    def thrust_slope(self) -> float:
+        """``dK_T/dJ`` [-]."""
+        return (self.K_T_at_J_max - self.K_T0) / self.J_max
+
+    @property
+    def torque_slope(self) -> float:
+        """``dK_Q/dJ`` [-]."""
+        return (self.K_Q_at_J_max - self.K_Q0) / self.J_max
+
+    @property
+    def order(self) -> None:
+        """No Fourier harmonics (kept so that every propeller answers ``order``) [-]."""
+        return None
+
+    @property
+    def max_order(self) -> int:
+        """Highest harmonic available: 0, the model has no Fourier series [-]."""
+        return 0
+
+
+#: Any propeller model a thruster can carry.
+Propeller = PropellerParams | LinearPropellerParams
+
+
+@dataclass(frozen=True, eq=False)
 class MotorParams:
     """Brushed DC motor driving one propeller (inductance neglected).
 
@@ -230,20 +339,22 @@ class MotorParams:
 
 @dataclass(frozen=True, eq=False)
 class VehicleParams:
-    """Everything that defines one vehicle type: hull, propellers, motors, limits, smoothing.
+    """A twin-thruster vehicle type (MEDUSA class): hull, propellers, motors, limits, smoothing.
 
-    The two identical thrusters sit at lateral positions ``y = ∓l`` (port negative) and push
-    along the body x axis. Smoothing constants make the model twice continuously
-    differentiable everywhere (see :mod:`auvplan.vehicle.dynamics`); their effect on thrust
-    and power is below 0.1 % at cruise (quantified in the tests).
+    The shorthand of a vehicle whose two identical thrusters sit at lateral positions
+    ``y = ∓l`` (port negative) and push along the body x axis; the model expands it to the
+    generic actuator list (:func:`auvplan.vehicle.actuators.actuated_vehicle`). Smoothing
+    constants make the model twice continuously differentiable everywhere (see
+    :mod:`auvplan.vehicle.dynamics`); their effect on thrust and power is below 0.1 % at
+    cruise (quantified in the tests).
     """
 
     name: str
     """Vehicle type name [-]."""
     hull: HullParams
     """Hull parameters [units per field of HullParams]."""
-    propeller: PropellerParams
-    """Propeller of both thrusters [units per field of PropellerParams]."""
+    propeller: Propeller
+    """Propeller of both thrusters [units per field of its class]."""
     motor: MotorParams
     """Motor of both thrusters [units per field of MotorParams]."""
     l: float  # noqa: E741  (the paper's symbol)
@@ -261,7 +372,7 @@ class VehicleParams:
     eps_abs_rate: float = DEFAULT_EPS_ABS_RATE
     """Smoothing of ``|r| ≈ sqrt(r² + ε²)`` [rad/s]."""
     eps_sign_n: float = DEFAULT_EPS_SIGN_N
-    """Smoothing of ``sgn(n) ≈ n / sqrt(n² + ε²)`` in the motor current [rev/s]."""
+    """Smoothing of ``sgn(n) ≈ n / sqrt(n² + ε²)`` in the motor current, and of ``|n|`` [rev/s]."""
     description: str = ""
     """Free text (origin of the parameter set) [-]."""
     metadata: dict[str, str] = field(default_factory=dict)
@@ -269,13 +380,52 @@ class VehicleParams:
 
     def __post_init__(self) -> None:
         _finite("l", self.l, positive=True)
-        _finite("hotel_power", self.hotel_power, nonnegative=True)
         _finite("n_max", self.n_max, positive=True)
         _finite("w_c", self.w_c, positive=True)
-        for name in ("eps_inflow", "eps_abs_speed", "eps_abs_rate", "eps_sign_n"):
-            _finite(name, getattr(self, name), positive=True)
-        if not self.name:
-            raise InputError("vehicle name must not be empty")
+        check_common_fields(self)
+
+
+class CommonVehicleFields(Protocol):
+    """The fields every vehicle parameter set has, whatever its actuator layout."""
+
+    @property
+    def name(self) -> str:
+        """Vehicle type name [-]."""
+
+    @property
+    def hotel_power(self) -> float:
+        """Hotel load [W]."""
+
+    @property
+    def eps_inflow(self) -> float:
+        """Propeller inflow smoothing [m/s]."""
+
+    @property
+    def eps_abs_speed(self) -> float:
+        """Smoothing of ``|u|``, ``|v|`` [m/s]."""
+
+    @property
+    def eps_abs_rate(self) -> float:
+        """Smoothing of ``|r|`` [rad/s]."""
+
+    @property
+    def eps_sign_n(self) -> float:
+        """Smoothing of ``sgn(n)``, ``|n|`` [rev/s]."""
+
+
+def check_common_fields(params: CommonVehicleFields) -> None:
+    """Validate the name, hotel load and smoothing constants of a vehicle parameter set.
+
+    Raises
+    ------
+    InputError
+        Naming the first offending field.
+    """
+    _finite("hotel_power", params.hotel_power, nonnegative=True)
+    for name in ("eps_inflow", "eps_abs_speed", "eps_abs_rate", "eps_sign_n"):
+        _finite(name, getattr(params, name), positive=True)
+    if not params.name:
+        raise InputError("vehicle name must not be empty")
 
 
 __all__ = [
@@ -283,9 +433,14 @@ __all__ = [
     "DEFAULT_EPS_ABS_SPEED",
     "DEFAULT_EPS_INFLOW",
     "DEFAULT_EPS_SIGN_N",
+    "CommonVehicleFields",
+    "CrossFlowParams",
     "CurrentModel",
     "HullParams",
+    "LinearPropellerParams",
     "MotorParams",
+    "Propeller",
     "PropellerParams",
     "VehicleParams",
+    "check_common_fields",
 ]

@@ -18,6 +18,13 @@ homogeneous polynomial of degree ``k`` divided by ``V_ε^{k-2}``: smooth because
 k-th harmonic is ``ρ^{k-2} - 1 ≈ -(k - 2) ε_V²/(2S)``, i.e. about 1e-5 at cruise for
 ``ε_V = 0.02`` m/s.
 
+Open-water propeller, ``K_T``, ``K_Q`` linear in ``J = v_a/(nD)`` (Fossen 2021, sec. 9.3)::
+
+    T = ρ D⁴ (K_T0 n |n|_ε + K_T' (v_a/D) |n|_ε),   Q = ρ D⁵ (K_Q0 n |n|_ε + K_Q' (v_a/D) |n|_ε)
+
+one formula for both signs of ``n`` (smooth; Fossen's ``remus100`` keeps only the ``K_T0``
+term in reverse), ``|n|_ε = sqrt(n² + ε_n²)``.
+
 Motor (DC, inductance neglected; paper Sec. II-C)::
 
     I = Q/K_t + I_0 sgn_ε(n)      (current_model = "torque")
@@ -43,7 +50,7 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
-from auvplan.vehicle.params import MotorParams, PropellerParams
+from auvplan.vehicle.params import LinearPropellerParams, MotorParams, Propeller, PropellerParams
 
 #: Radius fraction of the reference blade section [-].
 BLADE_RADIUS_FRACTION: Final = 0.7
@@ -51,8 +58,10 @@ BLADE_RADIUS_FRACTION: Final = 0.7
 CURRENT_FIT_DEGREE: Final = 3
 
 
-def resolve_order(propeller: PropellerParams, order: int | None) -> int:
+def resolve_order(propeller: Propeller, order: int | None) -> int:
     """Harmonic order actually used: ``order``, else ``propeller.order``, else all.
+
+    An open-water propeller has no harmonics: its order is 0.
 
     Raises
     ------
@@ -248,6 +257,69 @@ def smooth_thrust_torque_expression(
     return thrust, torque
 
 
+def linear_propeller_thrust_torque_expression(
+    advance_speed: ca.SX,
+    n: ca.SX,
+    propeller: LinearPropellerParams,
+    rho: float,
+    *,
+    eps_n: float,
+) -> tuple[ca.SX, ca.SX]:
+    """Smooth CasADi thrust ``T`` [N] and torque ``Q`` [N m] of an open-water propeller.
+
+    ``T = ρD⁴ (K_T0 n |n|_ε + K_T' (v_a/D) |n|_ε)``, ``Q`` likewise with ``ρD⁵``, ``K_Q``
+    (module docstring).
+
+    Parameters
+    ----------
+    advance_speed : casadi.SX
+        ``v_a`` [m/s].
+    n : casadi.SX
+        Propeller speed [rev/s].
+    propeller : LinearPropellerParams
+        Coefficients and diameter.
+    rho : float
+        Water density [kg/m³].
+    eps_n : float
+        ``ε_n`` of ``|n|_ε = sqrt(n² + ε_n²)`` [rev/s], > 0.
+
+    Returns
+    -------
+    thrust, torque : casadi.SX
+        Scalar expressions.
+    """
+    diameter = propeller.diameter
+    abs_n = ca.sqrt(n**2 + eps_n**2)
+    inflow = advance_speed / diameter * abs_n
+    thrust = rho * diameter**4 * (propeller.K_T0 * n * abs_n + propeller.thrust_slope * inflow)
+    torque = rho * diameter**5 * (propeller.K_Q0 * n * abs_n + propeller.torque_slope * inflow)
+    return thrust, torque
+
+
+def thrust_torque_expression(
+    advance_speed: ca.SX,
+    n: ca.SX,
+    propeller: Propeller,
+    rho: float,
+    *,
+    order: int,
+    eps_inflow: float,
+    eps_n: float,
+) -> tuple[ca.SX, ca.SX]:
+    """Thrust [N] and torque [N m] of any propeller model (smooth CasADi expressions).
+
+    Dispatches to :func:`smooth_thrust_torque_expression` (four-quadrant series, ``order``
+    harmonics, ``eps_inflow``) or :func:`linear_propeller_thrust_torque_expression` (``eps_n``).
+    """
+    if isinstance(propeller, LinearPropellerParams):
+        return linear_propeller_thrust_torque_expression(
+            advance_speed, n, propeller, rho, eps_n=eps_n
+        )
+    return smooth_thrust_torque_expression(
+        advance_speed, n, propeller, rho, order=order, eps_inflow=eps_inflow
+    )
+
+
 def fit_current_curve(motor: MotorParams, eps_sign_n: float) -> FloatArray:
     """Least-squares coefficients ``a_j`` of ``I(n) = sgn_ε(n) Σ_j a_j |n|_ε^j``.
 
@@ -311,11 +383,13 @@ __all__ = [
     "CURRENT_FIT_DEGREE",
     "fit_current_curve",
     "fourier_series",
+    "linear_propeller_thrust_torque_expression",
     "motor_current_expression",
     "motor_power_expression",
     "open_water_thrust_torque",
     "resolve_order",
     "smooth_thrust_torque_expression",
     "thrust_coefficient",
+    "thrust_torque_expression",
     "torque_coefficient",
 ]

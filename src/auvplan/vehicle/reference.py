@@ -1,10 +1,10 @@
 """Reference states of a vehicle moving along a timed path (the desired trajectory of stage 2).
 
 A timed path gives the pose ``(north, east, ψ)``, the surge speed ``u`` and the yaw rate
-``r`` at each instant. The matching state assumes no sway and the propeller speeds that hold
-``u`` in steady straight motion (:func:`auvplan.vehicle.trim.trim_surge`), interpolated in a
-table of ``TRIM_SAMPLES`` speeds from rest to top speed. This module is the only place
-outside the dynamics that knows how a vehicle's state vector is laid out.
+``r`` at each instant. The matching state assumes no sway, the forward propellers at the speed
+that holds ``u`` in steady straight motion (:func:`auvplan.vehicle.trim.trim_surge`),
+interpolated in a table of ``TRIM_SAMPLES`` speeds from rest to top speed, and every other
+actuator (steering) at zero, through :func:`auvplan.vehicle.operating.operating_state`.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.vehicle.dynamics import VehicleModel
+from auvplan.vehicle.operating import FIRST_ACTUATOR, operating_state
 from auvplan.vehicle.trim import top_speed, trim_surge
 
 #: Samples of the steady-surge trim table (propeller speed against surge speed).
@@ -24,7 +25,7 @@ TRIM_SAMPLES: Final = 40
 
 @cache
 def surge_trim_table(model: VehicleModel) -> tuple[FloatArray, FloatArray]:
-    """Steady-surge propeller speed [rev/s] against surge speed [m/s], rest to top speed.
+    """Steady-surge propeller speed (throttle) [rev/s] against surge speed [m/s], rest to top.
 
     Cached per model object.
     """
@@ -39,7 +40,7 @@ def reference_states(
     surge: FloatArray,
     yaw_rate: FloatArray,
 ) -> FloatArray:
-    """States ``(north, east, ψ, u, 0, r, n, n)`` along a timed path.
+    """States ``(north, east, ψ, u, 0, r, actuators…)`` along a timed path (module notes).
 
     Parameters
     ----------
@@ -73,9 +74,9 @@ def reference_states(
     states[:, model.index("u")] = surge
     states[:, model.index("r")] = yaw_rate
     speeds, revolutions = surge_trim_table(model)
-    propeller = np.interp(surge, speeds, revolutions)
-    for name in ("n_ps", "n_sb"):
-        states[:, model.index(name)] = propeller
+    unit_throttle = operating_state(model, throttle=1.0)[FIRST_ACTUATOR:]
+    throttle = np.interp(surge, speeds, revolutions)
+    states[:, FIRST_ACTUATOR:] = np.multiply.outer(throttle, unit_throttle)
     return states
 
 

@@ -21,7 +21,7 @@ from auvplan._typing import FloatArray
 from auvplan.errors import InputError
 from auvplan.vehicle.dynamics import VehicleModel
 
-#: A control law ``c(t)`` for the adaptive simulation: time [s] -> inputs of shape (2,).
+#: A control law ``c(t)`` for the adaptive simulation: time [s] -> inputs of shape (n_u,).
 ControlLaw = Callable[[float], FloatArray]
 
 
@@ -45,7 +45,7 @@ def rk4_step_function(model: VehicleModel, dt: float) -> ca.Function:
     Returns
     -------
     casadi.Function
-        ``"F"(x[8], c[2]) -> x_next[8]``, an SX graph (exact derivatives).
+        ``"F"(x[n_x], c[n_u]) -> x_next[n_x]``, an SX graph (exact derivatives).
 
     Examples
     --------
@@ -86,16 +86,16 @@ def rk4_simulate(model: VehicleModel, x0: FloatArray, inputs: FloatArray, dt: fl
     ----------
     model : VehicleModel
         Continuous model.
-    x0 : ndarray of shape (8,)
+    x0 : ndarray of shape (n_x,)
         Initial state.
-    inputs : ndarray of shape (N, 2)
+    inputs : ndarray of shape (N, n_u)
         Input ``c_k`` held on ``[k dt, (k + 1) dt)``.
     dt : float
         Step [s].
 
     Returns
     -------
-    ndarray of shape (N + 1, 8)
+    ndarray of shape (N + 1, n_x)
         States at ``t_k = k dt``, ``k = 0..N``.
 
     Raises
@@ -134,7 +134,7 @@ class AdaptiveSimulation:
     time: FloatArray
     """Sample times, shape ``(n_t,)`` [s]."""
     states: FloatArray
-    """States at ``time``, shape ``(n_t, 8)``."""
+    """States at ``time``, shape ``(n_t, n_x)``."""
     status: SimulationStatus
     """Whether every integration interval succeeded."""
     message: str
@@ -164,9 +164,9 @@ def simulate_adaptive(
     ----------
     model : VehicleModel
         Continuous model.
-    x0 : ndarray of shape (8,)
+    x0 : ndarray of shape (n_x,)
         Initial state.
-    control : ndarray of shape (N, 2) or callable
+    control : ndarray of shape (N, n_u) or callable
         Either inputs held constant on ``N`` equal intervals of ``t_span`` (the integrator
         restarts at each interval boundary, so the discontinuities are resolved exactly and
         the samples are the ``N + 1`` grid times), or a law ``c(t)`` (one integration; samples

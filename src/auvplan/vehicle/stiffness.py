@@ -7,7 +7,8 @@ the quadratic damping makes them grow with the body velocities, so a step that i
 straight cruise can be unstable during a turn, and an unstable discrete model *amplifies* a mode
 that the real vehicle damps. The bound here samples ``∂f/∂x`` over the vehicle's whole
 operating envelope (surge from slow astern to top speed, sway, yaw rate up to the steady
-maximum, propeller speeds up to ``n_max``) and returns
+maximum, every actuator over its range: propeller speeds up to ``n_max``, control surfaces up
+to ``δ_max``) and returns
 
 .. math::
 
@@ -46,14 +47,13 @@ def fastest_mode(model: VehicleModel) -> float:
     """
     fastest_u = top_speed(model)
     fastest_r = max_yaw_rate(model)
-    n_max = model.params.n_max
     axes = {
         "u": np.linspace(-0.3 * fastest_u, 1.05 * fastest_u, ENVELOPE_SAMPLES + 2),
         "v": np.linspace(-0.4 * fastest_u, 0.4 * fastest_u, ENVELOPE_SAMPLES),
         "r": np.linspace(-1.2 * fastest_r, 1.2 * fastest_r, ENVELOPE_SAMPLES),
-        "n_ps": np.linspace(-n_max, n_max, ENVELOPE_SAMPLES),
-        "n_sb": np.linspace(-n_max, n_max, ENVELOPE_SAMPLES),
     }
+    for name, limit in model.state_limits:
+        axes[name] = np.linspace(-limit, limit, ENVELOPE_SAMPLES)
     points = np.array(list(itertools.product(*axes.values())))
     states = np.zeros((points.shape[0], model.n_x))
     for k, name in enumerate(axes):

@@ -1,104 +1,51 @@
 """Steady states of the vehicle: straight-line trim, steady turns, limits, energy-optimal cruise.
 
 All equilibria solve ``ν̇ = 0`` of the full (smooth) model of
-:func:`auvplan.vehicle.dynamics.build_vehicle_model` with the propeller speeds held constant
-(``c = 0``), so they are consistent with what the optimiser sees.
+:func:`auvplan.vehicle.dynamics.build_vehicle_model` with the actuator states held constant
+(``c = 0``), so they are consistent with what the optimiser sees. The actuators are set by a
+throttle and a steering fraction (:mod:`auvplan.vehicle.operating`), so every function works
+for any actuator layout.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
 from functools import cache
-from typing import NamedTuple
 
-import casadi as ca
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar, root
+from scipy.optimize import brentq, minimize_scalar
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InfeasibleError, InputError, SolverError
+from auvplan.vehicle._steady import (
+    BollardPull,
+    CruiseOptimum,
+    SteadyMotion,
+    SteadyTurn,
+    SurgeTrim,
+    TurnTrim,
+    VehicleCharacteristics,
+    nu_dot,
+    solve_equilibrium,
+    steady_power,
+)
 from auvplan.vehicle.dynamics import VehicleModel
+from auvplan.vehicle.operating import (
+    FIRST_ACTUATOR,
+    ActuatorRoles,
+    actuator_roles,
+    mean_throttle,
+    operating_state,
+    steer_fraction,
+)
 
-_NU = slice(3, 6)
 _MIN_CRUISE_SPEED = 0.05  # m/s, lower end of the cruise-speed search
-
-
-class SurgeTrim(NamedTuple):
-    """Straight-line trim: both propellers at ``n``."""
-
-    n: float
-    """Propeller speed (both) [rev/s]; may exceed ``n_max`` above the top speed."""
-    power: float
-    """Electrical power including the hotel load [W]."""
-
-
-class TurnTrim(NamedTuple):
-    """Steady turn at a given surge speed and yaw rate."""
-
-    n_ps: float
-    """Port propeller speed [rev/s]."""
-    n_sb: float
-    """Starboard propeller speed [rev/s]."""
-    v: float
-    """Steady sway speed [m/s]."""
-    power: float
-    """Electrical power including the hotel load [W]."""
-
-
-class SteadyMotion(NamedTuple):
-    """Steady body velocities for fixed propeller speeds."""
-
-    u: float
-    """Surge speed [m/s]."""
-    v: float
-    """Sway speed [m/s]."""
-    r: float
-    """Yaw rate [rad/s]."""
-
-
-class BollardPull(NamedTuple):
-    """Thrust and torque of one propeller at ``n_max`` with the vehicle held at rest."""
-
-    thrust: float
-    """Thrust per propeller [N]."""
-    torque: float
-    """Shaft torque per propeller [N m]."""
-    power: float
-    """Electrical power of the vehicle, both motors at ``n_max`` plus hotel load [W]."""
-
-
-class CruiseOptimum(NamedTuple):
-    """Energy-optimal straight-line cruise."""
-
-    speed: float
-    """Surge speed minimising energy per metre [m/s]."""
-    energy_per_metre: float
-    """``P(u)/u`` at that speed [J/m]."""
-
-
-def _state(u: float, v: float, r: float, n_ps: float, n_sb: float) -> FloatArray:
-    return np.array([0.0, 0.0, 0.0, u, v, r, n_ps, n_sb])
-
-
-def _nu_dot(model: VehicleModel, state: FloatArray) -> FloatArray:
-    return np.asarray(model.dynamics(state, np.zeros(model.n_u)), dtype=np.float64).ravel()[_NU]
-
-
-def _power(model: VehicleModel, state: FloatArray) -> float:
-    return float(model.power(state, np.zeros(model.n_u)))
-
-
-def _jacobian(model: VehicleModel) -> ca.Function:
-    x = ca.SX.sym("x", model.n_x)
-    xdot = model.dynamics(x, ca.SX.zeros(model.n_u))
-    return ca.Function("f_x", [x], [ca.jacobian(xdot, x)])
 
 
 def trim_surge(model: VehicleModel, speed: float) -> SurgeTrim:
     """Propeller speed and electrical power of steady straight motion at surge ``speed``.
 
-    Solves ``u̇(u, v=0, r=0, n, n) = 0`` for ``n`` (Brent's method).
+    Solves ``u̇(u, v=0, r=0, throttle n) = 0`` for ``n`` (Brent's method).
 
     Parameters
     ----------
@@ -128,22 +75,22 @@ def trim_surge(model: VehicleModel, speed: float) -> SurgeTrim:
     if not math.isfinite(speed):
         raise InputError(f"speed must be finite, got {speed!r}")
     if speed == 0.0:
-        return SurgeTrim(0.0, _power(model, _state(0.0, 0.0, 0.0, 0.0, 0.0)))
+        return SurgeTrim(0.0, steady_power(model, operating_state(model)))
 
     def surge_acceleration(n: float) -> float:
-        return float(_nu_dot(model, _state(speed, 0.0, 0.0, n, n))[0])
+        return float(nu_dot(model, operating_state(model, u=speed, throttle=n))[0])
 
-    limit = 4.0 * model.params.n_max * math.copysign(1.0, speed)
+    limit = 4.0 * actuator_roles(model).throttle_max * math.copysign(1.0, speed)
     if surge_acceleration(limit) * surge_acceleration(0.0) > 0.0:
         raise InfeasibleError(
             f"no propeller speed within ±{abs(limit):.0f} rev/s holds surge speed {speed} m/s"
         )
     n = float(brentq(surge_acceleration, 0.0, limit, xtol=1e-10, rtol=1e-12))
-    return SurgeTrim(n, _power(model, _state(speed, 0.0, 0.0, n, n)))
+    return SurgeTrim(n, steady_power(model, operating_state(model, u=speed, throttle=n)))
 
 
-def steady_motion(model: VehicleModel, n_ps: float, n_sb: float) -> SteadyMotion:
-    """Steady body velocities ``(u, v, r)`` with both propeller speeds held fixed.
+def steady_motion(model: VehicleModel, *actuators: float) -> SteadyMotion:
+    """Steady body velocities ``(u, v, r)`` with every actuator state held fixed.
 
     Solved from a few starting points (the first equilibrium found is returned; with an
     unstable hull there can be more than one, e.g. an unstable straight-ish motion and a
@@ -153,8 +100,9 @@ def steady_motion(model: VehicleModel, n_ps: float, n_sb: float) -> SteadyMotion
     ----------
     model : VehicleModel
         Model.
-    n_ps, n_sb : float
-        Port and starboard propeller speeds [rev/s].
+    *actuators : float
+        The actuator states in the model's order: propeller speeds [rev/s], then control-
+        surface deflections [rad] (MEDUSA: ``n_ps, n_sb``).
 
     Returns
     -------
@@ -162,6 +110,8 @@ def steady_motion(model: VehicleModel, n_ps: float, n_sb: float) -> SteadyMotion
 
     Raises
     ------
+    InputError
+        If the number of actuator states is wrong.
     SolverError
         If the nonlinear solve does not converge.
 
@@ -173,35 +123,39 @@ def steady_motion(model: VehicleModel, n_ps: float, n_sb: float) -> SteadyMotion
     >>> round(motion.u, 3), round(motion.r, 6)
     (0.989, 0.0)
     """
-    jacobian = _jacobian(model)
+    settings = np.asarray(actuators, dtype=np.float64)
+    if settings.shape != (model.n_x - FIRST_ACTUATOR,):
+        raise InputError(
+            f"steady_motion needs {model.n_x - FIRST_ACTUATOR} actuator states "
+            f"{model.state_names[FIRST_ACTUATOR:]}, got {settings.size}"
+        )
 
-    def residual(nu: FloatArray) -> FloatArray:
-        return _nu_dot(model, _state(nu[0], nu[1], nu[2], n_ps, n_sb))
+    def state_of(nu: FloatArray) -> FloatArray:
+        return np.concatenate([np.zeros(3), nu, settings])
 
-    def residual_jacobian(nu: FloatArray) -> FloatArray:
-        full = np.asarray(jacobian(_state(nu[0], nu[1], nu[2], n_ps, n_sb)), dtype=np.float64)
-        return full[_NU, _NU]
-
-    mean_n = 0.5 * (n_ps + n_sb)
-    guess_u = math.copysign(1.0, mean_n) * min(abs(mean_n) / 50.0, 1.5)
-    guess_r = (n_ps - n_sb) / (2.0 * model.params.n_max)
+    guess_u = top_speed(model) * mean_throttle(model, settings) / actuator_roles(model).throttle_max
+    guess_r = steer_fraction(model, settings)
     turn = math.copysign(1.0, guess_r) if guess_r != 0.0 else 1.0
     # multi-start: with DSOR's MEDUSA hull (m_v > m_u) straight motion is directionally
     # unstable above ~0.7 m/s and a small differential gives a tight steady turn
-    message = ""
-    for r0 in (guess_r, 0.1 * turn, 0.3 * turn, 0.6 * turn, 1.0 * turn, -0.3 * turn):
-        solution = root(residual, np.array([guess_u, 0.0, r0]), jac=residual_jacobian, tol=1e-12)
-        if solution.success and np.max(np.abs(residual(solution.x))) <= 1e-8:
-            u, v, r = (float(value) for value in solution.x)
-            return SteadyMotion(u, v, r)
-        message = str(solution.message)
-    raise SolverError(f"steady motion for n = ({n_ps}, {n_sb}) rev/s did not converge: {message}")
+    guesses = [
+        (guess_u, 0.0, r0) for r0 in (guess_r, *(k * turn for k in (0.1, 0.3, 0.6, 1.0, -0.3)))
+    ]
+    u, v, r = (
+        float(value)
+        for value in solve_equilibrium(
+            model, state_of, guesses, f"steady motion for actuators {settings.tolist()}"
+        )
+    )
+    return SteadyMotion(u, v, r)
 
 
-def trim_turn(model: VehicleModel, speed: float, yaw_rate: float) -> TurnTrim:
-    """Propeller speeds, sway and power of a steady turn at surge ``speed`` and ``yaw_rate``.
+def steady_turn(model: VehicleModel, speed: float, yaw_rate: float) -> SteadyTurn:
+    """Steady turn at surge ``speed`` and ``yaw_rate``: throttle, steering and sway solved.
 
-    Solves ``ν̇ = 0`` for ``(n_ps, n_sb, v)`` with ``u`` and ``r`` fixed.
+    Solves ``ν̇ = 0`` for the throttle, the steering fraction and ``v`` with ``u`` and ``r``
+    fixed (:mod:`auvplan.vehicle.operating`); the steering may exceed full deflection when
+    the turn is tighter than the vehicle can fly.
 
     Parameters
     ----------
@@ -214,12 +168,47 @@ def trim_turn(model: VehicleModel, speed: float, yaw_rate: float) -> TurnTrim:
 
     Returns
     -------
-    TurnTrim
+    SteadyTurn
 
     Raises
     ------
+    InputError
+        If the vehicle has no steering actuator.
     SolverError
         If the nonlinear solve does not converge.
+
+    Examples
+    --------
+    >>> from auvplan.io.vehicles import load_vehicle
+    >>> from auvplan.vehicle.dynamics import build_vehicle_model
+    >>> round(steady_turn(build_vehicle_model(load_vehicle("medusa")), 0.5, 0.1).radius, 2)
+    5.02
+    """
+    _check_steering(model)
+
+    def state_of(z: FloatArray) -> FloatArray:
+        return operating_state(model, u=speed, v=z[2], r=yaw_rate, throttle=z[0], steer=z[1])
+
+    throttle = trim_surge(model, speed).n if speed != 0.0 else 1.0
+    turn = math.copysign(1.0, yaw_rate) if yaw_rate != 0.0 else 1.0
+    first = yaw_rate / max_yaw_rate(model)
+    guesses = [(throttle, s0, 0.0) for s0 in (first, *(k * turn for k in (0.05, 0.2, 0.5, 1.0)))]
+    solution = solve_equilibrium(
+        model, state_of, guesses, f"steady turn at u = {speed} m/s, r = {yaw_rate} rad/s"
+    )
+    state = state_of(solution)
+    return SteadyTurn(state, steady_power(model, state))
+
+
+def trim_turn(model: VehicleModel, speed: float, yaw_rate: float) -> TurnTrim:
+    """Propeller speeds, sway and power of a twin-thruster vehicle's steady turn.
+
+    :func:`steady_turn` reported as ``(n_ps, n_sb, v, power)``.
+
+    Raises
+    ------
+    InputError
+        If the vehicle's actuators are not the twin thrusters ``n_ps``, ``n_sb``.
 
     Examples
     --------
@@ -229,31 +218,60 @@ def trim_turn(model: VehicleModel, speed: float, yaw_rate: float) -> TurnTrim:
     >>> turn.n_ps > turn.n_sb
     True
     """
-    jacobian = _jacobian(model)
-    columns = [6, 7, 4]  # n_ps, n_sb, v
-
-    def residual(z: FloatArray) -> FloatArray:
-        return _nu_dot(model, _state(speed, z[2], yaw_rate, z[0], z[1]))
-
-    def residual_jacobian(z: FloatArray) -> FloatArray:
-        full = np.asarray(jacobian(_state(speed, z[2], yaw_rate, z[0], z[1])), dtype=np.float64)
-        return full[_NU][:, columns]
-
-    n_straight = trim_surge(model, speed).n if speed != 0.0 else 1.0
-    guess = np.array([n_straight + 5.0 * yaw_rate, n_straight - 5.0 * yaw_rate, 0.0])
-    solution = root(residual, guess, jac=residual_jacobian, tol=1e-12)
-    if not solution.success or np.max(np.abs(residual(solution.x))) > 1e-8:
-        raise SolverError(
-            f"steady turn at u = {speed} m/s, r = {yaw_rate} rad/s did not converge: "
-            f"{solution.message}"
+    if model.state_names[FIRST_ACTUATOR:] != ("n_ps", "n_sb"):
+        raise InputError(
+            f"trim_turn reports twin thrusters n_ps, n_sb; vehicle {model.vehicle.name!r} has "
+            f"{model.state_names[FIRST_ACTUATOR:]} (use steady_turn)"
         )
-    n_ps, n_sb, v = (float(value) for value in solution.x)
-    return TurnTrim(n_ps, n_sb, v, _power(model, _state(speed, v, yaw_rate, n_ps, n_sb)))
+    turn = steady_turn(model, speed, yaw_rate)
+    n_ps, n_sb = (float(value) for value in turn.state[FIRST_ACTUATOR:])
+    return TurnTrim(n_ps, n_sb, float(turn.state[4]), turn.power)
+
+
+def tightest_turn(model: VehicleModel, speed: float) -> SteadyTurn:
+    """Steady turn at surge ``speed`` with full steering to starboard.
+
+    Control surfaces at full deflection, the throttle holding ``speed``; a vehicle steering
+    by differential thrust keeps its outer thrusters at ``n_max`` (steering fraction
+    ``1 - n/n_max``). Its :attr:`SteadyTurn.radius` is the turning radius at that speed.
+
+    Raises
+    ------
+    InputError
+        If the vehicle has no steering actuator.
+    SolverError
+        If the nonlinear solve does not converge.
+
+    Examples
+    --------
+    >>> from auvplan.io.vehicles import load_vehicle
+    >>> from auvplan.vehicle.dynamics import build_vehicle_model
+    >>> round(tightest_turn(build_vehicle_model(load_vehicle("medusa")), 0.5).radius, 2)
+    0.65
+    """
+    roles = _check_steering(model)
+
+    def state_of(z: FloatArray) -> FloatArray:
+        steer = 1.0 - z[0] / roles.throttle_max if roles.thrust_steering else 1.0
+        return operating_state(model, u=speed, v=z[1], r=z[2], throttle=z[0], steer=steer)
+
+    throttle = trim_surge(model, speed).n
+    guesses = [(throttle, 0.0, r0) for r0 in (0.1, 0.3, 0.6, 1.0, 2.0)]
+    solution = solve_equilibrium(model, state_of, guesses, f"full-steering turn at u = {speed} m/s")
+    state = state_of(solution)
+    return SteadyTurn(state, steady_power(model, state))
+
+
+def _check_steering(model: VehicleModel) -> ActuatorRoles:
+    roles = actuator_roles(model)
+    if not roles.can_steer:
+        raise InputError(f"vehicle {model.vehicle.name!r} has no steering actuator")
+    return roles
 
 
 @cache
 def top_speed(model: VehicleModel) -> float:
-    """Steady straight-line speed with both propellers at ``n_max`` [m/s] (cached per model).
+    """Steady straight-line speed with the forward propellers at ``n_max`` [m/s] (cached).
 
     Examples
     --------
@@ -262,10 +280,10 @@ def top_speed(model: VehicleModel) -> float:
     >>> round(top_speed(build_vehicle_model(load_vehicle("medusa"))), 2)
     1.48
     """
-    n_max = model.params.n_max
+    n_max = actuator_roles(model).throttle_max
 
     def surge_acceleration(u: float) -> float:
-        return float(_nu_dot(model, _state(u, 0.0, 0.0, n_max, n_max))[0])
+        return float(nu_dot(model, operating_state(model, u=u, throttle=n_max))[0])
 
     upper = 1.0
     while surge_acceleration(upper) > 0.0:
@@ -286,17 +304,23 @@ def bollard(model: VehicleModel) -> BollardPull:
     >>> round(pull.thrust, 1), round(pull.torque, 3)
     (36.1, 0.442)
     """
-    n_max = model.params.n_max
-    state = _state(0.0, 0.0, 0.0, n_max, n_max)
-    thrust, _, torque, _ = model.thrust_torque(state)
-    return BollardPull(float(thrust), float(torque), _power(model, state))
+    roles = actuator_roles(model)
+    state = operating_state(model, throttle=roles.throttle_max)
+    outputs = [float(value) for value in model.thrust_torque(state)]
+    first = int(np.argmax(roles.throttle))
+    n_thrusters = len(model.vehicle.thrusters)
+    return BollardPull(outputs[first], outputs[n_thrusters + first], steady_power(model, state))
 
 
+@cache
 def max_yaw_rate(model: VehicleModel) -> float:
-    """Steady yaw rate turning on the spot: port at ``+n_max``, starboard at ``-n_max`` [rad/s].
+    """Steady yaw rate at full steering to starboard [rad/s] (cached per model).
 
-    The full steady state ``(u, v, r)`` is solved (the four-quadrant model gives less
-    reverse than forward thrust, so the vehicle also creeps ahead).
+    Differential-thrust vehicles turn on the spot (steering thrusters at ``±n_max``, MEDUSA:
+    port ``+n_max``, starboard ``-n_max``); vehicles with control surfaces turn at full
+    deflection with the propellers at ``n_max``. The full steady state ``(u, v, r)`` is
+    solved (the four-quadrant model gives less reverse than forward thrust, so MEDUSA also
+    creeps ahead).
 
     Examples
     --------
@@ -305,8 +329,10 @@ def max_yaw_rate(model: VehicleModel) -> float:
     >>> 0.8 < max_yaw_rate(build_vehicle_model(load_vehicle("medusa"))) < 1.1
     True
     """
-    n_max = model.params.n_max
-    return steady_motion(model, n_max, -n_max).r
+    roles = _check_steering(model)
+    throttle = 0.0 if roles.thrust_steering else roles.throttle_max
+    state = operating_state(model, throttle=throttle, steer=1.0)
+    return steady_motion(model, *state[FIRST_ACTUATOR:]).r
 
 
 def energy_per_metre(model: VehicleModel, speed: float) -> float:
@@ -346,7 +372,7 @@ def optimal_cruise_speed(model: VehicleModel) -> CruiseOptimum:
     upper = top_speed(model)
     if upper <= _MIN_CRUISE_SPEED:
         raise InputError(
-            f"vehicle {model.params.name!r} tops out at {upper:.3g} m/s, below the "
+            f"vehicle {model.vehicle.name!r} tops out at {upper:.3g} m/s, below the "
             f"{_MIN_CRUISE_SPEED:g} m/s a cruise speed is searched from; check its thrust and drag"
         )
     result = minimize_scalar(
@@ -357,55 +383,6 @@ def optimal_cruise_speed(model: VehicleModel) -> CruiseOptimum:
     )
     speed = float(result.x)
     return CruiseOptimum(speed, energy_per_metre(model, speed))
-
-
-@dataclass(frozen=True)
-class VehicleCharacteristics:
-    """Headline numbers of a vehicle type (what ``auvplan vehicle`` prints)."""
-
-    name: str
-    """Vehicle type."""
-    propeller_order: int
-    """Harmonics of the propeller series used [-]."""
-    n_max: float
-    """Maximum propeller speed [rev/s]."""
-    bollard_thrust: float
-    """Thrust per propeller at ``n_max``, vehicle at rest [N]."""
-    bollard_torque: float
-    """Torque per propeller at ``n_max``, vehicle at rest [N m]."""
-    bollard_power: float
-    """Electrical power at bollard, both motors plus hotel load [W]."""
-    top_speed: float
-    """Straight-line speed at ``n_max`` [m/s]."""
-    cruise_speed: float
-    """Energy-optimal cruise speed [m/s]."""
-    cruise_energy_per_metre: float
-    """Energy per metre at the cruise speed [J/m]."""
-    hotel_power: float
-    """Hotel load included in every power [W]."""
-    power_at_0_5: float
-    """Steady electrical power at 0.5 m/s (with hotel load) [W]."""
-    power_at_1_0: float
-    """Steady electrical power at 1.0 m/s (with hotel load) [W]."""
-    n_at_0_5: float
-    """Propeller speed at 0.5 m/s [rev/s]."""
-    n_at_1_0: float
-    """Propeller speed at 1.0 m/s [rev/s]."""
-    max_yaw_rate: float
-    """Steady yaw rate turning on the spot at ``±n_max`` [rad/s]."""
-
-    def to_dict(self) -> dict[str, float | int | str]:
-        """Plain dictionary (JSON-ready), SI units as documented per field.
-
-        Examples
-        --------
-        >>> from auvplan.io.vehicles import load_vehicle
-        >>> from auvplan.vehicle.dynamics import build_vehicle_model
-        >>> table = vehicle_characteristics(build_vehicle_model(load_vehicle("medusa"))).to_dict()
-        >>> table["name"], round(float(table["top_speed"]), 2)
-        ('medusa', 1.48)
-        """
-        return dict(asdict(self))
 
 
 def vehicle_characteristics(model: VehicleModel) -> VehicleCharacteristics:
@@ -423,21 +400,22 @@ def vehicle_characteristics(model: VehicleModel) -> VehicleCharacteristics:
     slow = trim_surge(model, 0.5)
     fast = trim_surge(model, 1.0)
     return VehicleCharacteristics(
-        name=model.params.name,
+        name=model.vehicle.name,
         propeller_order=model.propeller_order,
-        n_max=model.params.n_max,
+        n_max=actuator_roles(model).throttle_max,
         bollard_thrust=pull.thrust,
         bollard_torque=pull.torque,
         bollard_power=pull.power,
         top_speed=top_speed(model),
         cruise_speed=cruise.speed,
         cruise_energy_per_metre=cruise.energy_per_metre,
-        hotel_power=model.params.hotel_power,
+        hotel_power=model.vehicle.hotel_power,
         power_at_0_5=slow.power,
         power_at_1_0=fast.power,
         n_at_0_5=slow.n,
         n_at_1_0=fast.n,
         max_yaw_rate=max_yaw_rate(model),
+        turning_radius=tightest_turn(model, cruise.speed).radius,
     )
 
 
@@ -445,6 +423,7 @@ __all__ = [
     "BollardPull",
     "CruiseOptimum",
     "SteadyMotion",
+    "SteadyTurn",
     "SurgeTrim",
     "TurnTrim",
     "VehicleCharacteristics",
@@ -453,6 +432,8 @@ __all__ = [
     "max_yaw_rate",
     "optimal_cruise_speed",
     "steady_motion",
+    "steady_turn",
+    "tightest_turn",
     "top_speed",
     "trim_surge",
     "trim_turn",
