@@ -10,12 +10,12 @@ import numpy as np
 from auvplan._typing import FloatArray
 from auvplan.mission.config import CommConfig, WeightsConfig
 from auvplan.mission.fleet import (
-    REGULATOR_WEIGHTS,
     FleetLayout,
     FleetLimits,
     FleetProblemFunctions,
     FleetWeights,
     build_fleet_functions,
+    regulator_weights,
 )
 from auvplan.mission.preplan import PreplanStage
 from auvplan.mission.reward import information_reward
@@ -135,7 +135,7 @@ def assemble_problem(
             PathConstraint(block.function, kind=block.kind, name=block.name)
             for block in functions.constraints
         ),
-        regulator_Q=np.diag(layout.per_state(REGULATOR_WEIGHTS, 1.0)),
+        regulator_Q=np.diag(layout.per_state(regulator_weights, 1.0)),
         regulator_R=np.eye(layout.n_u),
         n_substeps=integration_substeps(layout, deconfliction.dt),
         regulator_floor=layout.per_state(regulator_floor, 0.0),

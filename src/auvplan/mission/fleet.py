@@ -35,16 +35,26 @@ from auvplan.optimization import StageBlock, stack_blocks
 from auvplan.vehicle import VehicleModel
 
 #: Desired-state weights Q of the tracking term per unit of ``terrain`` weight, by state name:
-#: position [W/m²], heading [W/rad²], surge [W/(m/s)²], propeller speeds [W/(rev/s)²];
-#: states not named here get 0.
-TRACKING_WEIGHTS: Final = {
-    "north": 1.0, "east": 1.0, "psi": 20.0, "u": 20.0, "n_ps": 1e-3, "n_sb": 1e-3,
-}  # fmt: skip
-#: Weights of the projection regulator (PRONTO's tracking LQR), by state name; others get 1.
-REGULATOR_WEIGHTS: Final = {
-    "north": 1.0, "east": 1.0, "psi": 10.0, "u": 10.0, "v": 1.0, "r": 10.0,
-    "n_ps": 1e-3, "n_sb": 1e-3,
-}  # fmt: skip
+#: position [W/m²], heading [W/rad²], surge [W/(m/s)²]; thruster (propeller-speed) states get
+#: :data:`THRUSTER_WEIGHT`, others 0 (see :func:`tracking_weights`).
+TRACKING_WEIGHTS: Final = {"north": 1.0, "east": 1.0, "psi": 20.0, "u": 20.0}
+#: Weights of the projection regulator (PRONTO's tracking LQR), by state name; thruster states
+#: get :data:`THRUSTER_WEIGHT`, others 1 (see :func:`regulator_weights`).
+REGULATOR_WEIGHTS: Final = {"north": 1.0, "east": 1.0, "psi": 10.0, "u": 10.0, "v": 1.0, "r": 10.0}
+#: Weight of every thruster (propeller-speed) state in both [per (rev/s)²].
+THRUSTER_WEIGHT: Final = 1e-3
+
+
+def tracking_weights(model: VehicleModel) -> dict[str, float]:
+    """Tracking weights of ``model``'s states by name (:data:`TRACKING_WEIGHTS`)."""
+    return {**TRACKING_WEIGHTS, **dict.fromkeys(model.thruster_states, THRUSTER_WEIGHT)}
+
+
+def regulator_weights(model: VehicleModel) -> dict[str, float]:
+    """Projection-regulator weights of ``model``'s states by name (:data:`REGULATOR_WEIGHTS`)."""
+    return {**REGULATOR_WEIGHTS, **dict.fromkeys(model.thruster_states, THRUSTER_WEIGHT)}
+
+
 #: Input regularisation R [W per unit c²] (keeps the LQ subproblem strongly convex in c).
 INPUT_WEIGHT: Final = 1e-2
 #: Terminal stiffness per unit of ``terminal`` weight: position [J/m²], heading [J/rad²].
@@ -209,7 +219,7 @@ def build_fleet_functions(
     models = layout.models
 
     def tracking(model: VehicleModel) -> list[float]:
-        return [TRACKING_WEIGHTS.get(name, 0.0) for name in model.state_names]
+        return [tracking_weights(model).get(name, 0.0) for name in model.state_names]
 
     blocks = tuple(
         StageBlock(
