@@ -12,6 +12,7 @@ from auvplan.vehicle.propulsion import thrust_coefficient, torque_coefficient
 from auvplan.vehicle.reference import positions
 from auvplan.vehicle.simulate import rk4_simulate
 from auvplan.vehicle.trim import top_speed, trim_surge, trim_turn
+from auvplan.viz.style import plain_tick_labels
 
 
 def plot_vehicle_validation(
@@ -131,7 +132,7 @@ def plot_vehicle_validation(
     )
     turn_axes.legend(fontsize=8)
     turn_axes.grid(alpha=0.3)
-    return figure
+    return plain_tick_labels(figure)
 
 
 __all__ = ["plot_vehicle_validation"]
