@@ -100,9 +100,9 @@ class ConsoleProgress:
             console = Console(stderr=True)
         is_live = console.is_terminal or console.is_jupyter if self._live is None else self._live
         if is_live:
+            self._log_through(console)  # before the display replaces sys.stderr by its proxy
             self._display = _rich_display(console)
             self._display.start()
-            self._log_through(console)
         return self
 
     def __exit__(

@@ -158,16 +158,16 @@ class MissionPlan:
         """The optimised trajectories in long format: one row per vehicle and time sample.
 
         Columns ``vehicle``, ``time`` (UTC), ``t`` [s since the start], then the coordinates
-        and variables of :meth:`to_xarray` (``lat``, ``lon`` on georeferenced terrain,
-        ``depth``, ``north``, ``east``, ``heading``, ``u``, ``v``, ``r``, ``n_ps``, ``n_sb``,
-        ``power``).
+        and variables of :meth:`to_xarray`: ``lat``, ``lon`` (georeferenced terrain only),
+        ``depth``, ``north``, ``east``, ``u``, ``v``, ``r``, ``n_ps``, ``n_sb``, ``power``,
+        ``heading``.
         """
         dataset = self.to_xarray()
         frame = dataset.to_dataframe().reset_index().drop(columns="obs")
         frame = frame.rename(columns={"trajectory": "vehicle"}).astype({"vehicle": str})
         frame["t"] = (frame["time"] - dataset["time"].values.min()).dt.total_seconds()
-        first = ["vehicle", "time", "t"]
-        return frame[first + [column for column in frame.columns if column not in first]]
+        places = [name for name in ("lat", "lon", "depth") if name in dataset.coords]
+        return frame[["vehicle", "time", "t", *places, *map(str, dataset.data_vars)]]
 
     def plot(self) -> Figure:
         """The mission figure: pre-planned paths and optimised trajectories over the terrain.
@@ -233,6 +233,12 @@ class MissionPlan:
             figure_format=figure_format, dpi=dpi,
             exports=parse_formats(",".join(exports)) if exports else (), tolerance=tolerance_m,
         )  # fmt: skip
+
+    def _repr_html_(self) -> str:
+        """The status and the vehicles table (Jupyter shows a plan with it)."""
+        from auvplan.viz.html import render_overview
+
+        return render_overview(self._summary)
 
     def __repr__(self) -> str:
         where = "" if self._folder is None else f", folder={str(self._folder)!r}"

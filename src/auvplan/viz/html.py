@@ -53,7 +53,6 @@ def render_report(
     str
         A complete HTML5 document.
     """
-    status, status_class = _status(summary)
     mission = summary.get("mission") or "built-in demo mission"
     parts = [
         "<!DOCTYPE html>",
@@ -72,9 +71,9 @@ def render_report(
                 "terrain": summary.get("terrain", {}).get("name"),
             }
         ),
-        f'<p><span class="status {status_class}">{_text(status)}</span></p>',
         *_warnings(summary),
-        *_vehicles(summary),
+        "<h2>Status and vehicles</h2>",
+        render_overview(summary),
         *_optimizer(summary.get("optimization"), "Optimiser"),
         *_comparison(summary),
         *_deconfliction(summary),
@@ -97,6 +96,20 @@ def render_report(
     return "\n".join(parts) + "\n"
 
 
+def render_overview(summary: Mapping[str, Any]) -> str:
+    """An HTML fragment: the plan's status and the vehicles table (a notebook's view of a plan).
+
+    Examples
+    --------
+    >>> render_overview({"stage": "preplan", "vehicles": []})[:40]
+    '<p><span class="status info">stopped aft'
+    """
+    status, status_class = _status(summary)
+    return "\n".join(
+        [f'<p><span class="status {status_class}">{_text(status)}</span></p>', _vehicles(summary)]
+    )
+
+
 def _status(summary: Mapping[str, Any]) -> tuple[str, str]:
     """The headline and its CSS class: the plan status, or the stage the run stopped after."""
     optimization = summary.get("optimization")
@@ -115,7 +128,7 @@ def _warnings(summary: Mapping[str, Any]) -> list[str]:
     return ["<h2>Warnings</h2>", f'<ul class="warnings">{items}</ul>']
 
 
-def _vehicles(summary: Mapping[str, Any]) -> list[str]:
+def _vehicles(summary: Mapping[str, Any]) -> str:
     optimized = (summary.get("optimization") or {}).get("vehicles", {})
     rows = []
     for vehicle in summary.get("vehicles", []):
@@ -145,7 +158,7 @@ def _vehicles(summary: Mapping[str, Any]) -> list[str]:
     )  # fmt: skip
     formats = (str, str, _fixed(2), _fixed(3), _fixed(2), _fixed(2), str, _fixed(1), _fixed(1),
                _fixed(1), _fixed(1))  # fmt: skip
-    return ["<h2>Vehicles</h2>", _table(headers, rows, formats)]
+    return _table(headers, rows, formats)
 
 
 def _closest(separations: Mapping[str, float | None]) -> str | None:
@@ -315,4 +328,4 @@ def _text(value: Any) -> str:
     return html.escape(str(value), quote=True)
 
 
-__all__ = ["render_report"]
+__all__ = ["render_overview", "render_report"]

@@ -19,7 +19,7 @@ from auvplan._typing import FloatArray
 from auvplan.terrain.grid import BathymetryGrid
 from auvplan.vehicle import STATE_NAMES
 from auvplan.viz.geography import add_geographic_axes
-from auvplan.viz.style import pair_colors, plain_tick_labels, vehicle_colors
+from auvplan.viz.style import lighter, pair_colors, plain_tick_labels, vehicle_colors
 
 
 def plot_mission_paths(
@@ -45,7 +45,8 @@ def plot_mission_paths(
     names : sequence of str
         Vehicle names.
     planned : sequence of ndarray of shape (n_i, 2)
-        Pre-planned paths, ``north, east`` [m] (drawn dashed, in the vehicle's colour).
+        Pre-planned paths, ``north, east`` [m] (drawn dashed, in a light shade of the
+        vehicle's colour, over the trajectories).
     optimized : sequence of ndarray of shape (n_t, 2) or None
         Optimised trajectories (solid, per-vehicle colour), with start/goal markers and safety
         circles of radius ``safety_radius`` at both ends.
@@ -63,7 +64,8 @@ def plot_mission_paths(
     axes = figure.add_subplot()
     g = bathymetry.geometry
     field = bathymetry.depth if background is None else background
-    mesh = axes.pcolormesh(g.east, g.north, field, cmap=cmap, shading="nearest")
+    # the grid as an image inside vector (SVG/PDF) files: small files, vector lines and text
+    mesh = axes.pcolormesh(g.east, g.north, field, cmap=cmap, shading="nearest", rasterized=True)
     figure.colorbar(mesh, ax=axes, label=background_label, shrink=0.85)
     if background is None:
         finite = bathymetry.depth[np.isfinite(bathymetry.depth)]
@@ -72,10 +74,10 @@ def plot_mission_paths(
                          linewidths=0.4, alpha=0.5)  # fmt: skip
     colors = vehicle_colors(len(names))
     for k, (name, path) in enumerate(zip(names, planned, strict=True)):
-        axes.plot(path[:, 1], path[:, 0], "--", color=colors[k], lw=1.4, alpha=0.9,
+        axes.plot(path[:, 1], path[:, 0], "--", color=lighter(colors[k]), lw=1.5, zorder=3,
                   label=f"{name} pre-planned" if optimized is None else None)  # fmt: skip
     if optimized is not None:
-        axes.plot([], [], "--", color="0.4", lw=1.4, label="pre-planned (dashed)")
+        axes.plot([], [], "--", color="0.6", lw=1.5, label="pre-planned (dashed)")
         for k, (name, track) in enumerate(zip(names, optimized, strict=True)):
             axes.plot(track[:, 1], track[:, 0], "-", color=colors[k], lw=2.0, label=name)
             for point, marker in ((track[0], "o"), (track[-1], "*")):

@@ -105,8 +105,9 @@ def _draw_map(
 ) -> None:
     geometry = bathymetry.geometry
     mesh = axes.pcolormesh(
-        geometry.east, geometry.north, bathymetry.depth, cmap="viridis_r", shading="nearest"
-    )
+        geometry.east, geometry.north, bathymetry.depth, cmap="viridis_r", shading="nearest",
+        rasterized=True,
+    )  # fmt: skip
     axes.figure.colorbar(mesh, ax=axes, label="depth [m]", shrink=0.9)
     for name, result in evaluation.results.items():
         color = colors[names.index(name)]

@@ -15,12 +15,15 @@ from typing import Final
 import numpy as np
 from matplotlib import colormaps
 from matplotlib.axis import Axis
-from matplotlib.colors import to_hex
+from matplotlib.colors import to_hex, to_rgb
 from matplotlib.figure import Figure
 from matplotlib.ticker import LogFormatter, LogFormatterSciNotation, ScalarFormatter
 
-#: Up to ten vehicles: matplotlib's ``tab10`` in its order (blue, orange, green, red, ...).
+#: Up to ten vehicles: matplotlib's ``tab10`` in this order (blue, green, orange, purple, red,
+#: brown, pink, grey, olive, cyan), so that the example missions' vehicles, named after
+#: colours in that order, are drawn in their colours.
 _FEW: Final = "tab10"
+_FEW_ORDER: Final = (0, 2, 1, 4, 3, 5, 6, 7, 8, 9)
 #: Eleven to twenty vehicles: ``tab20``, the strong shades first, then the light ones.
 _MORE: Final = "tab20"
 #: More than twenty: evenly spaced hues of ``turbo``.
@@ -47,19 +50,31 @@ def vehicle_colors(n_vehicles: int) -> tuple[str, ...]:
 
     Examples
     --------
-    >>> vehicle_colors(2)
-    ('#1f77b4', '#ff7f0e')
+    >>> vehicle_colors(2)  # tab:blue, tab:green
+    ('#1f77b4', '#2ca02c')
     >>> len(set(vehicle_colors(64)))
     64
     """
     if n_vehicles <= 10:
-        values = [colormaps[_FEW](index) for index in range(n_vehicles)]
+        values = [colormaps[_FEW](index) for index in _FEW_ORDER[:n_vehicles]]
     elif n_vehicles <= 20:
         order = [*range(0, 20, 2), *range(1, 20, 2)]  # strong shades before light ones
         values = [colormaps[_MORE](index) for index in order[:n_vehicles]]
     else:
         values = [colormaps[_MANY](value) for value in np.linspace(0.05, 0.95, n_vehicles)]
     return tuple(to_hex(value) for value in values)
+
+
+def lighter(color: str, amount: float = 0.55) -> str:
+    """``color`` mixed with white by ``amount`` in ``[0, 1]`` (a vehicle's secondary shade).
+
+    Examples
+    --------
+    >>> lighter("#000000", 0.5)
+    '#808080'
+    """
+    red, green, blue = to_rgb(color)
+    return to_hex(tuple(c + amount * (1.0 - c) for c in (red, green, blue)))
 
 
 def pair_colors(n_pairs: int) -> tuple[str, ...]:
@@ -117,4 +132,4 @@ def _plain(axis: Axis) -> None:
         axis.set_major_formatter(plain)
 
 
-__all__ = ["pair_colors", "plain_tick_labels", "vehicle_colors"]
+__all__ = ["lighter", "pair_colors", "plain_tick_labels", "vehicle_colors"]
