@@ -73,8 +73,8 @@ def lighter(color: str, amount: float = 0.55) -> str:
     >>> lighter("#000000", 0.5)
     '#808080'
     """
-    red, green, blue = to_rgb(color)
-    return to_hex(tuple(c + amount * (1.0 - c) for c in (red, green, blue)))
+    red, green, blue = (c + amount * (1.0 - c) for c in to_rgb(color))
+    return to_hex((red, green, blue))
 
 
 def pair_colors(n_pairs: int) -> tuple[str, ...]:
