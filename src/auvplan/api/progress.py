@@ -162,7 +162,9 @@ class ConsoleProgress:
     def _advance(self, stage: _Stage, label: str) -> None:
         stage.done += 1
         if self._display is not None and stage.task is not None:
-            self._display.update(stage.task, completed=stage.done, description=f"{stage.name}")
+            self._display.update(
+                stage.task, completed=stage.done, description=f"{stage.name} {label}"
+            )
             return
         total = stage.total
         if total is None:
