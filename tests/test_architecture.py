@@ -1,5 +1,6 @@
 """Dependency direction (STYLE B1): core packages never import cli or viz, and
-terrain <- planning <- deconfliction; vehicle <- optimization; mission -> everything."""
+terrain <- planning <- deconfliction; vehicle <- optimization; mission -> everything;
+api (the notebook API: mission + viz) is imported only by cli and users."""
 
 from __future__ import annotations
 
@@ -12,12 +13,30 @@ SRC = Path(__file__).parents[1] / "src" / "auvplan"
 
 # package -> auvplan subpackages it must NOT import
 FORBIDDEN = {
-    "terrain": {"planning", "deconfliction", "vehicle", "optimization", "mission", "cli", "viz"},
-    "planning": {"deconfliction", "vehicle", "optimization", "mission", "cli", "viz"},
-    "deconfliction": {"vehicle", "optimization", "mission", "cli", "viz"},
-    "vehicle": {"terrain", "planning", "deconfliction", "optimization", "mission", "cli", "viz"},
-    "optimization": {"terrain", "planning", "deconfliction", "mission", "cli", "viz"},
-    "io": {"mission", "cli", "viz", "optimization", "export"},
+    "terrain": {
+        "planning",
+        "deconfliction",
+        "vehicle",
+        "optimization",
+        "mission",
+        "cli",
+        "viz",
+        "api",
+    },
+    "planning": {"deconfliction", "vehicle", "optimization", "mission", "cli", "viz", "api"},
+    "deconfliction": {"vehicle", "optimization", "mission", "cli", "viz", "api"},
+    "vehicle": {
+        "terrain",
+        "planning",
+        "deconfliction",
+        "optimization",
+        "mission",
+        "cli",
+        "viz",
+        "api",
+    },
+    "optimization": {"terrain", "planning", "deconfliction", "mission", "cli", "viz", "api"},
+    "io": {"mission", "cli", "viz", "optimization", "export", "api"},
     "export": {
         "planning",
         "deconfliction",
@@ -27,8 +46,9 @@ FORBIDDEN = {
         "scenarios",
         "cli",
         "viz",
+        "api",
     },
-    "mission": {"cli", "viz", "scenarios"},
+    "mission": {"cli", "viz", "scenarios", "api"},
     "navigation": {
         "planning",
         "deconfliction",
@@ -38,10 +58,12 @@ FORBIDDEN = {
         "cli",
         "viz",
         "io",
+        "api",
     },
-    "scenarios": {"optimization", "mission", "cli", "viz"},
-    "sweep": {"cli", "viz"},
-    "viz": {"cli"},
+    "scenarios": {"optimization", "mission", "cli", "viz", "api"},
+    "sweep": {"cli", "viz", "api"},
+    "viz": {"cli", "api"},
+    "api": {"cli"},
 }
 
 

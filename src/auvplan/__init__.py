@@ -4,19 +4,83 @@ Implements (and extends) Häusler, Saccon, Pascoal, Hauser & Aguiar, "Cooperativ
 planning using terrain information", OCEANS 2013: terrain-information maps and A* pre-planning,
 temporal deconfliction in the coordination space, and PRONTO trajectory optimisation of the
 MEDUSA vehicle model with approximate-barrier collision constraints.
+
+The common tasks need only this namespace::
+
+    import auvplan
+
+    plan = auvplan.plan("mission.toml")      # or a MissionConfig, a dict, auvplan.demo_mission()
+    plan.status                              # "CONVERGED", ...
+    plan.to_xarray()                         # trajectories.nc as an xarray Dataset
+    plan.to_dataframe()                      # long format: vehicle, time, t, north, east, ...
+    plan.plot()                              # the mission figure
+    plan.summary                             # summary.json as a dict
+    plan.save("out/run1")                    # the output folder of `auvplan plan`
+    auvplan.load("out/run1")                 # open a folder again
+
+The names are imported on first use, so ``import auvplan`` (and the command line) stays fast.
 """
 
 from __future__ import annotations
 
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from auvplan.errors import AuvplanError, DataFormatError, InfeasibleError, InputError, SolverError
 
 __version__ = "0.1.0"
+
+#: Public name -> the module that defines it (imported on first access).
+_LAZY = {
+    "MissionPlan": "auvplan.api.result",
+    "load": "auvplan.api.result",
+    "plan": "auvplan.api.result",
+    "MissionConfig": "auvplan.mission.config",
+    "demo_mission": "auvplan.mission.config",
+    "load_mission": "auvplan.mission.config",
+    "parse_mission": "auvplan.mission.config",
+    "MissionResult": "auvplan.mission.pipeline",
+    "Stage": "auvplan.mission.pipeline",
+    "run_mission": "auvplan.mission.pipeline",
+    "read_bathymetry": "auvplan.io.bathymetry",
+}
+
+if TYPE_CHECKING:
+    from auvplan.api.result import MissionPlan, load, plan
+    from auvplan.io.bathymetry import read_bathymetry
+    from auvplan.mission.config import MissionConfig, demo_mission, load_mission, parse_mission
+    from auvplan.mission.pipeline import MissionResult, Stage, run_mission
 
 __all__ = [
     "AuvplanError",
     "DataFormatError",
     "InfeasibleError",
     "InputError",
+    "MissionConfig",
+    "MissionPlan",
+    "MissionResult",
     "SolverError",
+    "Stage",
     "__version__",
+    "demo_mission",
+    "load",
+    "load_mission",
+    "parse_mission",
+    "plan",
+    "read_bathymetry",
+    "run_mission",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name of :data:`__all__` on first use (PEP 562)."""
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'auvplan' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

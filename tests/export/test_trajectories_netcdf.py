@@ -9,7 +9,12 @@ import numpy as np
 import xarray as xr
 from pyproj import Proj
 
-from auvplan.io.trajectories_file import SERIES, true_heading, write_trajectories_netcdf
+from auvplan.io.trajectories_file import (
+    SERIES,
+    read_trajectories_netcdf,
+    trajectories_dataset,
+    true_heading,
+)
 from auvplan.terrain import LocalProjection
 
 from ._readers import cf_findings
@@ -38,10 +43,13 @@ def test_without_georeference_the_file_has_no_lat_lon_and_is_still_cf(tmp_path: 
     psi = rng.uniform(-np.pi, np.pi, size=(2, time.size))
     path = tmp_path / "trajectories.nc"
     start = datetime(2026, 5, 1, 8, 0, 0, 500000, tzinfo=UTC)
-    write_trajectories_netcdf(
-        path, ["a", "b c"], time, series, psi=psi, start_time=start, depth=0.0, projection=None,
+    built = trajectories_dataset(
+        ["a", "b c"], time, series, psi=psi, start_time=start, depth=0.0, projection=None,
         attributes={"history": "test"},
     )  # fmt: skip
+    built.to_netcdf(path)
+    # the in-memory dataset is the file as read back (values, coordinates, attributes)
+    xr.testing.assert_identical(read_trajectories_netcdf(path), built)
     findings = cf_findings(path, tmp_path / "cf.json")
     assert findings["high"] == [], findings
     assert findings["medium"] == [], findings

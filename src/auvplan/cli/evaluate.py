@@ -3,8 +3,9 @@
 Reads ``maps.nc`` and ``trajectories.csv`` (and ``trajectories_energy_only.csv`` when the plan
 was run with ``--compare-energy-only``) from the folder of ``auvplan plan``/``demo``, runs
 Monte-Carlo particle-filter navigation along every vehicle's track and writes
-``navigation.json`` and ``navigation.png`` into the same folder, all-or-nothing
-(:func:`auvplan.io.output.staged_output_dir`: the folder's other files are kept).
+``navigation.json`` and ``navigation.png`` (or ``.svg``/``.pdf``: ``--figure-format``) into the
+same folder, all-or-nothing (:func:`auvplan.io.output.staged_output_dir`: the folder's other
+files are kept).
 """
 
 from __future__ import annotations
@@ -16,6 +17,8 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
+
+from auvplan.cli.figure_options import add_figure_options
 
 
 def register(subparsers: argparse._SubParsersAction[Any]) -> None:
@@ -64,6 +67,7 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
         "MB-System's rule)",
     )
     parser.add_argument("--no-figure", action="store_true", help="write navigation.json only")
+    add_figure_options(parser)
     parser.set_defaults(run=run)
 
 
@@ -114,14 +118,20 @@ def run(args: argparse.Namespace) -> int:
     figure = None
     if not args.no_figure:
         from auvplan.viz.navigation import plot_navigation
+        from auvplan.viz.report import render_figure
 
-        figure = plot_navigation(folder.bathymetry, evaluations)
+        figure = render_figure(
+            plot_navigation(folder.bathymetry, evaluations),
+            figure_format=args.figure_format,
+            dpi=args.dpi,
+        )
     with staged_output_dir(args.output) as staging:
         write_json(document, staging / "navigation.json")
         written = [args.output / "navigation.json"]
         if figure is not None:
-            figure.savefig(staging / "navigation.png", dpi=110)
-            written.append(args.output / "navigation.png")
+            figure_name = f"navigation.{args.figure_format}"
+            (staging / figure_name).write_bytes(figure.data)
+            written.append(args.output / figure_name)
     if not args.quiet:
         _print_report(document, written)
     return 0

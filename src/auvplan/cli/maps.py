@@ -1,6 +1,7 @@
 """``auvplan maps``: terrain-information maps (paper Fig. 5) from a bathymetry file.
 
-Writes ``DIR/maps.nc`` and ``DIR/maps.png`` all-or-nothing: ``DIR`` is checked before any work
+Writes ``DIR/maps.nc`` and ``DIR/maps.png`` (or ``.svg``/``.pdf``, ``--figure-format``)
+all-or-nothing: ``DIR`` is checked before any work
 (by :mod:`auvplan.cli.main`) and replaced as a whole at the end
 (:func:`auvplan.io.output.staged_output_dir`: other files already in ``DIR`` are kept); on any
 error nothing is written.
@@ -11,6 +12,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+from auvplan.cli.figure_options import add_figure_options
 
 if TYPE_CHECKING:
     from auvplan.terrain.maps import TerrainMaps
@@ -47,6 +50,7 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
     )
     maps.add_argument("--omega", type=float, default=10.0, help="cost shift omega (> 0)")
     maps.add_argument("--w", type=float, default=10.0, dest="weight", help="cost weight w (>= 0)")
+    add_figure_options(parser)
     parser.set_defaults(run=run)
 
 
@@ -61,6 +65,7 @@ def run(args: argparse.Namespace) -> int:
     from auvplan.io.output import staged_output_dir
     from auvplan.terrain import MapParameters, compute_terrain_maps, synthetic_bank
     from auvplan.viz.maps import plot_terrain_maps
+    from auvplan.viz.report import render_figure
 
     parameters = MapParameters(
         exponent=args.exponent,
@@ -88,16 +93,17 @@ def run(args: argparse.Namespace) -> int:
             window_lon=_pair(args.window_lon),
         )
     maps = compute_terrain_maps(grid, parameters)
-    figure = plot_terrain_maps(maps)
+    figure = render_figure(plot_terrain_maps(maps), figure_format=args.figure_format, dpi=args.dpi)
+    figure_name = f"maps.{args.figure_format}"
     with staged_output_dir(args.output) as staging:
         write_maps_netcdf(maps, staging / "maps.nc")
-        figure.savefig(staging / "maps.png", dpi=120)
+        (staging / figure_name).write_bytes(figure.data)
     if not args.quiet:
-        _print_summary(maps, args.output)
+        _print_summary(maps, args.output, figure_name)
     return 0
 
 
-def _print_summary(maps: TerrainMaps, output: Path) -> None:
+def _print_summary(maps: TerrainMaps, output: Path, figure_name: str) -> None:
     import numpy as np
 
     fine, coarse = maps.bathymetry.geometry, maps.cost_geometry
@@ -113,4 +119,4 @@ def _print_summary(maps: TerrainMaps, output: Path) -> None:
         f"cost grid    {coarse.n_rows} x {coarse.n_cols} blocks of {coarse.spacing_north:.2f} m x "
         f"{coarse.spacing_east:.2f} m; shifted cost {np.nanmin(cost):.2f} … {np.nanmax(cost):.2f}"
     )
-    print(f"wrote        {output / 'maps.nc'}, {output / 'maps.png'}")
+    print(f"wrote        {output / 'maps.nc'}, {output / figure_name}")

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from auvplan.cli.export import add_export_options
+from auvplan.cli.figure_options import add_figure_options
 
 STAGES = ("preplan", "deconflict", "full")
 #: Exit code when the plan did not converge or breaks a constraint (user errors exit with 2).
@@ -51,7 +52,10 @@ def _add_common(parser: argparse.ArgumentParser, *, default_output: Path | None)
         action="store_true",
         help="also optimise without the terrain term (the energy-only reference)",
     )
-    parser.add_argument("--no-figures", action="store_true", help="write data files only")
+    parser.add_argument(
+        "--no-figures", action="store_true", help="write no figures (report.html has tables only)"
+    )
+    add_figure_options(parser)
 
 
 def run_plan(args: argparse.Namespace) -> int:
@@ -63,12 +67,9 @@ def run_plan(args: argparse.Namespace) -> int:
 
 def run_demo(args: argparse.Namespace) -> int:
     """Run the packaged demo mission."""
-    from importlib import resources
+    from auvplan.mission.config import demo_mission
 
-    from auvplan.mission.config import load_mission
-
-    with resources.as_file(resources.files("auvplan") / "data/missions/demo.toml") as path:
-        return _run(load_mission(path), args)
+    return _run(demo_mission(), args)
 
 
 def _export_formats(config: Any, args: argparse.Namespace) -> tuple[str, ...]:
@@ -90,30 +91,27 @@ def _export_formats(config: Any, args: argparse.Namespace) -> tuple[str, ...]:
 
 
 def _run(config: Any, args: argparse.Namespace) -> int:
-    from auvplan.io.output import staged_output_dir
-    from auvplan.mission.outputs import write_mission_files
-    from auvplan.mission.pipeline import Stage, run_mission
+    from auvplan.api import plan
+    from auvplan.export import DEFAULT_TOLERANCE_M
 
     formats = _export_formats(config, args)
-    result = run_mission(
-        config, stage=Stage(args.stage), compare_energy_only=args.compare_energy_only
+    mission_plan = plan(
+        config,
+        stage=args.stage,
+        compare_energy_only=args.compare_energy_only,
+        progress=not args.quiet,
     )
-    with staged_output_dir(args.output) as staging:
-        written = write_mission_files(result, staging)
-        if formats and result.plan is not None:  # from the folder, as `auvplan export` does
-            from auvplan.export import write_exports
-            from auvplan.mission.folder import load_export_plan
-
-            written += write_exports(
-                load_export_plan(staging), staging / "export", formats, tolerance=args.tolerance_m
-            )
-        if not args.no_figures:
-            from auvplan.viz.report import save_mission_figures
-
-            written += save_mission_figures(result, staging)
-        shown = [args.output / path.relative_to(staging) for path in written]
+    written = mission_plan.save(
+        args.output,
+        figures=not args.no_figures,
+        figure_format=args.figure_format,
+        dpi=args.dpi,
+        exports=formats,
+        tolerance_m=getattr(args, "tolerance_m", DEFAULT_TOLERANCE_M),  # demo: no --export
+    )
+    result = mission_plan.result
     if not args.quiet:
-        _print_report(result, shown)
+        _print_report(result, written)
     return _exit_code(result)
 
 

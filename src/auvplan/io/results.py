@@ -32,18 +32,29 @@ DESIRED_COLUMNS = ("vehicle", "t", "north", "east", "psi")
 
 def write_json(data: Mapping[str, Any], path: Path) -> None:
     """Write ``data`` as indented JSON; numpy scalars/arrays become numbers/lists, NaN -> null."""
-    path.write_text(json.dumps(_plain(data), indent=2, allow_nan=False) + "\n", encoding="utf-8")
+    text = json.dumps(json_values(data), indent=2, allow_nan=False)
+    path.write_text(text + "\n", encoding="utf-8")
 
 
-def _plain(value: Any) -> Any:
+def json_values(value: Any) -> Any:
+    """``value`` as plain JSON values, as :func:`write_json` writes and ``json.load`` reads it.
+
+    Mappings become dicts with string keys, tuples and arrays lists, numpy scalars Python
+    numbers, and NaN or infinite floats ``None``.
+
+    Examples
+    --------
+    >>> json_values({1: (np.float64(0.5), np.array([1, 2])), "x": float("inf")})
+    {'1': [0.5, [1, 2]], 'x': None}
+    """
     if isinstance(value, Mapping):
-        return {str(key): _plain(item) for key, item in value.items()}
+        return {str(key): json_values(item) for key, item in value.items()}
     if isinstance(value, np.ndarray):
-        return _plain(value.tolist())
+        return json_values(value.tolist())
     if isinstance(value, list | tuple):
-        return [_plain(item) for item in value]
+        return [json_values(item) for item in value]
     if isinstance(value, np.generic):
-        return _plain(value.item())
+        return json_values(value.item())
     if isinstance(value, float) and not math.isfinite(value):
         return None
     return value

@@ -100,8 +100,7 @@ def true_heading(
     return np.mod(np.asarray(azimuth, dtype=np.float64), 360.0)
 
 
-def write_trajectories_netcdf(
-    path: Path,
+def trajectories_dataset(
     names: Sequence[str],
     time: FloatArray,
     series: Mapping[str, FloatArray],
@@ -111,13 +110,15 @@ def write_trajectories_netcdf(
     depth: float,
     projection: LocalProjection | None,
     attributes: Mapping[str, Any],
-) -> None:
-    """Write ``trajectories.nc`` (see the module notes for its variables).
+) -> xr.Dataset:
+    """The content of ``trajectories.nc`` as :func:`read_trajectories_netcdf` returns it.
+
+    ``time`` is decoded (UTC ``datetime64``); the CF encoding of the file (time units, no fill
+    values, the vehicle names as characters) is kept in each variable's ``encoding``, so that
+    ``dataset.to_netcdf(path)`` writes ``trajectories.nc``.
 
     Parameters
     ----------
-    path : Path
-        Output file.
     names : sequence of str
         Vehicle names, length ``n_vehicles``.
     time : ndarray of shape (n_t,)
@@ -131,9 +132,14 @@ def write_trajectories_netcdf(
     depth : float
         Constant depth [m] of the plan.
     projection : LocalProjection or None
-        Local frame to WGS 84; ``None`` writes no ``lat``/``lon``.
+        Local frame to WGS 84; ``None`` gives no ``lat``/``lon``.
     attributes : mapping
         Extra global attributes (strings or numbers).
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions ``trajectory`` (vehicles) and ``obs`` (samples); see the module notes.
     """
     import xarray as xr
 
@@ -141,7 +147,8 @@ def write_trajectories_netcdf(
     shape = (n_vehicles, n_t)
     dims = ("trajectory", "obs")
     north, east = series["north"], series["east"]
-    epoch = start_time.strftime("%Y-%m-%dT%H:%M:%S.%fZ")
+    epoch = np.datetime64(start_time.replace(tzinfo=None), "ns")
+    offsets = np.rint(np.asarray(time, dtype=np.float64) * 1e9).astype("timedelta64[ns]")
     coords: dict[str, Any] = {
         "trajectory": (
             "trajectory",
@@ -150,14 +157,8 @@ def write_trajectories_netcdf(
         ),
         "time": (
             dims,
-            np.broadcast_to(time, shape).copy(),
-            {
-                "standard_name": "time",
-                "long_name": "time (UTC)",
-                "units": f"seconds since {epoch}",
-                "calendar": "standard",
-                "axis": "T",
-            },
+            np.broadcast_to(epoch + offsets, shape).copy(),
+            {"standard_name": "time", "long_name": "time (UTC)", "axis": "T"},
         ),
         "depth": (
             dims,
@@ -198,11 +199,15 @@ def write_trajectories_netcdf(
         "time_coverage_start": start_time.isoformat(),
         **attributes,
     }
-    encoding: dict[str, dict[str, Any]] = {
-        name: {"_FillValue": None} for name in [*dataset.data_vars, *dataset.coords]
-    }
-    encoding["trajectory"] = {"dtype": "S1", "char_dim_name": "name_strlen"}
-    dataset.to_netcdf(path, encoding=encoding)
+    for variable in dataset.variables.values():
+        variable.encoding["_FillValue"] = None
+    dataset["trajectory"].encoding.update(dtype="S1", char_dim_name="name_strlen")
+    dataset["time"].encoding.update(
+        units=f"seconds since {start_time.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}",
+        calendar="standard",
+        dtype="float64",
+    )
+    return dataset
 
 
 def read_trajectories_netcdf(path: Path) -> xr.Dataset:
@@ -227,4 +232,9 @@ def read_trajectories_netcdf(path: Path) -> xr.Dataset:
     return loaded
 
 
-__all__ = ["SERIES", "read_trajectories_netcdf", "true_heading", "write_trajectories_netcdf"]
+__all__ = [
+    "SERIES",
+    "read_trajectories_netcdf",
+    "trajectories_dataset",
+    "true_heading",
+]

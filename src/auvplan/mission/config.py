@@ -127,6 +127,20 @@ def load_mission(path: Path | str) -> MissionConfig:
     return parse_mission(read_toml(path, what="mission file"), base_dir=path.parent, source=path)
 
 
+def demo_mission() -> MissionConfig:
+    """The packaged demo mission (``auvplan demo``): the paper's scenario on the synthetic bank.
+
+    Examples
+    --------
+    >>> [vehicle.name for vehicle in demo_mission().vehicles]
+    ['blue', 'green']
+    """
+    from importlib import resources
+
+    with resources.as_file(resources.files("auvplan") / "data/missions/demo.toml") as path:
+        return load_mission(path)
+
+
 def parse_mission(
     data: Mapping[str, Any], *, base_dir: Path = Path(), source: Path | None = None
 ) -> MissionConfig:
@@ -254,6 +268,7 @@ __all__ = [
     "VehicleConfig",
     "WeightsConfig",
     "WindowConfig",
+    "demo_mission",
     "load_mission",
     "parse_mission",
     "resolved_document",

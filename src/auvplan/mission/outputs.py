@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -15,20 +17,26 @@ from auvplan.io.results import (
     write_trajectories_csv,
 )
 from auvplan.io.text import write_toml
-from auvplan.io.trajectories_file import SERIES, write_trajectories_netcdf
+from auvplan.io.trajectories_file import SERIES, trajectories_dataset
 from auvplan.mission.config import resolved_document
 from auvplan.mission.evaluation import OptimizedPlan
 from auvplan.mission.pipeline import MissionResult
 from auvplan.mission.summary import mission_summary
 from auvplan.vehicle import headings, positions
 
+if TYPE_CHECKING:
+    import xarray as xr
 
-def write_mission_files(result: MissionResult, directory: Path) -> list[Path]:
+
+def write_mission_files(
+    result: MissionResult, directory: Path, *, warnings: Sequence[str] = ()
+) -> list[Path]:
     """Write the mission's data files into ``directory`` and return their paths.
 
-    Always ``summary.json``, ``mission.toml`` (the resolved mission: ``auvplan plan`` of it
-    reruns the mission), ``maps.nc`` and ``paths.geojson``; after deconfliction
-    ``desired.csv``; after optimisation ``trajectories.csv`` and ``trajectories.nc`` (and
+    Always ``summary.json`` (with ``warnings``, the warnings logged during the run),
+    ``mission.toml`` (the resolved mission: ``auvplan plan`` of it reruns the mission),
+    ``maps.nc`` and ``paths.geojson``; after deconfliction ``desired.csv``; after
+    optimisation ``trajectories.csv`` and ``trajectories.nc`` (and
     ``trajectories_energy_only.csv``/``.nc`` when the comparison was run).
     """
     preplan = result.preplan
@@ -39,7 +47,7 @@ def write_mission_files(result: MissionResult, directory: Path) -> list[Path]:
         directory / "maps.nc",
         directory / "paths.geojson",
     ]
-    write_json(mission_summary(result), written[0])
+    write_json(mission_summary(result, warnings=warnings), written[0])
     source = result.config.source
     write_toml(
         resolved_document(result.config),
@@ -74,13 +82,18 @@ def write_mission_files(result: MissionResult, directory: Path) -> list[Path]:
             write_trajectories_csv(
                 csv_path, names, stage2.time, plan.states, plan.inputs, np.asarray(plan.power)
             )
-            _write_trajectories_netcdf(result, plan, netcdf_path)
+            plan_dataset(result, plan).to_netcdf(netcdf_path)
             written += [csv_path, netcdf_path]
     return written
 
 
-def _write_trajectories_netcdf(result: MissionResult, plan: OptimizedPlan, path: Path) -> None:
-    """``trajectories.nc`` of one optimised plan (:mod:`auvplan.io.trajectories_file`)."""
+def plan_dataset(result: MissionResult, plan: OptimizedPlan) -> xr.Dataset:
+    """``trajectories.nc`` of one optimised plan of ``result``, in memory.
+
+    The dataset of :func:`auvplan.io.trajectories_file.trajectories_dataset`: what
+    :func:`~auvplan.io.trajectories_file.read_trajectories_netcdf` reads back from the file
+    that :func:`write_mission_files` writes.
+    """
     assert result.deconfliction is not None  # a plan exists only after stage 2
     models = result.deconfliction.layout.models
     series = {
@@ -89,8 +102,7 @@ def _write_trajectories_netcdf(result: MissionResult, plan: OptimizedPlan, path:
         if name != "power"
     }
     psi = np.stack([headings(model, plan.states[i]) for i, model in enumerate(models)])
-    write_trajectories_netcdf(
-        path,
+    return trajectories_dataset(
         result.preplan.names,
         result.deconfliction.time,
         {**series, "power": np.asarray(plan.power)},

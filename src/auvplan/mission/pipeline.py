@@ -32,6 +32,7 @@ from auvplan.mission.config import MissionConfig
 from auvplan.mission.evaluation import OptimizedPlan, evaluate_plan
 from auvplan.mission.fleet import FleetLayout
 from auvplan.mission.preplan import PreplanStage, run_preplan
+from auvplan.mission.progress import ProgressReporter, no_progress
 from auvplan.mission.timing import DeconflictStage, run_deconfliction
 from auvplan.optimization import solve_pronto
 from auvplan.vehicle import VehicleModel, build_vehicle_model, top_speed
@@ -71,6 +72,7 @@ def run_mission(
     stage: Stage = Stage.FULL,
     compare_energy_only: bool = False,
     callback: Callable[[Any], None] | None = None,
+    progress: ProgressReporter = no_progress,
 ) -> MissionResult:
     """Run the pipeline on a validated mission up to ``stage``.
 
@@ -84,16 +86,20 @@ def run_mission(
         Also optimise with the terrain weight set to 0 (the paper's energy-only reference).
     callback : callable, optional
         Passed to :func:`auvplan.optimization.solve_pronto` (per-iteration records).
+    progress : ProgressReporter
+        Told of each stage (by its ``timings`` name) and of each vehicle's A* search
+        (:mod:`auvplan.mission.progress`).
     """
     timings: dict[str, float] = {}
 
     def timed(name: str, work: Callable[[], Any]) -> Any:
         started = wallclock.perf_counter()
-        value = work()
+        with progress(name):
+            value = work()
         timings[name] = wallclock.perf_counter() - started
         return value
 
-    preplan = timed("preplan", lambda: run_preplan(config))
+    preplan = timed("preplan", lambda: run_preplan(config, progress=progress))
     if stage is Stage.PREPLAN:
         return MissionResult(config, stage, preplan, timings=timings)
 

@@ -19,6 +19,7 @@ from auvplan.mission.config import (
     Position,
     TerrainConfig,
 )
+from auvplan.mission.progress import ProgressReporter, no_progress
 from auvplan.planning import (
     CircleObstacle,
     EdgeModel,
@@ -133,40 +134,52 @@ def plan_routes(
     *,
     clearance: float,
     planner: PlannerConfig,
+    progress: ProgressReporter = no_progress,
 ) -> tuple[tuple[Route, ...], tuple[FloatArray, ...]]:
-    """One A* route per vehicle on the shifted cost map, and its smoothed curve."""
+    """One A* route per vehicle on the shifted cost map, and its smoothed curve.
+
+    ``progress`` is told of each vehicle's search (stage ``"A*"``, one unit per vehicle).
+    """
     geometry = maps.cost_geometry
     cell = min(geometry.spacing_north, geometry.spacing_east)
     blocked = blocked_cells(maps.shifted_cost, geometry, obstacles=obstacles, clearance=clearance)
     is_blocked = blocked_lookup(geometry, blocked)
     routes, paths = [], []
-    for index, name in enumerate(names):
-        route = plan_route(
-            maps.shifted_cost,
-            geometry,
-            (float(starts[index, 0]), float(starts[index, 1])),
-            (float(goals[index, 0]), float(goals[index, 1])),
-            obstacles=obstacles,
-            clearance=clearance,
-            edge_model=EdgeModel(planner.edge_model),
-            name=name,
-        )
-        routes.append(route)
-        # within half a cell of the route, never through a no-go cell
-        paths.append(
-            smooth_path(
-                route.points, spacing=0.25 * cell, max_deviation=0.5 * cell, is_blocked=is_blocked
+    with progress("A*", total=len(names)) as advance:
+        for index, name in enumerate(names):
+            route = plan_route(
+                maps.shifted_cost,
+                geometry,
+                (float(starts[index, 0]), float(starts[index, 1])),
+                (float(goals[index, 0]), float(goals[index, 1])),
+                obstacles=obstacles,
+                clearance=clearance,
+                edge_model=EdgeModel(planner.edge_model),
+                name=name,
             )
-        )
-        logger.info(
-            "A* %s: %d cells, cost %.1f, %d expanded", name, len(route.cells), route.cost,
-            route.n_expanded,
-        )  # fmt: skip
+            routes.append(route)
+            # within half a cell of the route, never through a no-go cell
+            paths.append(
+                smooth_path(
+                    route.points,
+                    spacing=0.25 * cell,
+                    max_deviation=0.5 * cell,
+                    is_blocked=is_blocked,
+                )
+            )
+            logger.info(
+                "A* %s: %d cells, cost %.1f, %d expanded", name, len(route.cells), route.cost,
+                route.n_expanded,
+            )  # fmt: skip
+            advance(name)
     return tuple(routes), tuple(paths)
 
 
-def run_preplan(config: MissionConfig) -> PreplanStage:
-    """Stage 1: load terrain, compute the maps, resolve poses, plan and smooth A* routes."""
+def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progress) -> PreplanStage:
+    """Stage 1: load terrain, compute the maps, resolve poses, plan and smooth A* routes.
+
+    ``progress`` is told of each vehicle's A* search (:func:`plan_routes`).
+    """
     bathymetry = load_terrain(config.terrain)
     maps = compute_maps(bathymetry, config.maps)
     logger.info(
@@ -191,7 +204,7 @@ def run_preplan(config: MissionConfig) -> PreplanStage:
     obstacles, obstacle_names = resolve_obstacles(config, bathymetry)
     routes, paths = plan_routes(
         maps, names, starts, goals, obstacles,
-        clearance=config.fleet.safety_radius, planner=config.planner,
+        clearance=config.fleet.safety_radius, planner=config.planner, progress=progress,
     )  # fmt: skip
     return PreplanStage(
         bathymetry=bathymetry,

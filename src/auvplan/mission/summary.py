@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from enum import Enum
 from importlib.resources.abc import Traversable
 from pathlib import Path
@@ -107,8 +108,12 @@ def _inputs(config: MissionConfig) -> dict[str, Any]:
     }
 
 
-def mission_summary(result: MissionResult) -> dict[str, Any]:
-    """Build the ``summary.json`` document of a mission run."""
+def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> dict[str, Any]:
+    """Build the ``summary.json`` document of a mission run.
+
+    ``warnings`` are the warnings logged during the run (one line each), kept under
+    ``"warnings"``.
+    """
     config = result.config
     preplan = result.preplan
     maps = preplan.maps
@@ -141,6 +146,7 @@ def mission_summary(result: MissionResult) -> dict[str, Any]:
         "solver": {**config.solver.model_dump(), "propeller_order": config.solver.harmonics},
         "vehicles": [],
         "wall_time_s": dict(result.timings),
+        "warnings": list(warnings),
     }
     for i, name in enumerate(preplan.names):
         route = preplan.routes[i]

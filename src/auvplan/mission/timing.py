@@ -185,7 +185,7 @@ def run_deconfliction(
         coordination.method,
         f", {coordination.fallback}" if coordination.fallback else "",
         horizon,
-        ", ".join(f"{delay:.1f}" for delay in coordination.delays),
+        ", ".join(f"{delay:.1f}" for delay in np.round(coordination.delays, 1) + 0.0),  # no -0.0
         coordination.certificate.min_separation,
     )
     return DeconflictStage(layout, horizon, dt, speeds, problem, coordination, time, desired)

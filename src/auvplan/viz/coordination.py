@@ -12,6 +12,7 @@ from auvplan.deconfliction import (
     timed_positions,
 )
 from auvplan.errors import InputError
+from auvplan.viz.style import pair_colors, plain_tick_labels, vehicle_colors
 
 #: Raster resolution of the shaded collision region (samples per axis).
 REGION_SAMPLES = 400
@@ -86,7 +87,7 @@ def plot_coordination_space(
     )
     ax.title.set_fontsize("small")
     ax.legend(loc="upper left", fontsize="small")
-    return figure
+    return plain_tick_labels(figure)
 
 
 def plot_timed_paths(
@@ -119,7 +120,7 @@ def plot_timed_paths(
     """
     figure = Figure(figsize=(width_inches, 0.45 * width_inches), layout="constrained")
     ax_map, ax_sep = figure.subplots(1, 2)
-    colors = [f"C{i % 10}" for i in range(problem.n_vehicles)]
+    colors = vehicle_colors(problem.n_vehicles)
     snapshots = np.linspace(0.0, result.time[-1], n_snapshots)
     marks = timed_positions(result, problem, snapshots)
     critical = timed_positions(result, problem, np.array([result.min_separation_time]))[:, 0]
@@ -154,14 +155,16 @@ def plot_timed_paths(
     ax_map.legend(fontsize="small")
     fine = result.time if result.time.size <= 20_000 else np.linspace(0, result.time[-1], 20_000)
     positions = timed_positions(result, problem, fine)
-    for i in range(problem.n_vehicles):
-        for j in range(i + 1, problem.n_vehicles):
-            ax_sep.plot(
-                fine,
-                np.hypot(*(positions[i] - positions[j]).T),
-                lw=1,
-                label=f"{problem.label(i)}–{problem.label(j)}" if problem.n_vehicles <= 6 else None,
-            )
+    n = problem.n_vehicles
+    pairs = [(i, j) for i in range(n) for j in range(i + 1, n)]
+    for (i, j), color in zip(pairs, pair_colors(len(pairs)), strict=True):
+        ax_sep.plot(
+            fine,
+            np.hypot(*(positions[i] - positions[j]).T),
+            lw=1,
+            color=color,
+            label=f"{problem.label(i)}–{problem.label(j)}" if n <= 6 else None,
+        )
     ax_sep.axhline(problem.separation, color="tab:red", lw=1.5, label="2 $r_c$")
     ax_sep.plot(
         [result.min_separation_time],
@@ -178,7 +181,7 @@ def plot_timed_paths(
     )
     ax_sep.title.set_fontsize("small")
     ax_sep.legend(fontsize="small", ncols=2)
-    return figure
+    return plain_tick_labels(figure)
 
 
 def _circle(center: np.ndarray, radius: float) -> np.ndarray:

@@ -10,6 +10,8 @@ from matplotlib.figure import Figure
 from auvplan._typing import FloatArray
 from auvplan.terrain.grid import GridGeometry
 from auvplan.terrain.maps import TerrainMaps
+from auvplan.viz.geography import add_geographic_axes
+from auvplan.viz.style import plain_tick_labels
 
 #: Colour of NaN (land / no-data / no-go) cells.
 LAND_COLOR = "#c8b58a"
@@ -29,8 +31,10 @@ def plot_terrain_maps(maps: TerrainMaps, *, width_inches: float = 11.0) -> Figur
     -------
     matplotlib.figure.Figure
         A 2 x 2 grid of panels with east to the right, north up, equal aspect, a colour bar
-        with units on each panel, and NaN (no-go) cells in a land colour. Created without
-        pyplot, so it never touches global state; save it with ``fig.savefig(path)``.
+        with units on each panel, and NaN (no-go) cells in a land colour; on georeferenced
+        terrain, longitude on top of the upper panels and a scale bar on the bathymetry.
+        Created without pyplot, so it never touches global state; save it with
+        ``fig.savefig(path)``.
     """
     fine, coarse = maps.bathymetry.geometry, maps.cost_geometry
     south, north = fine.north_bounds
@@ -71,7 +75,11 @@ def plot_terrain_maps(maps: TerrainMaps, *, width_inches: float = 11.0) -> Figur
         f"Terrain maps of {maps.bathymetry.name or 'the bathymetry'}: "
         f"shifted cost = {parameters.omega:g} + {parameters.weight:g} $M_C$"
     )
-    return figure
+    projection = maps.bathymetry.projection
+    if projection is not None:
+        for column, ax in enumerate(axes[0]):
+            add_geographic_axes(ax, projection, latitude=False, scale_bar=column == 0)
+    return plain_tick_labels(figure)
 
 
 def _draw(

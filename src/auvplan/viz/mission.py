@@ -1,7 +1,9 @@
 """Figures of a planned mission: the paper's Fig. 6, time series and pairwise separation.
 
-East is drawn to the right and north up, with equal aspect; all functions return a
-:class:`matplotlib.figure.Figure` and touch no global pyplot state.
+East is drawn to the right and north up, with equal aspect; on georeferenced terrain the map
+also has latitude/longitude axes and a scale bar (:mod:`auvplan.viz.geography`). Each vehicle
+has its colour of :func:`auvplan.viz.style.vehicle_colors` in every figure. All functions
+return a :class:`matplotlib.figure.Figure` and touch no global pyplot state.
 """
 
 from __future__ import annotations
@@ -16,12 +18,8 @@ from matplotlib.patches import Circle, Polygon
 from auvplan._typing import FloatArray
 from auvplan.terrain.grid import BathymetryGrid
 from auvplan.vehicle import STATE_NAMES
-
-VEHICLE_COLORS = ("tab:blue", "tab:green", "tab:orange", "tab:purple", "tab:red", "tab:brown")
-
-
-def _color(index: int) -> str:
-    return VEHICLE_COLORS[index % len(VEHICLE_COLORS)]
+from auvplan.viz.geography import add_geographic_axes
+from auvplan.viz.style import lighter, pair_colors, plain_tick_labels, vehicle_colors
 
 
 def plot_mission_paths(
@@ -47,7 +45,8 @@ def plot_mission_paths(
     names : sequence of str
         Vehicle names.
     planned : sequence of ndarray of shape (n_i, 2)
-        Pre-planned paths, ``north, east`` [m] (drawn dashed, pink as in the paper).
+        Pre-planned paths, ``north, east`` [m] (drawn dashed, in a light shade of the
+        vehicle's colour, over the trajectories).
     optimized : sequence of ndarray of shape (n_t, 2) or None
         Optimised trajectories (solid, per-vehicle colour), with start/goal markers and safety
         circles of radius ``safety_radius`` at both ends.
@@ -65,23 +64,26 @@ def plot_mission_paths(
     axes = figure.add_subplot()
     g = bathymetry.geometry
     field = bathymetry.depth if background is None else background
-    mesh = axes.pcolormesh(g.east, g.north, field, cmap=cmap, shading="nearest")
+    # the grid as an image inside vector (SVG/PDF) files: small files, vector lines and text
+    mesh = axes.pcolormesh(g.east, g.north, field, cmap=cmap, shading="nearest", rasterized=True)
     figure.colorbar(mesh, ax=axes, label=background_label, shrink=0.85)
     if background is None:
         finite = bathymetry.depth[np.isfinite(bathymetry.depth)]
         if finite.size and np.ptp(finite) > 0:
             axes.contour(g.east, g.north, bathymetry.depth, levels=12, colors="k",
                          linewidths=0.4, alpha=0.5)  # fmt: skip
-    for k, path in enumerate(planned):
-        axes.plot(path[:, 1], path[:, 0], "--", color="hotpink", lw=1.6,
-                  label="pre-planned" if k == 0 else None)  # fmt: skip
+    colors = vehicle_colors(len(names))
+    for k, (name, path) in enumerate(zip(names, planned, strict=True)):
+        axes.plot(path[:, 1], path[:, 0], "--", color=lighter(colors[k]), lw=1.5, zorder=3,
+                  label=f"{name} pre-planned" if optimized is None else None)  # fmt: skip
     if optimized is not None:
+        axes.plot([], [], "--", color="0.6", lw=1.5, label="pre-planned (dashed)")
         for k, (name, track) in enumerate(zip(names, optimized, strict=True)):
-            axes.plot(track[:, 1], track[:, 0], "-", color=_color(k), lw=2.0, label=name)
+            axes.plot(track[:, 1], track[:, 0], "-", color=colors[k], lw=2.0, label=name)
             for point, marker in ((track[0], "o"), (track[-1], "*")):
-                axes.plot(point[1], point[0], marker, color=_color(k), ms=9, mec="k")
+                axes.plot(point[1], point[0], marker, color=colors[k], ms=9, mec="k")
                 axes.add_patch(Circle((point[1], point[0]), safety_radius, fill=False,
-                                      ec=_color(k), lw=1.0))  # fmt: skip
+                                      ec=colors[k], lw=1.0))  # fmt: skip
     for north, east, radius in np.asarray(circles if circles is not None else []).reshape(-1, 3):
         axes.add_patch(Circle((east, north), radius, fc="0.3", ec="k", alpha=0.7))
     for vertices in polygons:
@@ -94,7 +96,9 @@ def plot_mission_paths(
     axes.set_ylim(*g.north_bounds)
     axes.legend(loc="upper left", fontsize="small")
     axes.set_title(title or "Pre-planned paths (dashed) and optimised trajectories")
-    return figure
+    if bathymetry.projection is not None:
+        add_geographic_axes(axes, bathymetry.projection)
+    return plain_tick_labels(figure)
 
 
 def plot_time_series(
@@ -106,8 +110,7 @@ def plot_time_series(
     """
     figure = Figure(figsize=(9.0, 9.0), layout="constrained")
     axes = figure.subplots(4, 1, sharex=True)
-    for k, name in enumerate(names):
-        color = _color(k)
+    for k, (name, color) in enumerate(zip(names, vehicle_colors(len(names)), strict=True)):
         axes[0].plot(time, states[k, :, STATE_NAMES.index("u")], color=color, label=f"{name} u")
         axes[0].plot(
             time, states[k, :, STATE_NAMES.index("v")], ":", color=color, label=f"{name} v"
@@ -130,7 +133,7 @@ def plot_time_series(
         ax.grid(alpha=0.3)
         ax.legend(fontsize="small", ncol=2)
     axes[-1].set_xlabel("time [s]")
-    return figure
+    return plain_tick_labels(figure)
 
 
 def plot_separation(
@@ -139,12 +142,13 @@ def plot_separation(
     """Pairwise (and vehicle-obstacle) separation [m] against time with the limit ``minimum``."""
     figure = Figure(figsize=(9.0, 4.0), layout="constrained")
     axes = figure.add_subplot()
-    for k, (label, distance) in enumerate(separations.items()):
-        axes.plot(time, distance, color=_color(k), label=label)
+    colors = pair_colors(len(separations))
+    for color, (label, distance) in zip(colors, separations.items(), strict=True):
+        axes.plot(time, distance, color=color, label=label)
     axes.axhline(minimum, color="r", ls="--", label=f"2 r_c = {minimum:g} m")
     axes.set_xlabel("time [s]")
     axes.set_ylabel("separation [m]")
     axes.set_yscale("log")
     axes.grid(alpha=0.3, which="both")
     axes.legend(fontsize="small")
-    return figure
+    return plain_tick_labels(figure)

@@ -17,7 +17,8 @@ from matplotlib.figure import Figure
 
 from auvplan.navigation.evaluation import PlanNavigation, time_series
 from auvplan.terrain import BathymetryGrid
-from auvplan.viz.mission import VEHICLE_COLORS
+from auvplan.viz.geography import add_geographic_axes
+from auvplan.viz.style import plain_tick_labels, vehicle_colors
 
 #: Margin [m] around the tracks in the map panels, and their least width / height.
 MAP_MARGIN_M = 40.0
@@ -46,11 +47,12 @@ def plot_navigation(
     figure = Figure(figsize=(5.2 * len(labels) + 1.0, 4.6 + 2.3 * len(names)), layout="constrained")
     grid = figure.add_gridspec(1 + len(names), len(labels), height_ratios=[2.2] + [1] * len(names))
     bounds = _track_bounds(evaluations)
+    colors = vehicle_colors(len(names))
     error_axes: list[Axes] = []
     for column, label in enumerate(labels):
         evaluation = evaluations[label]
         map_axes = figure.add_subplot(grid[0, column])
-        _draw_map(map_axes, bathymetry, evaluation, names, bounds)
+        _draw_map(map_axes, bathymetry, evaluation, names, bounds, colors)
         energy = sum(evaluation.energy.values())
         rmse = np.mean([result.rmse.mean() for result in evaluation.results.values()])
         map_axes.set_title(
@@ -62,7 +64,7 @@ def plot_navigation(
             )
             error_axes.append(axes)
             if name in evaluation.results:
-                _draw_errors(axes, evaluation, name, names.index(name))
+                _draw_errors(axes, evaluation, name, colors[names.index(name)], is_first=row == 0)
             axes.set_title(name, fontsize="medium", loc="left")
             axes.set_ylabel("position error [m]")
             if row == len(names) - 1:
@@ -73,11 +75,7 @@ def plot_navigation(
         for result in evaluation.results.values()
     )
     error_axes[0].set_ylim(0.0, 1.5 * top)  # room for the legend above the curves
-    return figure
-
-
-def _color(index: int) -> str:
-    return VEHICLE_COLORS[index % len(VEHICLE_COLORS)]
+    return plain_tick_labels(figure)
 
 
 def _track_bounds(evaluations: Mapping[str, PlanNavigation]) -> tuple[float, ...]:
@@ -103,14 +101,16 @@ def _draw_map(
     evaluation: PlanNavigation,
     names: list[str],
     bounds: tuple[float, ...],
+    colors: tuple[str, ...],
 ) -> None:
     geometry = bathymetry.geometry
     mesh = axes.pcolormesh(
-        geometry.east, geometry.north, bathymetry.depth, cmap="viridis_r", shading="nearest"
-    )
+        geometry.east, geometry.north, bathymetry.depth, cmap="viridis_r", shading="nearest",
+        rasterized=True,
+    )  # fmt: skip
     axes.figure.colorbar(mesh, ax=axes, label="depth [m]", shrink=0.9)
     for name, result in evaluation.results.items():
-        color = _color(names.index(name))
+        color = colors[names.index(name)]
         axes.plot(result.truth[:, 1], result.truth[:, 0], "-", color=color, lw=2.0, label=name)
         axes.plot(
             result.example_dead_reckoning[:, 1],
@@ -137,13 +137,16 @@ def _draw_map(
     axes.set_ylim(bounds[0], bounds[1])
     axes.set_xlabel("east [m]")
     axes.set_ylabel("north [m]")
+    if bathymetry.projection is not None:
+        add_geographic_axes(axes, bathymetry.projection, latitude=False)
 
 
-def _draw_errors(axes: Axes, evaluation: PlanNavigation, name: str, index: int) -> None:
+def _draw_errors(
+    axes: Axes, evaluation: PlanNavigation, name: str, color: str, *, is_first: bool
+) -> None:
     result = evaluation.results[name]
     curves = time_series(result)
     time = result.time
-    color = _color(index)
     axes.fill_between(
         time, 0.0, curves["sigma"], color=color, alpha=0.2, lw=0, label="filter σ (mean)"
     )
@@ -151,5 +154,5 @@ def _draw_errors(axes: Axes, evaluation: PlanNavigation, name: str, index: int) 
     axes.plot(time, curves["dead_reckoning"], "--", color="k", lw=1.0, label="dead reckoning")
     axes.plot(time, curves["pcrb"], ":", color="0.3", lw=1.2, label="PCRB")
     axes.grid(alpha=0.3)
-    if index == 0:
+    if is_first:
         axes.legend(fontsize="x-small", ncol=2, loc="upper right")

@@ -1,18 +1,81 @@
-"""All figures of a mission run, saved as PNG files."""
+"""All figures of a mission run, rendered as PNG, SVG or PDF files."""
 
 from __future__ import annotations
 
+import io
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Final
 
 import numpy as np
 from matplotlib.figure import Figure
 
+from auvplan._figures import DEFAULT_DPI, FIGURE_FORMATS
+from auvplan.errors import InputError
 from auvplan.mission.pipeline import MissionResult
 from auvplan.planning import CircleObstacle, PolygonObstacle
 from auvplan.vehicle import positions
 from auvplan.viz.coordination import plot_coordination_space
 from auvplan.viz.maps import plot_terrain_maps
 from auvplan.viz.mission import plot_mission_paths, plot_separation, plot_time_series
+
+#: What each figure of :func:`mission_figures` shows, by file stem.
+FIGURE_CAPTIONS: Final = {
+    "maps": "Terrain maps (paper Fig. 5): bathymetry, information, excitation and cost.",
+    "paths": "Pre-planned paths (dashed) and optimised trajectories over the bathymetry "
+    "(paper Fig. 6); circles: safety radius at start and goal.",
+    "paths_cost": "Pre-planned paths over the shifted cost map that A* searched.",
+    "paths_energy_only": "Energy-only optimum (terrain weight 0) against the pre-planned paths.",
+    "coordination": "Coordination space of the first two vehicles: collision region and the "
+    "deconflicted schedule.",
+    "time_series": "Surge and sway speed, yaw rate, propeller speeds and electrical power.",
+    "separation": "Distance between every pair of vehicles and to every obstacle, on the "
+    "closed-loop replay.",
+}
+
+
+@dataclass(frozen=True)
+class RenderedFigure:
+    """A figure rendered to bytes: the file, and a preview that a web page can show.
+
+    ``data`` is the file in ``figure_format`` (a key of :data:`FIGURE_FORMATS`); ``preview``
+    is the same picture as PNG or SVG (``data`` itself unless the format is PDF) of MIME type
+    ``preview_type``.
+    """
+
+    figure_format: str
+    data: bytes
+    preview: bytes
+    preview_type: str
+
+
+def render_figure(
+    figure: Figure, *, figure_format: str = "png", dpi: int = DEFAULT_DPI
+) -> RenderedFigure:
+    """Render ``figure`` as ``figure_format`` at ``dpi`` dots per inch (raster parts).
+
+    Raises
+    ------
+    InputError
+        If ``figure_format`` is not one of :data:`FIGURE_FORMATS` or ``dpi`` is not positive.
+    """
+    if figure_format not in FIGURE_FORMATS:
+        raise InputError(
+            f"figure format {figure_format!r} is not one of {', '.join(FIGURE_FORMATS)}"
+        )
+    if not dpi > 0:
+        raise InputError(f"dpi must be positive, got {dpi}")
+
+    def render(file_format: str) -> bytes:
+        buffer = io.BytesIO()
+        metadata = {"Date": None} if file_format == "svg" else {}  # reproducible files
+        figure.savefig(buffer, format=file_format, dpi=dpi, metadata=metadata)
+        return buffer.getvalue()
+
+    data = render(figure_format)
+    if figure_format == "pdf":
+        return RenderedFigure(figure_format, data, render("png"), FIGURE_FORMATS["png"])
+    return RenderedFigure(figure_format, data, data, FIGURE_FORMATS[figure_format])
 
 
 def mission_figures(result: MissionResult) -> dict[str, Figure]:
@@ -84,11 +147,25 @@ def _cost_on_bathymetry_grid(result: MissionResult) -> np.ndarray:
     return field
 
 
-def save_mission_figures(result: MissionResult, directory: Path) -> list[Path]:
-    """Save :func:`mission_figures` as ``directory/<stem>.png``; returns the paths."""
+def render_mission_figures(
+    result: MissionResult, *, figure_format: str = "png", dpi: int = DEFAULT_DPI
+) -> dict[str, RenderedFigure]:
+    """:func:`mission_figures` rendered by :func:`render_figure`, by file stem."""
+    return {
+        stem: render_figure(figure, figure_format=figure_format, dpi=dpi)
+        for stem, figure in mission_figures(result).items()
+    }
+
+
+def save_mission_figures(
+    result: MissionResult, directory: Path, *, figure_format: str = "png", dpi: int = DEFAULT_DPI
+) -> list[Path]:
+    """Save :func:`mission_figures` as ``directory/<stem>.<figure_format>``; returns the paths."""
     written = []
-    for stem, figure in mission_figures(result).items():
-        path = directory / f"{stem}.png"
-        figure.savefig(path, dpi=120)
+    for stem, rendered in render_mission_figures(
+        result, figure_format=figure_format, dpi=dpi
+    ).items():
+        path = directory / f"{stem}.{figure_format}"
+        path.write_bytes(rendered.data)
         written.append(path)
     return written

@@ -22,6 +22,7 @@ from auvplan.vehicle.trim import (
     top_speed,
     trim_surge,
 )
+from auvplan.viz.style import plain_tick_labels
 
 
 def plot_vehicle_validation(
@@ -72,7 +73,7 @@ def plot_vehicle_validation(
         turn = steady_turn(model, turn_speed, turn_rate)
         label = f"u = {turn_speed} m/s, r = {turn_rate} rad/s"
     _plot_turn(turn_axes, model, turn, label)
-    return figure
+    return plain_tick_labels(figure)
 
 
 def _plot_propeller(axes: Axes, propeller: Propeller, orders: Sequence[int]) -> None:

@@ -1,0 +1,91 @@
+"""The output folder of a mission run: data files, exports, figures and ``report.html``.
+
+:func:`write_output_folder` is what ``auvplan plan``/``demo`` and
+:meth:`auvplan.MissionPlan.save` write, all-or-nothing
+(:func:`~auvplan.io.output.staged_output_dir`): the data files of
+:func:`~auvplan.mission.outputs.write_mission_files`, the exports asked for (made from the
+folder, as ``auvplan export`` makes them), the figures of
+:func:`~auvplan.viz.report.mission_figures` and the self-contained ``report.html``
+(:func:`~auvplan.viz.html.render_report`), which is built from the folder's own
+``summary.json``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from auvplan._figures import DEFAULT_DPI
+from auvplan.export import DEFAULT_TOLERANCE_M, write_exports
+from auvplan.io.output import staged_output_dir
+from auvplan.io.text import read_json
+from auvplan.mission.folder import load_export_plan
+from auvplan.mission.outputs import write_mission_files
+from auvplan.mission.pipeline import MissionResult
+from auvplan.viz.html import render_report
+from auvplan.viz.report import RenderedFigure, render_mission_figures
+
+#: The report's file name in every output folder.
+REPORT_FILE = "report.html"
+
+
+def write_output_folder(
+    result: MissionResult,
+    target: Path,
+    *,
+    warnings: Sequence[str] = (),
+    figures: bool = True,
+    figure_format: str = "png",
+    dpi: int = DEFAULT_DPI,
+    exports: Sequence[str] = (),
+    tolerance: float = DEFAULT_TOLERANCE_M,
+) -> list[Path]:
+    """Write the output folder of ``result`` into ``target`` (module notes).
+
+    Parameters
+    ----------
+    result : MissionResult
+        The run.
+    target : Path
+        The folder; files of the same name are replaced, other files kept.
+    warnings : sequence of str
+        Warnings logged during the run (``summary.json`` and the report list them).
+    figures : bool
+        Write the figures (the report embeds them).
+    figure_format : str
+        ``"png"``, ``"svg"`` or ``"pdf"``.
+    dpi : int
+        Resolution of raster figures [dots per inch].
+    exports : sequence of str
+        Export formats (:data:`auvplan.export.FORMATS`), written into ``target/export``;
+        ignored without an optimised plan.
+    tolerance : float
+        Waypoint tolerance of the exports [m].
+
+    Returns
+    -------
+    list of Path
+        The files written, under ``target``.
+    """
+    rendered: dict[str, RenderedFigure] = {}
+    if figures:  # rendered before anything is written: a bad format or dpi writes nothing
+        rendered = render_mission_figures(result, figure_format=figure_format, dpi=dpi)
+    with staged_output_dir(target) as staging:
+        written = write_mission_files(result, staging, warnings=warnings)
+        if exports and result.plan is not None:
+            written += write_exports(
+                load_export_plan(staging), staging / "export", exports, tolerance=tolerance
+            )
+        for stem, figure in rendered.items():
+            path = staging / f"{stem}.{figure.figure_format}"
+            path.write_bytes(figure.data)
+            written.append(path)
+        report = staging / REPORT_FILE
+        names = [path.relative_to(staging).as_posix() for path in [*written, report]]
+        summary = read_json(staging / "summary.json", what="summary file")
+        report.write_text(render_report(summary, rendered, files=names), encoding="utf-8")
+        written.append(report)
+        return [target / path.relative_to(staging) for path in written]
+
+
+__all__ = ["REPORT_FILE", "write_output_folder"]

@@ -1,0 +1,357 @@
+"""The notebook-first API: plan a mission, look at the plan, save it, open it again.
+
+>>> import auvplan                                        # doctest: +SKIP
+>>> plan = auvplan.plan("mission.toml")                   # doctest: +SKIP
+>>> plan.status, plan.summary["optimization"]["total_energy_J"]   # doctest: +SKIP
+>>> plan.to_dataframe().groupby("vehicle")["power"].mean()          # doctest: +SKIP
+>>> plan.plot().savefig("paths.png")                      # doctest: +SKIP
+>>> plan.save("out/run1"); auvplan.load("out/run1").to_xarray()     # doctest: +SKIP
+
+A :class:`MissionPlan` holds what an output folder holds: the ``summary.json`` document, the
+bathymetry of ``maps.nc`` and the trajectories of ``trajectories.nc``, so a plan made in
+memory (:func:`plan`) and the same plan read back from its folder (:func:`load`) answer alike.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import shutil
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from auvplan._figures import DEFAULT_DPI
+from auvplan.errors import InputError
+from auvplan.export import DEFAULT_TOLERANCE_M
+from auvplan.io.maps_file import read_maps_netcdf
+from auvplan.io.output import staged_output_dir
+from auvplan.io.results import json_values
+from auvplan.io.text import read_json
+from auvplan.io.trajectories_file import read_trajectories_netcdf
+from auvplan.mission.config import MissionConfig, load_mission, parse_mission
+from auvplan.mission.outputs import plan_dataset
+from auvplan.mission.pipeline import MissionResult, Stage, run_mission
+from auvplan.mission.progress import no_progress
+from auvplan.mission.summary import mission_summary
+from auvplan.terrain import BathymetryGrid
+
+if TYPE_CHECKING:
+    import pandas as pd
+    import xarray as xr
+    from matplotlib.figure import Figure
+
+    from auvplan.api.progress import ConsoleProgress
+
+#: What :func:`plan` accepts as a mission: a TOML file, a validated mission, or its document.
+MissionSource = str | os.PathLike[str] | MissionConfig | Mapping[str, Any]
+
+
+class MissionPlan:
+    """A planned mission: its summary, trajectories and figures (module notes).
+
+    Made by :func:`plan` (in memory; :attr:`result` holds the full
+    :class:`~auvplan.mission.MissionResult`) or :func:`load` (from an output folder).
+
+    Parameters
+    ----------
+    summary : mapping
+        The ``summary.json`` document (plain JSON values).
+    bathymetry : BathymetryGrid
+        The terrain the mission was planned on (after any window).
+    trajectories : xarray.Dataset or None
+        ``trajectories.nc`` as read (:func:`auvplan.io.trajectories_file.trajectories_dataset`);
+        ``None`` when the run stopped before optimising or the optimiser failed.
+    result : MissionResult, optional
+        The run, when planned in this session.
+    folder : Path, optional
+        The output folder it was loaded from.
+    """
+
+    def __init__(
+        self,
+        summary: Mapping[str, Any],
+        bathymetry: BathymetryGrid,
+        trajectories: xr.Dataset | None,
+        *,
+        result: MissionResult | None = None,
+        folder: Path | None = None,
+    ) -> None:
+        self._summary = dict(summary)
+        self._bathymetry = bathymetry
+        self._trajectories = trajectories
+        self._result = result
+        self._folder = folder
+
+    @classmethod
+    def from_result(cls, result: MissionResult, *, warnings: Sequence[str] = ()) -> MissionPlan:
+        """The plan of a run of :func:`~auvplan.mission.run_mission` (``warnings``: logged)."""
+        summary = json_values(mission_summary(result, warnings=warnings))
+        trajectories = None if result.plan is None else plan_dataset(result, result.plan)
+        return cls(summary, result.preplan.bathymetry, trajectories, result=result)
+
+    @property
+    def summary(self) -> dict[str, Any]:
+        """The ``summary.json`` document (every number needed to verify the plan)."""
+        return self._summary
+
+    @property
+    def bathymetry(self) -> BathymetryGrid:
+        """The terrain the mission was planned on."""
+        return self._bathymetry
+
+    @property
+    def result(self) -> MissionResult | None:
+        """The full run (stage results, solver history), if planned in this session."""
+        return self._result
+
+    @property
+    def folder(self) -> Path | None:
+        """The output folder the plan was loaded from, if any."""
+        return self._folder
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The vehicles' names, in mission order."""
+        return tuple(vehicle["name"] for vehicle in self._summary["vehicles"])
+
+    @property
+    def status(self) -> str | None:
+        """The plan's status, ``None`` when the run stopped before the optimiser.
+
+        ``"CONVERGED"`` when every constraint holds between samples, another
+        :class:`~auvplan.mission.checks.PlanStatus` name, or ``"FAILED"``.
+        """
+        optimization = self._summary.get("optimization")
+        return None if optimization is None else str(optimization["plan_status"])
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """The warnings logged during the run."""
+        return tuple(self._summary.get("warnings", ()))
+
+    def to_xarray(self) -> xr.Dataset:
+        """The optimised trajectories: the dataset of ``trajectories.nc`` (a copy).
+
+        Dimensions ``trajectory`` (vehicles) and ``obs`` (time samples); coordinates ``time``
+        (UTC), ``depth`` and, on georeferenced terrain, ``lat``/``lon``; variables ``north``,
+        ``east`` [m], ``heading`` [deg], ``u``, ``v`` [m/s], ``r`` [rad/s], ``n_ps``,
+        ``n_sb`` [rev/s] and ``power`` [W] (:mod:`auvplan.io.trajectories_file`).
+
+        Raises
+        ------
+        InputError
+            If there is no optimised plan (the run stopped early or the optimiser failed).
+        """
+        if self._trajectories is None:
+            reason = self._summary.get("optimization", {}).get("verdict")
+            raise InputError(
+                "no optimised plan: "
+                + (reason or f"the run stopped after stage {self._summary.get('stage')}")
+            )
+        return self._trajectories.copy(deep=True)
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """The optimised trajectories in long format: one row per vehicle and time sample.
+
+        Columns ``vehicle``, ``time`` (UTC), ``t`` [s since the start], then the coordinates
+        and variables of :meth:`to_xarray`: ``lat``, ``lon`` (georeferenced terrain only),
+        ``depth``, ``north``, ``east``, ``u``, ``v``, ``r``, ``n_ps``, ``n_sb``, ``power``,
+        ``heading``.
+        """
+        dataset = self.to_xarray()
+        frame = dataset.to_dataframe().reset_index().drop(columns="obs")
+        frame = frame.rename(columns={"trajectory": "vehicle"}).astype({"vehicle": str})
+        frame["t"] = (frame["time"] - dataset["time"].values.min()).dt.total_seconds()
+        places = [name for name in ("lat", "lon", "depth") if name in dataset.coords]
+        return frame[["vehicle", "time", "t", *places, *map(str, dataset.data_vars)]]
+
+    def plot(self) -> Figure:
+        """The mission figure: pre-planned paths and optimised trajectories over the terrain.
+
+        The figure ``paths`` of the output folder (paper Fig. 6), with latitude/longitude
+        axes and a scale bar on georeferenced terrain.
+        """
+        from auvplan.viz.mission import plot_mission_paths
+
+        vehicles = self._summary["vehicles"]
+        planned = [np.asarray(v["preplan"]["points_north_east_m"], dtype=float) for v in vehicles]
+        tracks = None
+        if self._trajectories is not None:
+            north, east = self._trajectories["north"].values, self._trajectories["east"].values
+            tracks = [np.column_stack([n, e]) for n, e in zip(north, east, strict=True)]
+        obstacles = self._summary.get("obstacles", [])
+        circles = np.array(
+            [(o["center"]["north"], o["center"]["east"], o["radius_m"])
+             for o in obstacles if o["shape"] == "circle"]
+        ).reshape(-1, 3)  # fmt: skip
+        polygons = [
+            np.array([(p["north"], p["east"]) for p in o["vertices"]])
+            for o in obstacles
+            if o["shape"] == "polygon"
+        ]
+        return plot_mission_paths(
+            self._bathymetry, self.names, planned, tracks,
+            safety_radius=self._summary["fleet"]["safety_radius_m"],
+            circles=circles, polygons=polygons,
+        )  # fmt: skip
+
+    def save(
+        self,
+        directory: str | os.PathLike[str],
+        *,
+        figures: bool = True,
+        figure_format: str = "png",
+        dpi: int = DEFAULT_DPI,
+        exports: Sequence[str] = (),
+        tolerance_m: float = DEFAULT_TOLERANCE_M,
+    ) -> list[Path]:
+        """Write the output folder of ``auvplan plan`` into ``directory``; returns the files.
+
+        ``summary.json``, ``mission.toml``, ``maps.nc``, the trajectories (CSV and NetCDF),
+        the figures in ``figure_format`` (``png``, ``svg`` or ``pdf``) at ``dpi``, the
+        exports (``moos``, ``qgc``, ``imc``, ``gpx``, ``kml``, ``geojson``) into
+        ``directory/export`` and ``report.html``; all-or-nothing
+        (:func:`auvplan.api.folder.write_output_folder`). A plan loaded from a folder is
+        copied as it is (the options apply to a plan made in this session).
+        """
+        target = Path(directory)
+        if self._result is None:
+            assert self._folder is not None  # a plan is made in memory or loaded
+            with staged_output_dir(target) as staging:
+                shutil.copytree(self._folder, staging, dirs_exist_ok=True)
+                copied = sorted(path for path in staging.rglob("*") if path.is_file())
+                return [target / path.relative_to(staging) for path in copied]
+        from auvplan.api.folder import write_output_folder
+        from auvplan.export import parse_formats
+
+        return write_output_folder(
+            self._result, target, warnings=self.warnings, figures=figures,
+            figure_format=figure_format, dpi=dpi,
+            exports=parse_formats(",".join(exports)) if exports else (), tolerance=tolerance_m,
+        )  # fmt: skip
+
+    def _repr_html_(self) -> str:
+        """The status and the vehicles table (Jupyter shows a plan with it)."""
+        from auvplan.viz.html import render_overview
+
+        return render_overview(self._summary)
+
+    def __repr__(self) -> str:
+        where = "" if self._folder is None else f", folder={str(self._folder)!r}"
+        status = self.status or f"stage {self._summary.get('stage')}"
+        return f"MissionPlan(vehicles={list(self.names)}, status={status!r}{where})"
+
+
+def plan(
+    mission: MissionSource,
+    *,
+    stage: Stage | str = Stage.FULL,
+    compare_energy_only: bool = False,
+    progress: bool = True,
+) -> MissionPlan:
+    """Plan a mission: maps and A* paths, deconfliction, PRONTO (SPEC §1-§5).
+
+    Parameters
+    ----------
+    mission : str, path, MissionConfig or mapping
+        A mission TOML file, a validated mission (:func:`auvplan.load_mission`,
+        :func:`auvplan.demo_mission`), or the mission document as a dict (file paths in it
+        are relative to the current folder).
+    stage : Stage or str
+        Last stage to run: ``"preplan"``, ``"deconflict"`` or ``"full"``.
+    compare_energy_only : bool
+        Also optimise with the terrain weight set to 0 (the paper's energy-only reference).
+    progress : bool
+        Show progress (:class:`auvplan.api.progress.ConsoleProgress`).
+
+    Returns
+    -------
+    MissionPlan
+        Also when the optimiser fails or a constraint is violated: see
+        :attr:`MissionPlan.status` and ``summary["optimization"]``.
+
+    Raises
+    ------
+    InputError, DataFormatError, InfeasibleError
+        For a mission that cannot be planned (the message names the key, file or vehicle).
+    """
+    config = _mission_config(mission)
+    try:
+        last_stage = Stage(stage)
+    except ValueError:
+        choices = ", ".join(repr(s.value) for s in Stage)
+        raise InputError(f"stage must be one of {choices}, got {stage!r}") from None
+    with _logged_warnings() as warnings, _reporter(config, progress) as reporter:
+        result = run_mission(
+            config,
+            stage=last_stage,
+            compare_energy_only=compare_energy_only,
+            callback=None if reporter is None else reporter.iteration,
+            progress=no_progress if reporter is None else reporter,
+        )
+    return MissionPlan.from_result(result, warnings=warnings)
+
+
+def load(folder: str | os.PathLike[str]) -> MissionPlan:
+    """Open the output folder of ``auvplan plan``/``demo`` or :meth:`MissionPlan.save`.
+
+    Raises
+    ------
+    InputError
+        If ``folder`` is not an output folder (no ``summary.json``).
+    DataFormatError
+        If one of its files is unreadable.
+    """
+    path = Path(folder)
+    if not (path / "summary.json").is_file():
+        raise InputError(f"{path} is not an auvplan output folder (no summary.json)")
+    summary = read_json(path / "summary.json", what="summary file")
+    bathymetry = read_maps_netcdf(path / "maps.nc").bathymetry
+    netcdf = path / "trajectories.nc"
+    trajectories = read_trajectories_netcdf(netcdf) if netcdf.is_file() else None
+    return MissionPlan(summary, bathymetry, trajectories, folder=path)
+
+
+def _mission_config(mission: MissionSource) -> MissionConfig:
+    if isinstance(mission, MissionConfig):
+        return mission
+    if isinstance(mission, Mapping):
+        return parse_mission(mission, base_dir=Path.cwd())
+    return load_mission(Path(mission))
+
+
+@contextmanager
+def _logged_warnings() -> Iterator[list[str]]:
+    """Collect the warnings that auvplan logs while the block runs (one line each)."""
+    collected: list[str] = []
+
+    class Collector(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            collected.append(record.getMessage())
+
+    handler = Collector(logging.WARNING)
+    source = logging.getLogger("auvplan")
+    source.addHandler(handler)
+    try:
+        yield collected
+    finally:
+        source.removeHandler(handler)
+
+
+@contextmanager
+def _reporter(config: MissionConfig, progress: bool) -> Iterator[ConsoleProgress | None]:
+    if not progress:
+        yield None
+        return
+    from auvplan.api.progress import ConsoleProgress
+
+    levels = config.solver.pronto_options().epsilon_levels()
+    with ConsoleProgress(epsilon_levels=levels) as reporter:
+        yield reporter
+
+
+__all__ = ["MissionPlan", "MissionSource", "load", "plan"]
