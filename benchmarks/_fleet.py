@@ -108,12 +108,13 @@ def build_case(name: str, folder: Path) -> tuple[AssembledProblem, ProntoOptions
 
 
 def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, Any]:
-    """Solve ``case`` with ``solver`` (``kernels``, ``casadi`` or ``ipopt``) and time it.
+    """Solve ``case`` with ``solver`` and time it.
 
-    ``kernels``/``casadi``: PRONTO with/without the compiled stage kernels; the time includes
-    building the model (loading or compiling kernels). ``ipopt``: CasADi + IPOPT on the same
-    discretised problem from PRONTO's projected initial trajectory, hard constraints.
-    ``max_iter`` caps PRONTO's iterations (for per-iteration timing).
+    ``kernels``/``casadi``: PRONTO with/without the compiled stage kernels (the time includes
+    building the model: loading or compiling kernels). ``ipopt``/``ipopt-mx``: CasADi + IPOPT
+    on the same discretised problem from PRONTO's projected initial trajectory, hard
+    constraints, the NLP expanded to SX (fastest evaluation, memory grows with the horizon) or
+    kept as MX. ``max_iter`` caps PRONTO's iterations (for per-iteration timing).
     """
     with tempfile.TemporaryDirectory() as scratch:
         assembled, options = build_case(case, Path(scratch))
@@ -125,10 +126,10 @@ def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, An
         "n_substeps": problem.n_substeps,
     }  # fmt: skip
     started = time.perf_counter()
-    if solver == "ipopt":
+    if solver.startswith("ipopt"):
         initial, _ = project_guess(ModelCache().get(problem), guess, options)
         started = time.perf_counter()
-        result = solve_ipopt(problem, initial)
+        result = solve_ipopt(problem, initial, expand=solver == "ipopt")
         record.update(status=str(result.status), iterations=result.n_iter, cost=result.cost)
     else:
         backend = StageBackend(stage_kernels=solver == "kernels")

@@ -95,6 +95,7 @@ def comparison(cases: tuple[str, ...]) -> str:
                 "auvplan, warm cache": run(case, "kernels", cold_cache),
                 "PRONTO on the CasADi VM": run(case, "casadi", cold_cache),
                 "CasADi + IPOPT": run(case, "ipopt", cold_cache),
+                "CasADi + IPOPT (MX NLP)": run(case, "ipopt-mx", cold_cache),
             }
         ipopt = records["CasADi + IPOPT"]
         reference = ipopt.get("wall_s")
