@@ -6,12 +6,14 @@ import json
 import tomllib
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from auvplan.cli.main import main
 from auvplan.errors import InputError, SolverError
 from auvplan.mission import pipeline
 from auvplan.mission.config import parse_mission
+from auvplan.mission.preplan import goal_keep_outs
 
 MISSION = """
 [terrain]
@@ -63,3 +65,16 @@ def test_summary_keeps_the_keys_users_read(tmp_path: Path) -> None:
     assert summary["fleet"]["deconfliction_method"] == summary["deconfliction"]["method"]
     assert summary["solver"]["dt"] == 1.0
     assert summary["solver"]["propeller_order"] is None  # "full", as before
+
+
+def test_routes_keep_out_of_the_other_vehicles_goals() -> None:
+    starts = np.array([[0.0, 0.0, 0.0], [0.0, 100.0, 0.0], [0.0, 50.0, 0.0]])
+    goals = np.array([[100.0, 50.0, 0.0], [100.0, 0.0, 0.0], [100.0, 56.0, 0.0]])
+    discs = goal_keep_outs(starts, goals, 1, clearance=5.0, cell=2.0)
+    # the goals of vehicles 0 and 2 are kept out of, each by 2 r_c + a cell from the path
+    assert [(d.north, d.east, d.radius) for d in discs] == [
+        (100.0, 50.0, 7.0),
+        (100.0, 56.0, 7.0),
+    ]
+    # vehicle 2's own goal is 6 m from vehicle 0's: that disc would cover it and is left out
+    assert [(d.north, d.east) for d in goal_keep_outs(starts, goals, 2, 5.0, 2.0)] == [(100.0, 0.0)]

@@ -125,6 +125,25 @@ def check_communication_ranges(
                 )
 
 
+def goal_keep_outs(
+    starts: FloatArray, goals: FloatArray, index: int, clearance: float, cell: float
+) -> tuple[CircleObstacle, ...]:
+    """Discs around the other vehicles' goals that vehicle ``index``'s route keeps out of.
+
+    A vehicle parked at its goal cannot be passed within ``2 r_c`` by any schedule, so each
+    route avoids the others' goals by ``2 r_c`` plus a cell (A* blocks ``radius + clearance``
+    with ``clearance = r_c``). Discs that would cover the vehicle's own start or goal are left
+    out (then only timing can help, and deconfliction says so).
+    """
+    radius = clearance + cell
+    own = np.array([starts[index, :2], goals[index, :2]])
+    return tuple(
+        CircleObstacle(float(goal[0]), float(goal[1]), radius)
+        for other, goal in enumerate(goals[:, :2])
+        if other != index and np.min(np.hypot(*(own - goal).T)) > radius + clearance + cell
+    )
+
+
 def plan_routes(
     maps: TerrainMaps,
     names: tuple[str, ...],
@@ -147,16 +166,24 @@ def plan_routes(
     routes, paths = [], []
     with progress("A*", total=len(names)) as advance:
         for index, name in enumerate(names):
-            route = plan_route(
-                maps.shifted_cost,
-                geometry,
-                (float(starts[index, 0]), float(starts[index, 1])),
-                (float(goals[index, 0]), float(goals[index, 1])),
-                obstacles=obstacles,
-                clearance=clearance,
-                edge_model=EdgeModel(planner.edge_model),
-                name=name,
-            )
+
+            def search(extra: tuple[Obstacle, ...], index: int = index, name: str = name) -> Route:
+                return plan_route(
+                    maps.shifted_cost,
+                    geometry,
+                    (float(starts[index, 0]), float(starts[index, 1])),
+                    (float(goals[index, 0]), float(goals[index, 1])),
+                    obstacles=obstacles + extra,
+                    clearance=clearance,
+                    edge_model=EdgeModel(planner.edge_model),
+                    name=name,
+                )
+
+            keep_out = goal_keep_outs(starts, goals, index, clearance, cell)
+            try:
+                route = search(keep_out)
+            except InfeasibleError:  # the keep-outs close every way: timing must do it
+                route = search(())
             routes.append(route)
             # within half a cell of the route, never through a no-go cell
             paths.append(
