@@ -23,6 +23,7 @@ __all__ = [
     "Parallelization",
     "StageEvaluator",
     "Symbol",
+    "check_rollout",
     "check_stages",
     "dense_function",
     "evaluate",
@@ -155,6 +156,37 @@ def check_stages(array: FloatArray, n_cols: int, name: str, n_stages: int | None
     if n_stages is not None and array.shape[0] != n_stages:
         raise InputError(f"{name} must have {n_stages} rows, got {array.shape[0]}")
     return array
+
+
+def check_rollout(
+    sizes: tuple[int, int, int],
+    initial_state: FloatArray,
+    reference_states: FloatArray,
+    reference_inputs: FloatArray,
+    gains: FloatArray,
+    parameters: FloatArray,
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """A closed-loop rollout's arguments as float arrays of one horizon ``N``.
+
+    ``sizes`` is ``(n_x, n_u, n_p)``. Returns ``x0 (n_x,)``, ``α (N, n_x)`` (rows beyond ``N``
+    dropped), ``μ (N, n_u)``, ``K (N, n_u, n_x)`` and ``P (N, n_p)``.
+
+    Raises
+    ------
+    InputError
+        If the arrays do not describe the same ``N`` stages.
+    """
+    n_x, n_u, n_p = sizes
+    mu = check_stages(reference_inputs, n_u, "reference_inputs", None)
+    n_stages = mu.shape[0]
+    alpha = np.asarray(reference_states, dtype=np.float64)[:n_stages]
+    alpha = check_stages(alpha, n_x, "reference_states", n_stages)
+    params = check_stages(parameters, n_p, "parameters", n_stages)
+    gains = np.asarray(gains, dtype=np.float64)
+    if gains.shape != (n_stages, n_u, n_x):
+        raise InputError(f"gains must have shape {(n_stages, n_u, n_x)}")
+    x0 = np.asarray(initial_state, dtype=np.float64).reshape(n_x)
+    return x0, alpha, mu, gains, params
 
 
 @dataclass(frozen=True, eq=False)

@@ -36,7 +36,7 @@ from auvplan.errors import InputError
 from auvplan.optimization._casadi import (
     Parallelization,
     StageEvaluator,
-    check_stages,
+    check_rollout,
     evaluate,
     hessian_shapes,
     signature_sizes,
@@ -249,15 +249,11 @@ class DiscreteModel:
         InputError
             If the arrays do not describe the same ``N`` stages.
         """
-        mu = check_stages(reference_inputs, self.n_u, "reference_inputs", None)
+        x0, alpha, mu, gains, params = check_rollout(
+            (self.n_x, self.n_u, self.n_p),
+            initial_state, reference_states, reference_inputs, gains, parameters,
+        )  # fmt: skip
         n_stages = mu.shape[0]
-        alpha = np.asarray(reference_states, dtype=np.float64)[:n_stages]
-        alpha = check_stages(alpha, self.n_x, "reference_states", n_stages)
-        params = check_stages(parameters, self.n_p, "parameters", n_stages)
-        gains = np.asarray(gains, dtype=np.float64)
-        if gains.shape != (n_stages, self.n_u, self.n_x):
-            raise InputError(f"gains must have shape {(n_stages, self.n_u, self.n_x)}")
-        x0 = np.asarray(initial_state, dtype=np.float64).reshape(self.n_x)
         accumulated = self._stages.accumulated(self.functions.closed_loop_step, n_stages)
         (out,) = evaluate(accumulated, [x0, alpha, mu, gains.reshape(n_stages, -1), params])
         states = np.empty((n_stages + 1, self.n_x))

@@ -30,7 +30,7 @@ import numpy as np
 
 from auvplan._typing import FloatArray, IntArray
 from auvplan.errors import InputError
-from auvplan.optimization._casadi import check_stages
+from auvplan.optimization._casadi import check_rollout, check_stages
 from auvplan.optimization.block_kernels import BlockKernels, block_kernels
 
 __all__ = [
@@ -332,19 +332,11 @@ class BlockDiscreteModel:
         Same arguments and results as
         :meth:`~auvplan.optimization.discretization.DiscreteModel.rollout`.
         """
-        mu = check_stages(reference_inputs, self.n_u, "reference_inputs", None)
+        x0, alpha, mu, gains, params = check_rollout(
+            (self.n_x, self.n_u, self.n_p),
+            initial_state, reference_states, reference_inputs, gains, parameters,
+        )  # fmt: skip
         n_stages = mu.shape[0]
-        alpha = check_stages(
-            np.asarray(reference_states, dtype=np.float64)[:n_stages],
-            self.n_x,
-            "reference_states",
-            n_stages,
-        )
-        params = check_stages(parameters, self.n_p, "parameters", n_stages)
-        gains = np.asarray(gains, dtype=np.float64)
-        if gains.shape != (n_stages, self.n_u, self.n_x):
-            raise InputError(f"gains must have shape {(n_stages, self.n_u, self.n_x)}")
-        x0 = np.asarray(initial_state, dtype=np.float64).reshape(self.n_x)
         if not self._block_diagonal(gains):
             return self._coupled_rollout(x0, alpha, mu, gains, params)
         states = np.empty((n_stages + 1, self.n_x))
