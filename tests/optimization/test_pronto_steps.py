@@ -302,5 +302,8 @@ def test_armijo_rejects_infeasible_candidates_once_feasible() -> None:
 
 
 def test_converged() -> None:
-    assert converged(1e-7, 1e-6)
-    assert not converged(1e-5, 1e-6)
+    assert converged(1e-7, 1.0, 1e-6, 0.0)
+    assert not converged(1e-5, 1.0, 1e-6, 0.0)
+    assert converged(1e-5, 1e2, 1e-6, 1e-6)  # relative bound 1e-4 above the absolute one
+    assert not converged(1e-3, 1e2, 1e-6, 1e-6)
+    assert not converged(1e-5, -1e-2, 1e-6, 1e-6)  # |h| scales the relative bound

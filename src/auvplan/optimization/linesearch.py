@@ -151,12 +151,14 @@ def armijo_step(
     )
 
 
-def converged(decrement: float, tol: float) -> bool:
-    """Stopping test ``−Dh·ζ < tol`` (``decrement = −Dh·ζ``).
+def converged(decrement: float, cost: float, tol: float, rtol: float) -> bool:
+    """Stopping test ``−Dh·ζ < max(tol, rtol |h|)`` (``decrement = −Dh·ζ``, ``cost = h``).
 
     Examples
     --------
-    >>> converged(1e-9, 1e-6)
+    >>> converged(1e-9, 1.0, 1e-6, 0.0)
+    True
+    >>> converged(0.5, 1e6, 1e-6, 1e-6)
     True
     """
-    return bool(decrement < tol)
+    return bool(decrement < max(tol, rtol * abs(cost)))

@@ -65,10 +65,12 @@ class ProntoOptions:
 
     Attributes
     ----------
-    tol : float
-        Stop when ``−Dh·ζ < tol`` at the final barrier level (cost units).
-    inner_tol : float
-        Same test at intermediate barrier levels.
+    tol, rtol : float
+        Stop when ``−Dh·ζ < max(tol, rtol |h|)`` at the final barrier level (``tol`` in cost
+        units; ``−Dh·ζ ≈ 2 (h − h*)`` near a minimiser, so ``rtol`` bounds the relative
+        error of the objective by about ``rtol / 2``).
+    inner_tol, inner_rtol : float
+        Same test at intermediate barrier levels, whose minimisers only start the next level.
     max_iter : int
         Maximum number of PRONTO iterations (directions computed) over all levels.
     alpha, beta : float
@@ -108,7 +110,9 @@ class ProntoOptions:
     """
 
     tol: float = 1e-6
+    rtol: float = 1e-8
     inner_tol: float = 1e-4
+    inner_rtol: float = 1e-6
     max_iter: int = 200
     alpha: float = 0.4
     beta: float = 0.7
@@ -131,6 +135,8 @@ class ProntoOptions:
         checks = {
             "tol": self.tol > 0,
             "inner_tol": self.inner_tol > 0,
+            "rtol": self.rtol >= 0,
+            "inner_rtol": self.inner_rtol >= 0,
             "max_iter": self.max_iter >= 1,
             "alpha": 0 < self.alpha < 1,
             "beta": 0 < self.beta < 1,

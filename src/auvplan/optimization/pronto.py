@@ -83,12 +83,15 @@ def _iterate_level(
     model: ProntoModel,
     state: _State,
     epsilon: float,
-    tol: float,
+    tol: tuple[float, float],
     options: ProntoOptions,
     start: float,
     callback: Callable[[ProntoIteration], None] | None,
 ) -> ProntoStatus | None:
-    """Run PRONTO at one barrier weight until convergence; ``None`` means converged."""
+    """Run PRONTO at one barrier weight until convergence; ``None`` means converged.
+
+    ``tol = (absolute, relative)`` tolerances of the stopping test (:func:`converged`).
+    """
     while True:
         if len(state.history) >= options.max_iter:
             return ProntoStatus.MAX_ITER
@@ -99,7 +102,7 @@ def _iterate_level(
         state.gains = local.gains
         decrement = -direction.slope
         current = lin.cost.total
-        is_done = converged(decrement, tol)
+        is_done = converged(decrement, current, *tol)
         result = None
         if not is_done:
             result = armijo_step(
@@ -171,7 +174,8 @@ def _continuation(
     epsilon = levels[0]
     try:
         for index, epsilon in enumerate(levels):
-            tol = options.tol if index == len(levels) - 1 else options.inner_tol
+            last = index == len(levels) - 1
+            tol = (options.tol, options.rtol) if last else (options.inner_tol, options.inner_rtol)
             restarts = 0
             while True:
                 status = _iterate_level(model, state, epsilon, tol, options, start, callback)
@@ -259,7 +263,8 @@ def solve_pronto(
             message = f"converged but infeasible: smallest scaled slack {smallest:.3g}"
         else:
             status = ProntoStatus.CONVERGED
-            message = f"converged: -Dh·ζ < {options.tol:g} after {state.n_iter} steps"
+            bound = max(options.tol, options.rtol * abs(cost.objective))
+            message = f"converged: -Dh·ζ < {bound:.3g} after {state.n_iter} steps"
     elif not message:
         message = {
             ProntoStatus.MAX_ITER: f"reached max_iter = {options.max_iter}",
