@@ -10,7 +10,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from auvplan._typing import BoolArray, FloatArray
+from auvplan._typing import FloatArray, IntArray
 
 
 @numba.njit(cache=True)
@@ -53,18 +53,81 @@ def _cholesky_solve(lower: FloatArray, rhs: FloatArray) -> FloatArray:
 
 
 @numba.njit(cache=True)
-def below_floor(matrices: FloatArray, floor: float) -> BoolArray:
-    """Per stage, whether ``matrices[k] − floor·I`` is not positive definite (Cholesky test)."""
-    n_stages, n, _ = matrices.shape
-    out = np.zeros(n_stages, dtype=np.bool_)
+def _clip_in_place(matrix: FloatArray, floor: float) -> None:
+    """``V max(Λ, floor) Vᵀ`` of a symmetric matrix, written over it."""
+    values, vectors = np.linalg.eigh(matrix)
+    matrix[:, :] = (vectors * np.maximum(values, floor)) @ vectors.T
+
+
+@numba.njit(cache=True)
+def clip_stage_weights(
+    q_mat: FloatArray,
+    s_mat: FloatArray,
+    r_mat: FloatArray,
+    floor: float,
+    groups: IntArray,
+    group_sizes: IntArray,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Stage weights ``W = ½(Z + Zᵀ)``, ``Z = [[Q, S], [Sᵀ, R]]``, with eigenvalues clipped.
+
+    Per stage, the eigenvalues of ``W`` are clipped at ``floor`` where ``W − floor·I`` fails
+    the Cholesky test; elsewhere ``W`` is kept. ``groups[g, :group_sizes[g]]`` are index
+    sets of ``z = (x, u)`` (e.g. one per vehicle); a failing stage with no entry outside
+    their diagonal blocks is clipped block by block (the same projection, cheaper), any other
+    failing stage as a whole.
+
+    Returns the clipped ``Q (N, n_x, n_x)``, ``S (N, n_x, n_u)`` and ``R (N, n_u, n_u)``.
+    """
+    n_stages, n_x, _ = q_mat.shape
+    n_u = r_mat.shape[1]
+    n = n_x + n_u
+    inside = np.zeros((n, n), dtype=np.bool_)
+    for g in range(group_sizes.size):
+        for i in range(group_sizes[g]):
+            for j in range(group_sizes[g]):
+                inside[groups[g, i], groups[g, j]] = True
+    q_out = np.empty_like(q_mat)
+    s_out = np.empty_like(s_mat)
+    r_out = np.empty_like(r_mat)
+    stage = np.empty((n, n))
     shifted = np.empty((n, n))
     for k in range(n_stages):
-        shifted[:, :] = matrices[k]
+        for i in range(n_x):
+            for j in range(n_x):
+                stage[i, j] = 0.5 * (q_mat[k, i, j] + q_mat[k, j, i])
+            for j in range(n_u):
+                stage[i, n_x + j] = s_mat[k, i, j]
+                stage[n_x + j, i] = s_mat[k, i, j]
+        for i in range(n_u):
+            for j in range(n_u):
+                stage[n_x + i, n_x + j] = 0.5 * (r_mat[k, i, j] + r_mat[k, j, i])
+        shifted[:, :] = stage
         for i in range(n):
             shifted[i, i] -= floor
         _, is_pd = _cholesky(shifted)
-        out[k] = not is_pd
-    return out
+        if not is_pd:
+            separable = group_sizes.size > 0
+            for i in range(n):
+                for j in range(n):
+                    if not inside[i, j] and stage[i, j] != 0.0:
+                        separable = False
+            if separable:
+                for g in range(group_sizes.size):
+                    index = groups[g, : group_sizes[g]]
+                    block = np.empty((index.size, index.size))
+                    for i in range(index.size):
+                        for j in range(index.size):
+                            block[i, j] = stage[index[i], index[j]]
+                    _clip_in_place(block, floor)
+                    for i in range(index.size):
+                        for j in range(index.size):
+                            stage[index[i], index[j]] = block[i, j]
+            else:
+                _clip_in_place(stage, floor)
+        q_out[k] = stage[:n_x, :n_x]
+        s_out[k] = stage[:n_x, n_x:]
+        r_out[k] = stage[n_x:, n_x:]
+    return q_out, s_out, r_out
 
 
 @numba.njit(cache=True)

@@ -46,47 +46,28 @@ def convexify(
     Only stages that fail a Cholesky test above the floor change. ``groups`` (index sets of
     ``z = (x, u)`` that tile it, e.g. one per vehicle) speeds this up without changing the
     result: a stage with no entry outside the groups' diagonal blocks is block-diagonal, so
-    its blocks are clipped one by one.
+    its blocks are clipped one by one (:func:`auvplan.optimization._kernels.clip_stage_weights`).
 
     Returns
     -------
     StageWeights
         Positive-definite weights (projection onto ``{W ⪰ floor·I}`` per stage).
     """
-    n_x = weights.Q.shape[1]
-    top = np.concatenate([weights.Q, weights.S], axis=2)
-    bottom = np.concatenate([np.swapaxes(weights.S, 1, 2), weights.R], axis=2)
-    stacked = np.concatenate([top, bottom], axis=1)
-    clipped = np.ascontiguousarray(0.5 * (stacked + np.swapaxes(stacked, 1, 2)))
-    low = np.nonzero(_kernels.below_floor(clipped, floor))[0]  # only these stages change
-    if groups:
-        outside = np.ones(clipped.shape[1:], dtype=bool)
-        for group in groups:
-            outside[np.ix_(group, group)] = False
-        separable = ~np.any(clipped[low][:, outside] != 0.0, axis=1)
-        for group in groups:
-            stages = low[separable]
-            block = np.ix_(stages, group, group)
-            clipped[block] = _clip(clipped[block], floor)
-        low = low[~separable]
-    clipped[low] = _clip(clipped[low], floor)
+    sizes = np.array([group.size for group in groups], dtype=np.int64)
+    padded = np.zeros((len(groups), int(sizes.max(initial=0))), dtype=np.int64)
+    for row, group in zip(padded, groups, strict=True):
+        row[: group.size] = group
+    q_mat, s_mat, r_mat = _kernels.clip_stage_weights(
+        np.ascontiguousarray(weights.Q),
+        np.ascontiguousarray(weights.S),
+        np.ascontiguousarray(weights.R),
+        floor,
+        padded,
+        sizes,
+    )
     p_values, p_vectors = np.linalg.eigh(0.5 * (weights.P_N + weights.P_N.T))
     p_clipped = (p_vectors * np.maximum(p_values, floor)) @ p_vectors.T
-    return StageWeights(
-        np.ascontiguousarray(clipped[:, :n_x, :n_x]),
-        np.ascontiguousarray(clipped[:, :n_x, n_x:]),
-        np.ascontiguousarray(clipped[:, n_x:, n_x:]),
-        p_clipped,
-    )
-
-
-def _clip(matrices: FloatArray, floor: float) -> FloatArray:
-    """``V max(Λ, floor) Vᵀ`` of each symmetric matrix."""
-    values, vectors = np.linalg.eigh(matrices)
-    clipped: FloatArray = (vectors * np.maximum(values, floor)[:, None, :]) @ np.swapaxes(
-        vectors, 1, 2
-    )
-    return clipped
+    return StageWeights(q_mat, s_mat, r_mat, p_clipped)
 
 
 @dataclass(frozen=True)
