@@ -113,6 +113,7 @@ def run_mission(
             fleet=config.fleet,
             settings=config.deconfliction,
             dt=config.solver.dt,
+            current=preplan.current,
         ),
     )
     if stage is Stage.DECONFLICT:
@@ -178,7 +179,7 @@ def run_optimization(
     assembled = assemble_problem(
         layout, preplan, deconfliction,
         weights=config.weights, terrain_weight=terrain_weight,
-        safety_radius=config.fleet.safety_radius, comms=config.comms,
+        safety_radius=config.fleet.safety_radius, comms=config.comms, current=preplan.current,
     )  # fmt: skip
     result = solve_pronto(
         assembled.problem,
