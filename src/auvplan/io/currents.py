@@ -126,7 +126,7 @@ def _select(data: xr.DataArray, depth: float) -> tuple[xr.DataArray, str | None]
         if data[name].ndim == 1 and data.sizes[data[name].dims[0]] > 1:
             levels = np.abs(np.asarray(data[name].values, dtype=np.float64))
             data = data.isel({data[name].dims[0]: int(np.argmin(np.abs(levels - depth)))})
-    times = [data[name].dims[0] for name in data.cf.axes.get("T", []) if data[name].ndim == 1]
+    times = [str(data[name].dims[0]) for name in data.cf.axes.get("T", []) if data[name].ndim == 1]
     return data, times[0] if times else None
 
 

@@ -146,7 +146,7 @@ class FleetLayout:
         return self.n_x + (N_CURRENT_PARAMETERS * self.n_vehicles if has_current else 0)
 
     def parameter_slice(self, i: int, *, has_current: bool) -> slice:
-        """Rows of vehicle ``i`` in the stacked stage parameter (:func:`vehicle_stage_functions`)."""
+        """Rows of vehicle ``i`` in the stacked stage parameters (``vehicle_stage_functions``)."""
         extra = N_CURRENT_PARAMETERS if has_current else 0
         start = sum(model.n_x + extra for model in self.models[:i])
         return slice(start, start + self.models[i].n_x + extra)

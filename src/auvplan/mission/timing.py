@@ -253,7 +253,7 @@ def desired_states(
         speed = np.hypot(*velocity.T)
         path_heading = headings[i]
         if current is not None:
-            drift = np.column_stack(current.velocity(*positions[i].T, time))
+            drift = np.column_stack(current.velocity(positions[i][:, 0], positions[i][:, 1], time))
             speed, crab = through_water(velocity, drift)
             path_heading = np.where(speed > 1e-3, crab, path_heading)
         psi = np.unwrap(path_heading)

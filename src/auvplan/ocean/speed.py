@@ -22,7 +22,9 @@ from auvplan._typing import FloatArray
 __all__ = ["ground_speed", "through_water"]
 
 
-def ground_speed(water_speed: FloatArray, current: FloatArray, tangent: FloatArray) -> FloatArray:
+def ground_speed(
+    water_speed: FloatArray | float, current: FloatArray, tangent: FloatArray
+) -> FloatArray:
     """Ground speed along a path at a through-water speed (module equation).
 
     Parameters
