@@ -24,14 +24,16 @@ __all__ = ["check_crossable", "load_current", "mean_ground_speed", "path_ground_
 def load_current(config: MissionConfig, bathymetry: BathymetryGrid) -> CurrentField | None:
     """The ``[current]`` of the mission on its map (None: still water).
 
-    A file is read onto the terrain's local frame (:func:`auvplan.io.currents.read_current`),
+    A uniform current of zero is still water (the plan is then exactly the still-water one;
+    the current's code path gives it up to round-off, ~1e-6 m on positions). A file is read onto the terrain's local frame (:func:`auvplan.io.currents.read_current`),
     with time relative to ``[mission] start_time`` when the mission gives one.
     """
     table = config.current
     if table is None:
         return None
     if table.file is None:
-        return UniformCurrent(table.north or 0.0, table.east or 0.0)
+        north, east = table.north or 0.0, table.east or 0.0
+        return UniformCurrent(north, east) if north or east else None
     geometry = bathymetry.geometry
     given = "start_time" in config.mission.model_fields_set
     return read_current(
