@@ -49,9 +49,11 @@ def medusa() -> Any:
 
 def test_current_table() -> None:
     config = parse_mission(_mission({"east": 0.2}))
-    assert config.current is not None and (config.current.east, config.current.north) == (0.2, None)
+    assert config.current is not None
+    assert (config.current.east, config.current.north) == (0.2, None)
     config = parse_mission(_mission({"file": "c.nc"}), base_dir=Path("/data"))
-    assert config.current is not None and config.current.file == Path("/data/c.nc")
+    assert config.current is not None
+    assert config.current.file == Path("/data/c.nc")
     for bad, message in (({}, "give a current file"), ({"east": 9.0}, "current.east")):
         with pytest.raises(InputError, match=message):
             parse_mission(_mission(bad))
@@ -59,7 +61,9 @@ def test_current_table() -> None:
 
 def test_holding_station_costs_the_power_of_moving_through_water(medusa: Any) -> None:
     """In a 0.4 m/s current, heading into it at 0.4 m/s through the water holds station."""
-    trim = reference_states(medusa, np.array([[0.0, 0.0, -np.pi / 2]]), np.array([0.4]), np.zeros(1))
+    trim = reference_states(
+        medusa, np.array([[0.0, 0.0, -np.pi / 2]]), np.array([0.4]), np.zeros(1)
+    )
     state, inputs = trim[0], np.zeros(medusa.n_u)
     dt, n_steps = 0.1, 600
     step = _rk4(medusa.dynamics_in_current, dt)
@@ -70,11 +74,14 @@ def test_holding_station_costs_the_power_of_moving_through_water(medusa: Any) ->
     assert np.hypot(state[0], state[1]) < 0.3  # held within 0.3 m over 60 s (it would drift 24 m)
     still = electrical_power(trim, np.zeros((1, medusa.n_u)), medusa)[0]
     assert np.mean(power) == pytest.approx(still, rel=1e-3)
-    assert still > electrical_power(
-        reference_states(medusa, np.zeros((1, 3)), np.zeros(1), np.zeros(1)),
-        np.zeros((1, medusa.n_u)),
-        medusa,
-    )[0]  # and more than resting
+    assert (
+        still
+        > electrical_power(
+            reference_states(medusa, np.zeros((1, 3)), np.zeros(1), np.zeros(1)),
+            np.zeros((1, medusa.n_u)),
+            medusa,
+        )[0]
+    )  # and more than resting
 
 
 def _rk4(function: ca.Function, dt: float) -> Any:
@@ -140,7 +147,8 @@ def test_zero_current_gives_the_still_water_plan() -> None:
     """A zero ``[current]`` plans exactly as still water; the current's code path with
     ``v_c = 0`` (other compiled kernels, other rounding) agrees to round-off."""
     still, zero = _plan(None), _plan({"east": 0.0, "north": 0.0})
-    assert still.plan is not None and zero.plan is not None
+    assert still.plan is not None
+    assert zero.plan is not None
     np.testing.assert_array_equal(zero.plan.states, still.plan.states)
     np.testing.assert_array_equal(zero.plan.inputs, still.plan.inputs)
     np.testing.assert_array_equal(zero.plan.energy, still.plan.energy)
@@ -156,8 +164,10 @@ def test_zero_current_gives_the_still_water_plan() -> None:
 
 def test_downstream_leg_costs_less_than_upstream() -> None:
     downstream, upstream = _plan({"east": 0.15}), _plan({"east": -0.15})
-    assert downstream.plan is not None and upstream.plan is not None
-    assert downstream.plan.verdict.success and upstream.plan.verdict.success
+    assert downstream.plan is not None
+    assert upstream.plan is not None
+    assert downstream.plan.verdict.success
+    assert upstream.plan.verdict.success
     assert downstream.plan.energy[0] < 0.9 * upstream.plan.energy[0]
     # the surge through the water is lower downstream, higher upstream than the ground speed
     u = downstream.plan.states[0, :, 3], upstream.plan.states[0, :, 3]
@@ -171,7 +181,8 @@ def test_compare_no_current_flies_the_still_water_plan() -> None:
     config = parse_mission(_mission({"east": -0.15}))
     result = run_mission(config, compare_no_current=True)
     comparison = result.current_comparison
-    assert comparison is not None and result.plan is not None
+    assert comparison is not None
+    assert result.plan is not None
     using, still = comparison.using_current, comparison.still_water
     assert using.energy[0] == pytest.approx(result.plan.energy[0], rel=0.01)
     assert still.energy[0] == pytest.approx(using.energy[0], rel=0.03)
@@ -191,4 +202,6 @@ def test_bad_current_file_exits_2_with_one_line(
     code = main(["plan", str(mission), "-o", str(tmp_path / "out"), "--stage", "preplan"])
     err = capsys.readouterr().err
     assert code == 2
-    assert len(err.splitlines()) == 1 and "currents.nc" in err and "unreadable" in err
+    assert len(err.splitlines()) == 1
+    assert "currents.nc" in err
+    assert "unreadable" in err

@@ -29,7 +29,9 @@ def _read(path: Path, *, depth: float = 0.0, start: datetime | None = START_TIME
     return read_current(path, projection=PROJECTION, extent=EXTENT, start_time=start, depth=depth)
 
 
-def test_cf_file_reproduces_the_analytic_field(current_file: Path, rng: np.random.Generator) -> None:
+def test_cf_file_reproduces_the_analytic_field(
+    current_file: Path, rng: np.random.Generator
+) -> None:
     """A field linear in lat, lon and time is reproduced by the cubic B-splines.
 
     Exactly, but for the affine map of the file's axes to the local frame: over ±1 km the
@@ -132,7 +134,8 @@ def test_bad_files_are_one_line_errors(
 def test_uniform_current() -> None:
     field = UniformCurrent(-0.1, 0.3)
     v_n, v_e = field.velocity(np.zeros(3), np.ones(3), np.arange(3.0))
-    assert v_n.tolist() == [-0.1] * 3 and v_e.tolist() == [0.3] * 3
+    assert v_n.tolist() == [-0.1] * 3
+    assert v_e.tolist() == [0.3] * 3
     assert not np.any(field.gradient(np.zeros(3), np.zeros(3), np.zeros(3)))
 
 

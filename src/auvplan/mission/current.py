@@ -25,8 +25,9 @@ def load_current(config: MissionConfig, bathymetry: BathymetryGrid) -> CurrentFi
     """The ``[current]`` of the mission on its map (None: still water).
 
     A uniform current of zero is still water (the plan is then exactly the still-water one;
-    the current's code path gives it up to round-off, ~1e-6 m on positions). A file is read onto the terrain's local frame (:func:`auvplan.io.currents.read_current`),
-    with time relative to ``[mission] start_time`` when the mission gives one.
+    the current's code path gives it up to round-off, ~1e-6 m on positions). A file is read
+    onto the terrain's local frame (:func:`auvplan.io.currents.read_current`), with time
+    relative to ``[mission] start_time`` when the mission gives one.
     """
     table = config.current
     if table is None:
