@@ -205,3 +205,21 @@ def test_bad_current_file_exits_2_with_one_line(
     assert len(err.splitlines()) == 1
     assert "currents.nc" in err
     assert "unreadable" in err
+
+
+def test_independent_checker_flies_the_true_current(tmp_path: Path) -> None:
+    """``scenarios.check`` integrates the plan in the mission's current: its defect is tiny,
+    and the same plan checked as if in still water is off by the drift."""
+    import tomli_w
+
+    from auvplan.scenarios.check import check
+
+    with_current, still = tmp_path / "current.toml", tmp_path / "still.toml"
+    with_current.write_bytes(tomli_w.dumps(_mission({"east": -0.15, "north": 0.1})).encode())
+    still.write_bytes(tomli_w.dumps(_mission(None)).encode())
+    out = tmp_path / "out"
+    assert main(["-q", "plan", str(with_current), "-o", str(out), "--no-figures"]) == 0
+    report = check(out)
+    assert report.passed, report.failures
+    assert report.max_position_defect_m["blue"] < 1e-3
+    assert check(out, mission=still).max_position_defect_m["blue"] > 0.1
