@@ -133,7 +133,7 @@ class VehicleModel:
         >>> from auvplan.io.vehicles import load_vehicle
         >>> model = build_vehicle_model(load_vehicle("medusa"))
         >>> xdot = model.dynamics_in_current([0, 0, 0, 0.5, 0, 0, 40.0, 40.0], [0, 0], [-0.5, 0.1])
-        >>> [round(float(value), 6) for value in xdot[:2]]
+        >>> np.asarray(xdot).ravel()[:2].round(6).tolist()
         [0.0, 0.1]
         """
         x, c = ca.SX.sym("x", self.n_x), ca.SX.sym("c", self.n_u)
