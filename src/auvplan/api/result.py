@@ -251,6 +251,7 @@ def plan(
     *,
     stage: Stage | str = Stage.FULL,
     compare_energy_only: bool = False,
+    compare_no_current: bool = False,
     progress: bool = True,
 ) -> MissionPlan:
     """Plan a mission: maps and A* paths, deconfliction, PRONTO (SPEC §1-§5).
@@ -265,6 +266,9 @@ def plan(
         Last stage to run: ``"preplan"``, ``"deconflict"`` or ``"full"``.
     compare_energy_only : bool
         Also optimise with the terrain weight set to 0 (the paper's energy-only reference).
+    compare_no_current : bool
+        With a ``[current]``: also plan as if in still water, fly both plans in the current
+        and report the saving (``summary["current_comparison"]``).
     progress : bool
         Show progress (:class:`auvplan.api.progress.ConsoleProgress`).
 
@@ -290,6 +294,7 @@ def plan(
             config,
             stage=last_stage,
             compare_energy_only=compare_energy_only,
+            compare_no_current=compare_no_current,
             callback=None if reporter is None else reporter.iteration,
             progress=no_progress if reporter is None else reporter,
         )

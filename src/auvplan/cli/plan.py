@@ -53,6 +53,12 @@ def _add_common(parser: argparse.ArgumentParser, *, default_output: Path | None)
         help="also optimise without the terrain term (the energy-only reference)",
     )
     parser.add_argument(
+        "--compare-no-current",
+        action="store_true",
+        help="with a [current]: also plan as if in still water, fly that plan in the current "
+        "and report both energies and the saving",
+    )
+    parser.add_argument(
         "--no-figures", action="store_true", help="write no figures (report.html has tables only)"
     )
     add_figure_options(parser)
@@ -99,6 +105,7 @@ def _run(config: Any, args: argparse.Namespace) -> int:
         config,
         stage=args.stage,
         compare_energy_only=args.compare_energy_only,
+        compare_no_current=args.compare_no_current,
         progress=not args.quiet,
     )
     written = mission_plan.save(
@@ -154,4 +161,12 @@ def _print_report(result: Any, written: list[Path]) -> None:
                 f"   arrival error {plan.arrival_error[i]:.2f} m   closest {closest:.2f} m",
                 file=out,
             )
+    comparison = result.current_comparison
+    if comparison is not None:
+        using, still = comparison.using_current.energy.sum(), comparison.still_water.energy.sum()
+        print(
+            f"current: flown energy {using:.1f} J using it, {still:.1f} J with the still-water "
+            f"plan; saving {comparison.saving:.1f} J",
+            file=out,
+        )
     print("wrote: " + ", ".join(str(path) for path in written), file=out)

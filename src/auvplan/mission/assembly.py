@@ -15,11 +15,13 @@ from auvplan.mission.fleet import (
     FleetProblemFunctions,
     FleetWeights,
     build_fleet_functions,
+    current_parameters,
     regulator_weights,
 )
 from auvplan.mission.preplan import PreplanStage
 from auvplan.mission.reward import information_reward
 from auvplan.mission.timing import DeconflictStage
+from auvplan.ocean import CurrentField
 from auvplan.optimization import PathConstraint, Trajectory, TrajectoryProblem
 from auvplan.planning import CircleObstacle
 from auvplan.vehicle import headings, reference_states, regulator_floor, stable_rk4_step
@@ -84,6 +86,31 @@ def separation_margin(
     return max(dip, 0.01 * separation)
 
 
+def stage_parameters(
+    layout: FleetLayout,
+    desired: tuple[FloatArray, ...],
+    time: FloatArray,
+    current: CurrentField | None,
+) -> FloatArray:
+    """Stacked per-stage parameters ``(N, n_p)``: each vehicle's desired state (and current model).
+
+    Vehicle ``i`` holds :meth:`FleetLayout.parameter_slice`: its desired state ``x_d,k`` and,
+    in a current, ``v_c,k`` and ``G_k`` at the desired position at ``t_k``
+    (:func:`auvplan.mission.fleet.current_parameters`).
+    """
+    if current is None:
+        return np.ascontiguousarray(layout.stack(desired)[:-1])
+    return np.ascontiguousarray(
+        np.concatenate(
+            [
+                np.hstack([d[:-1], current_parameters(model, d[:-1], time[:-1], current)])
+                for d, model in zip(desired, layout.models, strict=True)
+            ],
+            axis=1,
+        )
+    )
+
+
 def assemble_problem(
     layout: FleetLayout,
     preplan: PreplanStage,
@@ -93,11 +120,13 @@ def assemble_problem(
     terrain_weight: float,
     safety_radius: float,
     comms: tuple[CommConfig, ...],
+    current: CurrentField | None = None,
 ) -> AssembledProblem:
     """The stacked fleet problem for PRONTO (and the IPOPT reference), with its initial guess.
 
     ``terrain_weight`` overrides ``weights.terrain`` (0 for the energy-only comparison). The
     guess is the desired trajectory with zero inputs; PRONTO projects it onto the dynamics.
+    ``current`` (None: still water) enters each stage linearised about the desired position.
     """
     desired = deconfliction.desired_states
     circles = [
@@ -120,6 +149,7 @@ def assemble_problem(
         goal_poses(layout, preplan.goals, desired),
         FleetWeights(terrain=terrain_weight, energy=weights.energy, terminal=weights.terminal),
         limits,
+        has_current=current is not None,
     )
     stacked_desired = layout.stack(desired)
     reward = information_reward(layout, preplan.maps, terrain_weight * weights.information)
@@ -130,7 +160,7 @@ def assemble_problem(
         initial_state=start_states(layout, preplan),
         dt=deconfliction.dt,
         n_steps=deconfliction.time.size - 1,
-        stage_parameters=np.ascontiguousarray(stacked_desired[:-1]),
+        stage_parameters=stage_parameters(layout, desired, deconfliction.time, current),
         constraints=tuple(
             PathConstraint(block.function, kind=block.kind, name=block.name)
             for block in functions.constraints

@@ -24,6 +24,7 @@ from auvplan.errors import InputError
 from auvplan.io.text import read_toml
 from auvplan.mission.tables import (
     CommConfig,
+    CurrentConfig,
     DeconflictionConfig,
     ExecutionConfig,
     FleetConfig,
@@ -60,6 +61,7 @@ class MissionConfig(TableModel):
     deconfliction: DeconflictionConfig = Field(default_factory=DeconflictionConfig)
     solver: SolverConfig = Field(default_factory=SolverConfig)
     mission: ExecutionConfig = Field(default_factory=ExecutionConfig)
+    current: CurrentConfig | None = Field(None, description="ocean current (absent: still water)")
     source: Path | None = Field(None, exclude=True, description="the mission file (not a key)")
 
     @model_validator(mode="before")
@@ -152,6 +154,10 @@ def parse_mission(
     if config.terrain.file is not None and not config.terrain.file.is_absolute():
         terrain = config.terrain.model_copy(update={"file": base_dir / config.terrain.file})
         config = config.model_copy(update={"terrain": terrain})
+    current = config.current
+    if current is not None and current.file is not None and not current.file.is_absolute():
+        current = current.model_copy(update={"file": base_dir / current.file})
+        config = config.model_copy(update={"current": current})
     vehicles = tuple(_resolve_vehicle_file(vehicle, base_dir) for vehicle in config.vehicles)
     return config.model_copy(update={"vehicles": vehicles})
 
@@ -253,6 +259,7 @@ def _one_line(error: ValidationError) -> str:
 
 __all__ = [
     "CommConfig",
+    "CurrentConfig",
     "DeconflictionConfig",
     "ExecutionConfig",
     "FleetConfig",

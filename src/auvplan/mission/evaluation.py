@@ -94,6 +94,7 @@ def evaluate_plan(
             layout.gains_of(result.regulator_gains, i),
             dt,
             refinement=CHECK_REFINEMENT,
+            current=preplan.current,
         )
         for i, model in enumerate(models)
     ]

@@ -31,6 +31,7 @@ import casadi as ca
 import numpy as np
 
 from auvplan._typing import FloatArray
+from auvplan.ocean import CurrentField
 from auvplan.optimization import StageBlock, stack_blocks
 from auvplan.vehicle import VehicleModel
 
@@ -62,21 +63,50 @@ TERMINAL_POSITION_WEIGHT: Final = 2e3
 TERMINAL_HEADING_WEIGHT: Final = 2e3
 
 
-def vehicle_stage_functions(model: VehicleModel) -> tuple[ca.Function, ca.Function]:
+#: Stage-parameter entries of the current model per vehicle: ``v_c,k`` (2) and ``G_k`` (4).
+N_CURRENT_PARAMETERS: Final = 6
+
+
+def vehicle_stage_functions(
+    model: VehicleModel, *, has_current: bool = False
+) -> tuple[ca.Function, ca.Function]:
     r"""One vehicle's block of the fleet problem: ``f(x, c, p)`` and cost rate ``l(x, c, p, w)``.
 
-    ``p`` is the vehicle's desired state and ``w = (w_E, w_T, r, q_1, …, q_{n_x})`` the
-    runtime weights: ``l = w_E P(x, c) + ½ w_T Σ_s q_s (x_s − p_s)² + ½ r ‖c‖²`` [W].
+    ``p`` is the vehicle's desired state ``x_d`` and ``w = (w_E, w_T, r, q_1, …, q_{n_x})`` the
+    runtime weights: ``l = w_E P(x, c) + ½ w_T Σ_s q_s (x_s − x_{d,s})² + ½ r ‖c‖²`` [W].
+    With ``has_current``, ``p = (x_d, v_c,k, vec(G_k))`` (:data:`N_CURRENT_PARAMETERS` more,
+    ``G_k`` row-major) and the dynamics are
+    :attr:`~auvplan.vehicle.VehicleModel.dynamics_in_current` with the current linearised
+    about the desired position ``p_d``: ``v_c(p) ≈ v_c,k + G_k (p − p_d)``.
     """
     x, c = ca.SX.sym("x", model.n_x), ca.SX.sym("c", model.n_u)
-    p, w = ca.SX.sym("p", model.n_x), ca.SX.sym("w", 3 + model.n_x)
-    error = x - p
+    n_p = model.n_x + (N_CURRENT_PARAMETERS if has_current else 0)
+    p, w = ca.SX.sym("p", n_p), ca.SX.sym("w", 3 + model.n_x)
+    error = x - p[: model.n_x]
     rate = w[0] * model.power(x, c) + 0.5 * w[1] * ca.dot(w[3:] * error, error)
     rate += 0.5 * w[2] * ca.dot(c, c)
+    if has_current:
+        rows = [model.index("north"), model.index("east")]
+        offset = p[model.n_x : model.n_x + 2]
+        jacobian = ca.reshape(p[model.n_x + 2 :], 2, 2).T  # row-major G
+        drift = offset + ca.mtimes(jacobian, x[rows] - p[rows])
+        xdot = model.dynamics_in_current(x, c, drift)
+    else:
+        xdot = model.dynamics(x, c)
     return (
-        ca.Function("vehicle_f", [x, c, p], [model.dynamics(x, c)]),
+        ca.Function("vehicle_f", [x, c, p], [xdot]),
         ca.Function("vehicle_l", [x, c, p, w], [rate]),
     )
+
+
+def current_parameters(
+    model: VehicleModel, desired: FloatArray, time: FloatArray, current: CurrentField
+) -> FloatArray:
+    """Per-stage ``(v_c,k, vec(G_k))`` of shape ``(n_t, 6)`` at the desired positions and times."""
+    north, east = desired[:, model.index("north")], desired[:, model.index("east")]
+    velocity = np.column_stack(current.velocity(north, east, time))
+    jacobian = current.gradient(north, east, time).reshape(-1, 4)
+    return np.hstack([velocity, jacobian])
 
 
 @dataclass(frozen=True, eq=False)
@@ -110,6 +140,16 @@ class FleetLayout:
         """Rows of vehicle ``i`` in the stacked input."""
         start = sum(model.n_u for model in self.models[:i])
         return slice(start, start + self.models[i].n_u)
+
+    def n_p(self, *, has_current: bool) -> int:
+        """Stacked stage-parameter dimension (desired states, plus the current model)."""
+        return self.n_x + (N_CURRENT_PARAMETERS * self.n_vehicles if has_current else 0)
+
+    def parameter_slice(self, i: int, *, has_current: bool) -> slice:
+        """Rows of vehicle ``i`` in the stacked stage parameters (``vehicle_stage_functions``)."""
+        extra = N_CURRENT_PARAMETERS if has_current else 0
+        start = sum(model.n_x + extra for model in self.models[:i])
+        return slice(start, start + self.models[i].n_x + extra)
 
     def stack(self, per_vehicle: Sequence[FloatArray]) -> FloatArray:
         """Per-vehicle arrays ``(n_t, n_x_i)`` (or ``(n_t, n_u_i)``) side by side."""
@@ -196,7 +236,12 @@ class FleetLimits:
 
 
 def build_fleet_functions(
-    layout: FleetLayout, goals: FloatArray, weights: FleetWeights, limits: FleetLimits
+    layout: FleetLayout,
+    goals: FloatArray,
+    weights: FleetWeights,
+    limits: FleetLimits,
+    *,
+    has_current: bool = False,
 ) -> FleetProblemFunctions:
     """Stack the vehicle models into the fleet problem.
 
@@ -210,10 +255,13 @@ def build_fleet_functions(
         Cost multipliers.
     limits : FleetLimits
         Safety radius, obstacles, communication pairs.
+    has_current : bool
+        Whether the stage parameters carry the current model (:func:`vehicle_stage_functions`).
     """
+    n_p = layout.n_p(has_current=has_current)
     x = ca.SX.sym("x", layout.n_x)
     c = ca.SX.sym("c", layout.n_u)
-    p = ca.SX.sym("p", layout.n_x)
+    p = ca.SX.sym("p", n_p)
     xs = [x[layout.state_slice(i)] for i in range(layout.n_vehicles)]
     cs = [c[layout.input_slice(i)] for i in range(layout.n_vehicles)]
     models = layout.models
@@ -223,15 +271,15 @@ def build_fleet_functions(
 
     blocks = tuple(
         StageBlock(
-            *vehicle_stage_functions(model),
+            *vehicle_stage_functions(model, has_current=has_current),
             weights=np.array([weights.energy, weights.terrain, INPUT_WEIGHT, *tracking(model)]),
             states=layout.state_slice(i),
             inputs=layout.input_slice(i),
-            parameters=layout.state_slice(i),
+            parameters=layout.parameter_slice(i, has_current=has_current),
         )
         for i, model in enumerate(models)
     )
-    dynamics, running_cost = stack_blocks(blocks, layout.n_x, layout.n_u, layout.n_x)
+    dynamics, running_cost = stack_blocks(blocks, layout.n_x, layout.n_u, n_p)
     powers = ca.vertcat(*[model.power(xs[i], cs[i]) for i, model in enumerate(models)])
 
     terminal = 0.0

@@ -33,6 +33,7 @@ from auvplan.mission.evaluation import OptimizedPlan, evaluate_plan
 from auvplan.mission.fleet import FleetLayout
 from auvplan.mission.preplan import PreplanStage, run_preplan
 from auvplan.mission.progress import ProgressReporter, no_progress
+from auvplan.mission.still_water import CurrentComparison, compare_with_still_water
 from auvplan.mission.timing import DeconflictStage, run_deconfliction
 from auvplan.optimization import solve_pronto
 from auvplan.vehicle import VehicleModel, build_vehicle_model, top_speed
@@ -64,6 +65,7 @@ class MissionResult:
     energy_only: OptimizedPlan | None = None
     timings: dict[str, float] = field(default_factory=dict)
     failure: str | None = None
+    current_comparison: CurrentComparison | None = None
 
 
 def run_mission(
@@ -71,6 +73,7 @@ def run_mission(
     *,
     stage: Stage = Stage.FULL,
     compare_energy_only: bool = False,
+    compare_no_current: bool = False,
     callback: Callable[[Any], None] | None = None,
     progress: ProgressReporter = no_progress,
 ) -> MissionResult:
@@ -84,6 +87,9 @@ def run_mission(
         Last stage to run.
     compare_energy_only : bool
         Also optimise with the terrain weight set to 0 (the paper's energy-only reference).
+    compare_no_current : bool
+        With a ``[current]``: also plan as if in still water and fly both plans in the current
+        (:mod:`auvplan.mission.still_water`).
     callback : callable, optional
         Passed to :func:`auvplan.optimization.solve_pronto` (per-iteration records).
     progress : ProgressReporter
@@ -113,6 +119,7 @@ def run_mission(
             fleet=config.fleet,
             settings=config.deconfliction,
             dt=config.solver.dt,
+            current=preplan.current,
         ),
     )
     if stage is Stage.DECONFLICT:
@@ -133,7 +140,34 @@ def run_mission(
         return MissionResult(
             config, stage, preplan, deconfliction, timings=timings, failure=failure
         )
-    return MissionResult(config, stage, preplan, deconfliction, plan, energy_only, timings=timings)
+    comparison = None
+    if compare_no_current and preplan.current is not None:
+        comparison = timed(
+            "compare_no_current",
+            lambda: _compare_no_current(config, layout, preplan, plan, callback=callback),
+        )
+    return MissionResult(
+        config, stage, preplan, deconfliction, plan, energy_only, timings=timings,
+        current_comparison=comparison,
+    )  # fmt: skip
+
+
+def _compare_no_current(
+    config: MissionConfig,
+    layout: FleetLayout,
+    preplan: PreplanStage,
+    plan: OptimizedPlan,
+    *,
+    callback: Callable[[Any], None] | None,
+) -> CurrentComparison | None:
+    """The still-water plan of the mission flown in its current (None if it found no plan)."""
+    assert preplan.current is not None
+    still = run_mission(config.model_copy(update={"current": None}), callback=callback)
+    if still.plan is None:
+        return None
+    return compare_with_still_water(
+        plan, still.plan, layout, preplan.goals, config.solver.dt, preplan.current
+    )
 
 
 def fleet_layout(config: MissionConfig) -> FleetLayout:
@@ -178,7 +212,7 @@ def run_optimization(
     assembled = assemble_problem(
         layout, preplan, deconfliction,
         weights=config.weights, terrain_weight=terrain_weight,
-        safety_radius=config.fleet.safety_radius, comms=config.comms,
+        safety_radius=config.fleet.safety_radius, comms=config.comms, current=preplan.current,
     )  # fmt: skip
     result = solve_pronto(
         assembled.problem,

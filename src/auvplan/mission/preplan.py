@@ -19,7 +19,9 @@ from auvplan.mission.config import (
     Position,
     TerrainConfig,
 )
+from auvplan.mission.current import load_current
 from auvplan.mission.progress import ProgressReporter, no_progress
+from auvplan.ocean import CurrentField
 from auvplan.planning import (
     CircleObstacle,
     EdgeModel,
@@ -44,7 +46,8 @@ class PreplanStage:
 
     ``starts`` and ``goals`` have shape ``(n_vehicles, 3)``: north, east [m], psi [rad];
     ``start_speeds`` [m/s]. ``paths`` are the smoothed routes (``(n_i, 2)`` north/east [m]);
-    ``obstacle_names`` label ``obstacles``.
+    ``obstacle_names`` label ``obstacles``; ``current`` is the ocean current (None: still
+    water).
     """
 
     bathymetry: BathymetryGrid
@@ -57,6 +60,7 @@ class PreplanStage:
     obstacle_names: tuple[str, ...]
     routes: tuple[Route, ...]
     paths: tuple[FloatArray, ...]
+    current: CurrentField | None = None
 
 
 def load_terrain(terrain: TerrainConfig) -> BathymetryGrid:
@@ -209,6 +213,7 @@ def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progre
     """
     bathymetry = load_terrain(config.terrain)
     maps = compute_maps(bathymetry, config.maps)
+    current = load_current(config, bathymetry)
     logger.info(
         "terrain: %s, %d x %d cells of %.1f x %.1f m; cost grid %d x %d",
         bathymetry.name,
@@ -244,4 +249,5 @@ def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progre
         obstacle_names=obstacle_names,
         routes=routes,
         paths=paths,
+        current=current,
     )

@@ -16,9 +16,10 @@ from auvplan.io.text import file_sha256
 from auvplan.io.vehicles import vehicle_file
 from auvplan.mission.assembly import integration_substeps
 from auvplan.mission.config import MissionConfig
-from auvplan.mission.evaluation import OptimizedPlan
+from auvplan.mission.evaluation import CHECK_REFINEMENT, OptimizedPlan
 from auvplan.mission.pipeline import MissionResult
 from auvplan.mission.preplan import PreplanStage
+from auvplan.mission.still_water import CurrentComparison
 from auvplan.planning import CircleObstacle, path_length
 from auvplan.terrain import LocalProjection
 
@@ -102,6 +103,9 @@ def _inputs(config: MissionConfig) -> dict[str, Any]:
     return {
         "mission": None if config.source is None else _fingerprint(config.source),
         "bathymetry": None if config.terrain.file is None else _fingerprint(config.terrain.file),
+        "current": None
+        if config.current is None or config.current.file is None
+        else _fingerprint(config.current.file),
         "vehicles": {
             vehicle.type: _fingerprint(vehicle_file(vehicle.type)) for vehicle in config.vehicles
         },
@@ -137,6 +141,9 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> d
             "origin": _place(preplan.bathymetry.projection, 0.0, 0.0),
         },
         "obstacles": _obstacles(preplan),
+        "current": None
+        if config.current is None
+        else config.current.model_dump(mode="json", exclude_none=True),
         "fleet": {
             "safety_radius_m": config.fleet.safety_radius,
             "edge_model": config.planner.edge_model,
@@ -195,4 +202,32 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> d
         summary["optimization"] = _plan_summary(result.plan, preplan.names)
     if result.energy_only is not None:
         summary["energy_only"] = _plan_summary(result.energy_only, preplan.names)
+    if result.current_comparison is not None:
+        summary["current_comparison"] = _comparison_summary(
+            result.current_comparison, preplan.names
+        )
     return summary
+
+
+def _comparison_summary(comparison: CurrentComparison, names: tuple[str, ...]) -> dict[str, Any]:
+    """``--compare-no-current``: both plans flown in the current (:mod:`.still_water`)."""
+    using, still = comparison.using_current, comparison.still_water
+    total_using, total_still = float(np.sum(using.energy)), float(np.sum(still.energy))
+    return {
+        "method": "both plans flown in the current with their own tracking regulators "
+        f"(RK4, {CHECK_REFINEMENT} substeps per solver step); energy = trapezoidal ∫ P dt",
+        "total_energy_using_current_J": total_using,
+        "total_energy_still_water_plan_J": total_still,
+        "saving_J": comparison.saving,
+        "saving_percent": 100.0 * comparison.saving / total_still if total_still > 0 else 0.0,
+        "still_water_plan": _plan_summary(comparison.still_water_plan, names),
+        "vehicles": {
+            name: {
+                "energy_using_current_J": float(using.energy[i]),
+                "energy_still_water_plan_J": float(still.energy[i]),
+                "arrival_error_using_current_m": float(using.arrival_error[i]),
+                "arrival_error_still_water_plan_m": float(still.arrival_error[i]),
+            }
+            for i, name in enumerate(names)
+        },
+    }

@@ -383,6 +383,32 @@ class SolverConfig(TableModel):
         return None if self.propeller_order == "full" else self.propeller_order
 
 
+class CurrentConfig(TableModel):
+    """The ocean current: uniform (``north``/``east``) or gridded (``file``); absent = still water.
+
+    Velocities are the direction the water flows **to** (oceanographic convention, CF
+    ``eastward_sea_water_velocity``), over ground, in the local frame.
+    """
+
+    north: Number | None = Field(
+        None, ge=-5.0, le=5.0, description="uniform current, northward component",
+        json_schema_extra=_unit("m/s"),
+    )  # fmt: skip
+    east: Number | None = Field(
+        None, ge=-5.0, le=5.0, description="uniform current, eastward component",
+        json_schema_extra=_unit("m/s"),
+    )  # fmt: skip
+    file: Path | None = Field(
+        None, description="NetCDF current file (CF names, or uo/vo, water_u/water_v, u/v)"
+    )
+
+    @model_validator(mode="after")
+    def _one_source(self) -> CurrentConfig:
+        if (self.file is None) == (self.north is None and self.east is None):
+            raise ValueError("give a current file = '...' or north/east components (one of them)")
+        return self
+
+
 class ExecutionConfig(TableModel):
     """When and at what depth the plan is flown (timestamps and depths of the exports).
 

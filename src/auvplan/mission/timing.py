@@ -28,7 +28,9 @@ from auvplan.deconfliction import (
 )
 from auvplan.errors import InfeasibleError, InputError
 from auvplan.mission.config import DeconflictionConfig, FleetConfig
+from auvplan.mission.current import check_crossable, mean_ground_speed, path_ground_speeds
 from auvplan.mission.fleet import FleetLayout
+from auvplan.ocean import CurrentField, through_water
 from auvplan.planning import path_length
 from auvplan.vehicle import (
     max_surge_acceleration,
@@ -124,6 +126,7 @@ def run_deconfliction(
     fleet: FleetConfig,
     settings: DeconflictionConfig,
     dt: float,
+    current: CurrentField | None = None,
 ) -> DeconflictStage:
     """Stage 2: choose the horizon, deconflict in the coordination space, sample the timing.
 
@@ -139,12 +142,20 @@ def run_deconfliction(
         Timing, safety radius and coordination-space settings.
     dt : float
         Solver (control) interval [s].
+    current : CurrentField, optional
+        The ocean current (None: still water); speeds and their limits are then ground
+        speeds along each path (:func:`ground_speed_limits`).
     """
     names = layout.names
     lengths = np.array([path_length(path) for path in paths])
     limits = np.array([SPEED_MARGIN * top_speed(model) for model in layout.models])
-    speeds, horizon = _nominal_speeds(fleet, lengths, limits, names)
     slowest = np.array([minimum_useful_speed(model) for model in layout.models])
+    if current is not None:
+        limits, slowest = ground_speed_limits(names, paths, limits, slowest, current)
+    speeds, horizon = _nominal_speeds(fleet, lengths, limits, names)
+    if current is not None and fleet.cruise_speed is not None:  # cruise through the water
+        cruise = [mean_ground_speed(path, fleet.cruise_speed, current) for path in paths]
+        speeds = np.fmin(limits, cruise)  # NaN (cannot hold the path at cruise): the limit
     accelerations = np.array([max_surge_acceleration(model) for model in layout.models])
     for _attempt in range(HORIZON_ATTEMPTS):
         problem = CoordinationProblem(
@@ -179,7 +190,7 @@ def run_deconfliction(
     n_steps = check_problem_size(layout, horizon, dt)
     coordination = retime_for_arrival(coordination, problem, horizon)
     time = dt * np.arange(n_steps + 1, dtype=np.float64)
-    desired = desired_states(layout, problem, coordination, time, start_headings)
+    desired = desired_states(layout, problem, coordination, time, start_headings, current)
     logger.info(
         "deconfliction (%s%s): horizon %.1f s, delays %s s, min separation %.2f m",
         coordination.method,
@@ -191,22 +202,63 @@ def run_deconfliction(
     return DeconflictStage(layout, horizon, dt, speeds, problem, coordination, time, desired)
 
 
+def ground_speed_limits(
+    names: tuple[str, ...],
+    paths: tuple[FloatArray, ...],
+    fastest: FloatArray,
+    slowest: FloatArray,
+    current: CurrentField,
+) -> tuple[FloatArray, FloatArray]:
+    """Ground-speed range [m/s] of each vehicle on its path from its through-water range.
+
+    The upper limit is the lowest ground speed along the path at the fastest through-water
+    speed (so it can be held everywhere), the lower one the lowest at the slowest speed
+    (kept >= 1 % of the upper one).
+
+    Raises
+    ------
+    InfeasibleError
+        If the current holds a vehicle off or back on its path (:func:`check_crossable`).
+    """
+    upper = np.array(
+        [np.min(check_crossable(name, path, float(top), current), initial=top)
+         for name, path, top in zip(names, paths, fastest, strict=True)]
+    )  # fmt: skip
+    lower = np.array(
+        [np.nanmin(path_ground_speeds(path, float(low), current)[0], initial=low)
+         for path, low in zip(paths, slowest, strict=True)]
+    )  # fmt: skip
+    return upper, np.clip(lower, 0.01 * upper, upper)
+
+
 def desired_states(
     layout: FleetLayout,
     problem: CoordinationProblem,
     coordination: CoordinationResult,
     time: FloatArray,
     start_headings: FloatArray,
+    current: CurrentField | None = None,
 ) -> tuple[FloatArray, ...]:
-    """Each vehicle's reference state along its timed path, on ``time``."""
+    """Each vehicle's reference state along its timed path, on ``time``.
+
+    In a current the surge is the speed through the water and the heading crabs into the
+    current (:func:`auvplan.ocean.through_water`); where the vehicle would drift with the water
+    (under 1 mm/s through it) the path's heading is kept.
+    """
     positions = timed_positions(coordination, problem, time)
     headings = timed_headings(coordination, problem, time)
     desired = []
     for i, model in enumerate(layout.models):
-        psi = np.unwrap(headings[i])
+        velocity = np.gradient(positions[i], time, axis=0)
+        speed = np.hypot(*velocity.T)
+        path_heading = headings[i]
+        if current is not None:
+            drift = np.column_stack(current.velocity(positions[i][:, 0], positions[i][:, 1], time))
+            speed, crab = through_water(velocity, drift)
+            path_heading = np.where(speed > 1e-3, crab, path_heading)
+        psi = np.unwrap(path_heading)
         # keep the first desired heading within pi of the start heading
         psi += 2 * np.pi * np.round((start_headings[i] - psi[0]) / (2 * np.pi))
-        speed = np.hypot(*np.gradient(positions[i], time, axis=0).T)
         pose = np.column_stack([positions[i], psi])
         desired.append(reference_states(model, pose, speed, np.gradient(psi, time)))
     return tuple(desired)

@@ -23,7 +23,8 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
-from auvplan.mission.fleet import vehicle_stage_functions
+from auvplan.mission.fleet import current_parameters, vehicle_stage_functions
+from auvplan.ocean import CurrentField
 from auvplan.optimization import block_kernels
 from auvplan.vehicle import VehicleModel
 
@@ -36,6 +37,7 @@ def replay_closed_loop(
     dt: float,
     *,
     refinement: int = 10,
+    current: CurrentField | None = None,
 ) -> FloatArray:
     """Fly a planned trajectory with its sampled tracking regulator on a finer grid.
 
@@ -53,6 +55,10 @@ def replay_closed_loop(
         Solver step [s].
     refinement : int
         Integration sub-steps per solver step.
+    current : CurrentField, optional
+        The ocean current (None: still water), linearised on each step about the planned
+        position at its start, as the optimiser sees it
+        (:func:`auvplan.mission.fleet.current_parameters`).
 
     Returns
     -------
@@ -65,13 +71,18 @@ def replay_closed_loop(
             f"inconsistent plan shapes: states {states.shape}, inputs {inputs.shape}, "
             f"gains {gains.shape}"
         )
-    kernels = block_kernels(*vehicle_stage_functions(model))
+    kernels = block_kernels(*vehicle_stage_functions(model, has_current=current is not None))
+    parameters = np.zeros((n_steps, model.n_x))
+    if current is not None:
+        time = dt * np.arange(n_steps, dtype=np.float64)
+        drift = current_parameters(model, states[:-1], time, current)
+        parameters = np.hstack([parameters, drift])
     path, _ = kernels.closed_loop(
         states[:1],
         states[None, :-1],
         inputs[None],
         gains[None],
-        np.zeros((1, n_steps, model.n_x)),
+        np.ascontiguousarray(parameters[None]),
         np.zeros((1, kernels.n_w)),
         dt / refinement,
         refinement,

@@ -33,6 +33,7 @@ from scipy.integrate import solve_ivp
 
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError, InputError
+from auvplan.ocean import CurrentField
 from auvplan.vehicle.params import (
     DEFAULT_EPS_ABS_RATE,
     DEFAULT_EPS_ABS_SPEED,
@@ -204,14 +205,34 @@ def read_medusa_model(
 
 
 def _scaled_derivative(
-    _s: float, y: FloatArray, model: MedusaModel, duration: FloatArray, held: FloatArray
+    s: float,
+    y: FloatArray,
+    model: MedusaModel,
+    duration: FloatArray,
+    held: FloatArray,
+    start: FloatArray,
+    current: CurrentField | None,
 ) -> FloatArray:
-    """``dx/ds = h_k f(x, c_k)``: each step's time normalised to ``s`` in [0, 1]."""
-    return (duration * model.derivative(y.reshape(-1, 8), held)).ravel()
+    """``dx/ds = h_k f(x, c_k)``: each step's time normalised to ``s`` in [0, 1].
+
+    In a current the position also moves with the water: ``(ṅ, ė) += v_c(n, e, t_k + s h_k)``.
+    """
+    states = y.reshape(-1, 8)
+    rates = model.derivative(states, held)
+    if current is not None:
+        time = start[:, 0] + s * duration[:, 0]
+        v_n, v_e = current.velocity(states[:, 0], states[:, 1], time)
+        rates[:, 0] += v_n
+        rates[:, 1] += v_e
+    return (duration * rates).ravel()
 
 
 def step_defects(
-    model: MedusaModel, time: FloatArray, states: FloatArray, inputs: FloatArray
+    model: MedusaModel,
+    time: FloatArray,
+    states: FloatArray,
+    inputs: FloatArray,
+    current: CurrentField | None = None,
 ) -> FloatArray:
     """Per-step defect of a sampled trajectory against the model's exact flow.
 
@@ -228,6 +249,9 @@ def step_defects(
         Planned states.
     inputs : ndarray of shape (n_t - 1, 2)
         Inputs held over each step.
+    current : CurrentField, optional
+        The true current field (not the optimiser's linearisation); ``u, v`` are then speeds
+        through the water.
 
     Returns
     -------
@@ -246,7 +270,7 @@ def step_defects(
             method="DOP853",
             rtol=INTEGRATION_TOLERANCE,
             atol=INTEGRATION_TOLERANCE,
-            args=(model, steps[batch, None], inputs[batch]),
+            args=(model, steps[batch, None], inputs[batch], time[batch, None], current),
         )
         if not solution.success:
             raise RuntimeError(f"reference integration failed: {solution.message}")

@@ -9,7 +9,8 @@ pairs; ``maps.nc`` only for the projection when an obstacle centre is in lat/lon
     vehicle keeps ``>= r_c`` from every obstacle's edge, every communication pair stays within
     its range;
 (b) **dynamics**: the per-step defect of the samples against an independent plain-numpy
-    MEDUSA model integrated with the input held (:mod:`auvplan.scenarios._model`);
+    MEDUSA model integrated with the input held (:mod:`auvplan.scenarios._model`), in the
+    mission's true current field when it has a ``[current]``;
 (c) **arrival**: the distance of each vehicle's last sample from its goal.
 """
 
@@ -20,6 +21,7 @@ import json
 import tomllib
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
+from datetime import datetime
 from pathlib import Path
 from typing import Any, Final
 
@@ -29,6 +31,8 @@ from scipy.interpolate import CubicSpline
 
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError, InputError
+from auvplan.io.currents import read_current
+from auvplan.ocean import CurrentField, UniformCurrent
 from auvplan.scenarios._model import read_medusa_model, step_defects
 
 STATE_COLUMNS: Final = ("north", "east", "psi", "u", "v", "r", "n_ps", "n_sb")
@@ -185,6 +189,7 @@ def check(
 
     vehicles = {vehicle["name"]: vehicle for vehicle in summary["vehicles"]}
     order = summary["solver"].get("propeller_order")
+    current = _current(document, mission_path.parent, summary, output_dir)
     position_defects, state_defects, arrival = {}, {}, {}
     for name, (t, states, inputs) in tracks.items():
         model = read_medusa_model(
@@ -192,7 +197,7 @@ def check(
             propeller_order=order,
             base_dirs=(mission_path.parent, Path()),
         )
-        defects = step_defects(model, t, states, inputs)
+        defects = step_defects(model, t, states, inputs, current)
         position_defects[name] = float(np.max(np.hypot(defects[:, 0], defects[:, 1]), initial=0.0))
         state_defects[name] = dict(
             zip(STATE_COLUMNS, np.max(np.abs(defects), axis=0, initial=0.0).tolist(), strict=True)
@@ -225,6 +230,32 @@ def check(
         max_state_defect=state_defects,
         arrival_error_m=arrival,
         failures=tuple(failures),
+    )
+
+
+def _current(
+    document: Mapping[str, Any], base_dir: Path, summary: Mapping[str, Any], output_dir: Path
+) -> CurrentField | None:
+    """The mission's true current (``[current]``; a file on the frame of ``maps.nc``)."""
+    table = document.get("current")
+    if table is None:
+        return None
+    if "file" not in table:
+        return UniformCurrent(float(table.get("north", 0.0)), float(table.get("east", 0.0)))
+    from auvplan.io.bathymetry import read_bathymetry
+
+    grid = read_bathymetry(output_dir / "maps.nc")
+    execution = document.get("mission", {})
+    start = execution.get("start_time")
+    return read_current(
+        base_dir / table["file"],
+        projection=grid.projection,
+        extent=(
+            (float(grid.geometry.north[0]), float(grid.geometry.north[-1])),
+            (float(grid.geometry.east[0]), float(grid.geometry.east[-1])),
+        ),
+        start_time=None if start is None else datetime.fromisoformat(summary["start_time"]),
+        depth=float(execution.get("depth_m", 0.0)),
     )
 
 

@@ -34,6 +34,7 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Final
 
 import casadi as ca
@@ -116,6 +117,33 @@ class VehicleModel:
         3
         """
         return self.state_names.index(name)
+
+    @cached_property
+    def dynamics_in_current(self) -> ca.Function:
+        r"""``f(x[n_x], c[n_u], v_c[2]) -> xdot[n_x]`` in a current, named ``"f_current"``.
+
+        ``u, v, r`` are the velocities through the water ``ν_r = ν − ν_c``: drag, propeller
+        inflow, control-surface lift and power see them (Fossen 2021, Sec. 10.3, for an
+        irrotational current whose acceleration is negligible), and the position moves with
+        the water, ``(ṅ, ė) = R(ψ) (u, v) + v_c`` with ``v_c = (v_N, v_E)`` [m/s] over ground.
+        With ``v_c = 0`` it is :attr:`dynamics`.
+
+        Examples
+        --------
+        >>> from auvplan.io.vehicles import load_vehicle
+        >>> model = build_vehicle_model(load_vehicle("medusa"))
+        >>> xdot = model.dynamics_in_current([0, 0, 0, 0.5, 0, 0, 40.0, 40.0], [0, 0], [-0.5, 0.1])
+        >>> np.asarray(xdot).ravel()[:2].round(6).tolist()
+        [0.0, 0.1]
+        """
+        x, c = ca.SX.sym("x", self.n_x), ca.SX.sym("c", self.n_u)
+        current = ca.SX.sym("v_c", 2)
+        drift = ca.SX.zeros(self.n_x)
+        drift[self.index("north")] = current[0]
+        drift[self.index("east")] = current[1]
+        return ca.Function(
+            "f_current", [x, c, current], [self.dynamics(x, c) + drift], ["x", "c", "v_c"], ["xdot"]
+        )
 
     @property
     def thruster_states(self) -> tuple[str, ...]:

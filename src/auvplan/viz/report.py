@@ -16,6 +16,7 @@ from auvplan.mission.pipeline import MissionResult
 from auvplan.planning import CircleObstacle, PolygonObstacle
 from auvplan.vehicle import positions
 from auvplan.viz.coordination import plot_coordination_space
+from auvplan.viz.current import add_current_arrows
 from auvplan.viz.maps import plot_terrain_maps
 from auvplan.viz.mission import plot_mission_paths, plot_separation, plot_time_series
 
@@ -96,10 +97,10 @@ def mission_figures(result: MissionResult) -> dict[str, Figure]:
     optimized = None if result.plan is None else _tracks(result, result.plan.states)
     radius = config.fleet.safety_radius
     figures: dict[str, Figure] = {"maps": plot_terrain_maps(preplan.maps)}
-    figures["paths"] = plot_mission_paths(
+    figures["paths"] = add_current_arrows(plot_mission_paths(
         preplan.bathymetry, preplan.names, planned, optimized, safety_radius=radius,
         circles=circles, polygons=polygons,
-    )  # fmt: skip
+    ), preplan.bathymetry, preplan.current)  # fmt: skip
     cost_on_grid = _cost_on_bathymetry_grid(result)
     figures["paths_cost"] = plot_mission_paths(
         preplan.bathymetry, preplan.names, planned, optimized, safety_radius=radius,

@@ -1,0 +1,103 @@
+"""The mission's ocean current: loading the ``[current]`` table, and speeds along the paths.
+
+The pre-planned paths are fixed curves; in a current ``v_c`` a vehicle moving at ``U_w``
+through the water covers them at the ground speed of :func:`auvplan.ocean.ground_speed`.
+:func:`path_ground_speeds` evaluates it along a path (current at ``t = 0``: the deconfliction
+works on geometry and time laws before the times are known), and :func:`check_crossable`
+refuses a path on which the cross-path current is stronger than the vehicle.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from auvplan._typing import FloatArray
+from auvplan.errors import InfeasibleError
+from auvplan.io.currents import read_current
+from auvplan.mission.config import MissionConfig
+from auvplan.ocean import CurrentField, UniformCurrent, ground_speed
+from auvplan.terrain import BathymetryGrid
+
+__all__ = ["check_crossable", "load_current", "mean_ground_speed", "path_ground_speeds"]
+
+
+def load_current(config: MissionConfig, bathymetry: BathymetryGrid) -> CurrentField | None:
+    """The ``[current]`` of the mission on its map (None: still water).
+
+    A uniform current of zero is still water (the plan is then exactly the still-water one;
+    the current's code path gives it up to round-off, ~1e-6 m on positions). A file is read
+    onto the terrain's local frame (:func:`auvplan.io.currents.read_current`), with time
+    relative to ``[mission] start_time`` when the mission gives one.
+    """
+    table = config.current
+    if table is None:
+        return None
+    if table.file is None:
+        north, east = table.north or 0.0, table.east or 0.0
+        return UniformCurrent(north, east) if north or east else None
+    geometry = bathymetry.geometry
+    given = "start_time" in config.mission.model_fields_set
+    return read_current(
+        table.file,
+        projection=bathymetry.projection,
+        extent=(
+            (float(geometry.north[0]), float(geometry.north[-1])),
+            (float(geometry.east[0]), float(geometry.east[-1])),
+        ),
+        start_time=config.mission.start_time if given else None,
+        depth=config.mission.depth,
+    )
+
+
+def path_ground_speeds(
+    path: FloatArray, water_speed: float, current: CurrentField
+) -> tuple[FloatArray, FloatArray]:
+    """Ground speed [m/s] on each segment of ``path`` at ``water_speed``, and segment lengths [m].
+
+    ``path`` ``(n, 2)`` north/east [m]; the current is taken at each segment's midpoint at
+    ``t = 0`` (a segment of length 0 counts as heading north). NaN marks a segment whose
+    cross-path current exceeds ``water_speed``.
+    """
+    steps = np.diff(path, axis=0)
+    lengths = np.hypot(steps[:, 0], steps[:, 1])
+    safe = np.where(lengths > 0.0, lengths, 1.0)
+    tangent = np.where(lengths[:, None] > 0.0, steps / safe[:, None], [1.0, 0.0])
+    middle = 0.5 * (path[:-1] + path[1:])
+    velocity = np.column_stack(
+        current.velocity(middle[:, 0], middle[:, 1], np.zeros(middle.shape[0]))
+    )
+    return ground_speed(water_speed, velocity, tangent), lengths
+
+
+def mean_ground_speed(path: FloatArray, water_speed: float, current: CurrentField) -> float:
+    """Length over travel time [m/s] of ``path`` at ``water_speed`` (NaN if it cannot be held)."""
+    speeds, lengths = path_ground_speeds(path, water_speed, current)
+    moving = lengths > 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        travel = np.sum(lengths[moving] / np.where(speeds[moving] > 0.0, speeds[moving], np.nan))
+    return float(np.sum(lengths) / travel) if travel > 0.0 else float("nan")
+
+
+def check_crossable(
+    name: str, path: FloatArray, water_speed: float, current: CurrentField
+) -> FloatArray:
+    """Ground speeds of :func:`path_ground_speeds`, all positive, or one line naming the cause.
+
+    Raises
+    ------
+    InfeasibleError
+        If somewhere on the path the current pushes vehicle ``name`` off the path or back
+        along it at its fastest planned speed ``water_speed`` through the water.
+    """
+    speeds, lengths = path_ground_speeds(path, water_speed, current)
+    stuck = ~(speeds > 0.0) & (lengths > 0.0)
+    if np.any(stuck):
+        k = int(np.argmax(stuck))
+        where = 0.5 * (path[k] + path[k + 1])
+        v_n, v_e = current.velocity(where[:1], where[1:], np.zeros(1))
+        raise InfeasibleError(
+            f"vehicle {name} cannot hold its path at north {where[0]:.0f} m, east "
+            f"{where[1]:.0f} m: the current ({float(v_n[0]):.2f}, {float(v_e[0]):.2f}) m/s "
+            f"north/east is stronger than its {water_speed:.2f} m/s through the water"
+        )
+    return speeds[lengths > 0.0]
