@@ -53,8 +53,19 @@ def _cholesky_solve(lower: FloatArray, rhs: FloatArray) -> FloatArray:
 
 
 @numba.njit(cache=True)
+def _above_floor(matrix: FloatArray, floor: float) -> bool:
+    """Whether ``matrix − floor·I`` passes the Cholesky test (all eigenvalues above ``floor``)."""
+    shifted = matrix.copy()
+    for i in range(matrix.shape[0]):
+        shifted[i, i] -= floor
+    return _cholesky(shifted)[1]
+
+
+@numba.njit(cache=True)
 def _clip_in_place(matrix: FloatArray, floor: float) -> None:
-    """``V max(Λ, floor) Vᵀ`` of a symmetric matrix, written over it."""
+    """``V max(Λ, floor) Vᵀ`` of a symmetric matrix, written over it (kept when already above)."""
+    if _above_floor(matrix, floor):
+        return
     values, vectors = np.linalg.eigh(matrix)
     matrix[:, :] = (vectors * np.maximum(values, floor)) @ vectors.T
 
@@ -73,8 +84,8 @@ def clip_stage_weights(
     Per stage, the eigenvalues of ``W`` are clipped at ``floor`` where ``W − floor·I`` fails
     the Cholesky test; elsewhere ``W`` is kept. ``groups[g, :group_sizes[g]]`` are index
     sets of ``z = (x, u)`` (e.g. one per vehicle); a failing stage with no entry outside
-    their diagonal blocks is clipped block by block (the same projection, cheaper), any other
-    failing stage as a whole.
+    their diagonal blocks is clipped block by block (the same projection, cheaper: blocks
+    already above the floor are kept), any other failing stage as a whole.
 
     Returns the clipped ``Q (N, n_x, n_x)``, ``S (N, n_x, n_u)`` and ``R (N, n_u, n_u)``.
     """
@@ -90,7 +101,6 @@ def clip_stage_weights(
     s_out = np.empty_like(s_mat)
     r_out = np.empty_like(r_mat)
     stage = np.empty((n, n))
-    shifted = np.empty((n, n))
     for k in range(n_stages):
         for i in range(n_x):
             for j in range(n_x):
@@ -101,11 +111,7 @@ def clip_stage_weights(
         for i in range(n_u):
             for j in range(n_u):
                 stage[n_x + i, n_x + j] = 0.5 * (r_mat[k, i, j] + r_mat[k, j, i])
-        shifted[:, :] = stage
-        for i in range(n):
-            shifted[i, i] -= floor
-        _, is_pd = _cholesky(shifted)
-        if not is_pd:
+        if not _above_floor(stage, floor):
             separable = group_sizes.size > 0
             for i in range(n):
                 for j in range(n):
