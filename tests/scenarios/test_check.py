@@ -10,8 +10,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from auvplan.cli.main import main
-from auvplan.scenarios import check, generate
 from auvplan.io.results import write_trajectories_csv
+from auvplan.scenarios import check, generate
 from auvplan.scenarios._model import ReferenceModel
 from auvplan.scenarios._vehicle_file import read_reference_model
 

@@ -11,10 +11,10 @@ import numpy as np
 from auvplan import __version__
 from auvplan.io.maps_file import write_maps_netcdf
 from auvplan.io.results import (
+    union_names,
     write_desired_csv,
     write_json,
     write_paths_geojson,
-    union_names,
     write_trajectories_csv,
 )
 from auvplan.io.text import write_toml

@@ -162,7 +162,8 @@ class ReferenceModel:
     @property
     def input_names(self) -> tuple[str, ...]:
         """``c_<thruster>``…, ``c_<surface>``…."""
-        return tuple(f"c_{a.name}" for a in (*self.thrusters, *self.surfaces))
+        names = [thruster.name for thruster in self.thrusters]
+        return tuple(f"c_{name}" for name in names + [surface.name for surface in self.surfaces])
 
     @property
     def limits(self) -> dict[str, float]:

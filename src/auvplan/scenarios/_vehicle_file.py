@@ -46,6 +46,11 @@ _HULL: Final = (
     ("X_u", "kg/s"), ("Y_v", "kg/s"), ("N_r", "kg m^2/s"), ("X_uu", "kg/m"), ("Y_vv", "kg/m"),
     ("N_rr", "kg m^2"), ("rho", "kg/m^3"),
 )  # fmt: skip
+#: Control-surface keys and units.
+_SURFACE: Final = {
+    "x": "m", "y": "m", "area": "m^2", "lift_slope": "1/rad", "drag_slope": "1/rad^2",
+    "delta_max": "rad", "rate_max": "rad/s",
+}  # fmt: skip
 #: Smoothing keys, units and the values used when the vehicle file omits them.
 _SMOOTHING: Final = {
     "inflow": ("m/s", DEFAULT_EPS_INFLOW),
@@ -155,10 +160,7 @@ def _actuators(
             name=str(entry["name"]),
             **{
                 key: _quantity(entry, key, unit, f"control_surface[{k}]")
-                for key, unit in (
-                    ("x", "m"), ("y", "m"), ("area", "m^2"), ("lift_slope", "1/rad"),
-                    ("drag_slope", "1/rad^2"), ("delta_max", "rad"), ("rate_max", "rad/s"),
-                )  # fmt: skip
+                for key, unit in _SURFACE.items()
             },
         )
         for k, entry in enumerate(document.get("control_surface", []))
@@ -195,7 +197,7 @@ def read_reference_model(
     if strips is not None:
         length = _quantity(strips, "length", "m", "hull.crossflow")
         count = int(strips.get("strips", 20))
-        stations = -0.5 * length + length / count * np.arange(count + 1)
+        stations = np.asarray(-0.5 * length + length / count * np.arange(count + 1), dtype=float)
         crossflow_scale = (
             -0.5 * hull["rho"] * _quantity(strips, "height", "m", "hull.crossflow")
             * _quantity(strips, "drag_coefficient", "1", "hull.crossflow") * length / count

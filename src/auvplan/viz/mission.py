@@ -110,7 +110,7 @@ def plot_mission_paths(
 def plot_time_series(
     time: FloatArray,
     names: Sequence[str],
-    states: Sequence[FloatArray],
+    states: FloatArray | Sequence[FloatArray],
     power: FloatArray,
     *,
     models: Sequence[VehicleModel] | None = None,
@@ -122,6 +122,7 @@ def plot_time_series(
     [W]. Each propeller speed ``n_<thruster>`` [rev/s] is drawn and labelled with its
     thruster's name; a fleet with control surfaces gets a panel of deflections [deg].
     """
+    layouts: list[tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]]
     if models is None:
         layouts = [(STATE_NAMES, STATE_NAMES[6:], ())] * len(names)
     else:
