@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import csv
 import json
 from pathlib import Path
 
@@ -11,23 +10,30 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from auvplan.cli.main import main
+from auvplan.io.results import write_trajectories_csv
 from auvplan.scenarios import check, generate
-from auvplan.scenarios._model import MedusaModel, read_medusa_model
-from auvplan.scenarios.check import INPUT_COLUMNS, STATE_COLUMNS
+from auvplan.scenarios._model import ReferenceModel
+from auvplan.scenarios._vehicle_file import read_reference_model
 
 DT = 0.5
 N_STEPS = 120
 SAFETY_RADIUS = 5.0
 
 
-@pytest.mark.parametrize("order", [0, 3, None])
-def test_independent_model_matches_the_planner_model(order: int | None) -> None:
+@pytest.mark.parametrize(
+    ("vehicle", "order"), [("medusa", 0), ("medusa", 3), ("medusa", None), ("remus100", None)]
+)
+def test_independent_model_matches_the_planner_model(vehicle: str, order: int | None) -> None:
     from auvplan.io.vehicles import load_vehicle  # the only use of the planner's model
     from auvplan.vehicle import build_vehicle_model
 
-    planner = build_vehicle_model(load_vehicle("medusa"), propeller_order=order)
-    independent = read_medusa_model("medusa", propeller_order=order)
+    planner = build_vehicle_model(load_vehicle(vehicle), propeller_order=order)
+    independent = read_reference_model(vehicle, propeller_order=order)
+    assert independent.state_names == planner.state_names
+    assert independent.input_names == planner.input_names
+    assert independent.limits == pytest.approx(dict(planner.state_limits), rel=1e-12)
     rng = np.random.default_rng(11)
+    limits = np.array([limit for _, limit in planner.state_limits])
     for _ in range(20):
         state = np.concatenate(
             [
@@ -35,23 +41,23 @@ def test_independent_model_matches_the_planner_model(order: int | None) -> None:
                 rng.uniform(-4.0, 4.0, 1),
                 rng.uniform(-1.5, 1.5, 1),
                 rng.uniform(-0.5, 0.5, 2),
-                rng.uniform(-75.0, 75.0, 2),
+                rng.uniform(-1.0, 1.0, limits.size) * limits,
             ]
         )
-        command = rng.uniform(-2.0, 2.0, 2)
+        command = rng.uniform(-2.0, 2.0, planner.n_u)
         expected = np.asarray(planner.dynamics(state, command)).ravel()
         np.testing.assert_allclose(
             independent.derivative(state, command), expected, rtol=1e-9, atol=1e-9
         )
-    at_rest = np.zeros(8)
+    at_rest = np.zeros(planner.n_x)
     np.testing.assert_allclose(
-        independent.derivative(at_rest, np.zeros(2)),
-        np.asarray(planner.dynamics(at_rest, [0.0, 0.0])).ravel(),
+        independent.derivative(at_rest, np.zeros(planner.n_u)),
+        np.asarray(planner.dynamics(at_rest, np.zeros(planner.n_u))).ravel(),
         atol=1e-12,
     )
 
 
-def _fly(model: MedusaModel, start: np.ndarray, inputs: np.ndarray) -> np.ndarray:
+def _fly(model: ReferenceModel, start: np.ndarray, inputs: np.ndarray) -> np.ndarray:
     """States at every step, each step integrated with its input held."""
     states = [start]
     for command in inputs:
@@ -68,20 +74,30 @@ def _fly(model: MedusaModel, start: np.ndarray, inputs: np.ndarray) -> np.ndarra
 
 
 def _write_plan(
-    folder: Path, tracks: dict[str, tuple[np.ndarray, np.ndarray]], mission_extra: str = ""
+    folder: Path,
+    tracks: dict[str, tuple[np.ndarray, np.ndarray]],
+    mission_extra: str = "",
+    types: dict[str, str] | None = None,
 ) -> Path:
-    """A plan output folder (summary.json, trajectories.csv) and its mission file."""
+    """A plan output folder (summary.json, trajectories.csv) and its mission file.
+
+    ``types`` maps vehicle names to their types (default ``medusa``).
+    """
+    types = {name: (types or {}).get(name, "medusa") for name in tracks}
     folder.mkdir(parents=True, exist_ok=True)
     mission = folder / "mission.toml"
     mission.write_text(f"[fleet]\nsafety_radius_m = {SAFETY_RADIUS}\n{mission_extra}")
-    time = DT * np.arange(N_STEPS + 1)
-    with (folder / "trajectories.csv").open("w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(["vehicle", "t", *STATE_COLUMNS, *INPUT_COLUMNS, "power"])
-        for name, (states, inputs) in tracks.items():
-            held = np.vstack([inputs, inputs[-1:]])
-            for k in range(time.size):
-                writer.writerow([name, time[k], *states[k], *held[k], 40.0])
+    models = [read_reference_model(types[name], propeller_order=3) for name in tracks]
+    write_trajectories_csv(
+        folder / "trajectories.csv",
+        list(tracks),
+        DT * np.arange(N_STEPS + 1),
+        [states for states, _ in tracks.values()],
+        [inputs for _, inputs in tracks.values()],
+        np.full((len(tracks), N_STEPS + 1), 40.0),
+        state_names=[model.state_names for model in models],
+        input_names=[model.input_names for model in models],
+    )
     summary = {
         "mission": str(mission),
         "fleet": {"safety_radius_m": SAFETY_RADIUS},
@@ -89,7 +105,7 @@ def _write_plan(
         "vehicles": [
             {
                 "name": name,
-                "type": "medusa",
+                "type": types[name],
                 "goal": {"north": states[-1, 0], "east": states[-1, 1], "heading_rad": 0.0},
             }
             for name, (states, _) in tracks.items()
@@ -103,7 +119,7 @@ def _write_plan(
 @pytest.fixture(scope="module")
 def tracks() -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Two MEDUSAs 30 m apart, cruising north and weaving gently."""
-    model = read_medusa_model("medusa", propeller_order=3)
+    model = read_reference_model("medusa", propeller_order=3)
     time = DT * np.arange(N_STEPS)
     inputs = 0.02 * np.column_stack([np.sin(time / 8.0), -np.sin(time / 8.0)])
     result = {}
@@ -111,6 +127,45 @@ def tracks() -> dict[str, tuple[np.ndarray, np.ndarray]]:
         start = np.array([50.0, east, 0.0, 0.5, 0.0, 0.0, 25.0, 25.0])
         result[name] = (_fly(model, start, inputs), inputs)
     return result
+
+
+@pytest.fixture(scope="module")
+def remus_track() -> tuple[np.ndarray, np.ndarray]:
+    """A REMUS 100 cruising north at 1.4 m/s, 40 m east of blue, weaving on its rudder."""
+    model = read_reference_model("remus100", propeller_order=3)
+    time = DT * np.arange(N_STEPS)
+    inputs = np.column_stack([np.zeros(N_STEPS), 0.002 * np.sin(time / 8.0)])
+    start = np.array([50.0, 60.0, 0.0, 1.4, 0.0, 0.0, 19.0, 0.0])
+    return _fly(model, start, inputs), inputs
+
+
+def test_mixed_fleet_plan_is_read_by_each_vehicle_s_own_model(
+    tmp_path: Path, tracks: dict, remus_track: tuple[np.ndarray, np.ndarray]
+) -> None:
+    folder = _write_plan(tmp_path, {**tracks, "red": remus_track}, types={"red": "remus100"})
+    header = (folder / "trajectories.csv").read_text().splitlines()[0].split(",")
+    assert header[-7:] == ["n_prop", "delta_rudder", "c_ps", "c_sb", "c_prop", "c_rudder", "power"]
+    report = check(folder)
+    assert report.success, report.failures
+    assert report.max_position_defect_m["red"] < 1e-6
+    assert set(report.max_state_defect["red"]) >= {"n_prop", "delta_rudder"}
+    assert 0.0 < report.max_limit_fraction["red"]["delta_rudder"] < 1.0
+    assert set(report.max_limit_fraction["blue"]) == {"n_ps", "n_sb"}
+
+
+def test_limit_exceeded_at_the_last_sample_fails(
+    tmp_path: Path, tracks: dict, remus_track: tuple[np.ndarray, np.ndarray]
+) -> None:
+    model = read_reference_model("remus100", propeller_order=3)
+    states, inputs = remus_track
+    inputs = inputs.copy()
+    inputs[-1, 1] = 1.0  # the rudder swings 0.5 s x 150 deg/s x tanh(1) = 57 deg > 15 deg
+    flown = states.copy()
+    flown[-1] = _fly(model, states[-2], inputs[-1:])[-1]
+    report = check(_write_plan(tmp_path, {"red": (flown, inputs)}, types={"red": "remus100"}))
+    assert {failure.kind for failure in report.failures} == {"state_limit"}
+    assert report.max_limit_fraction["red"]["delta_rudder"] > 3.0
+    assert report.max_position_defect_m["red"] < 1e-6
 
 
 def _kinds(folder: Path) -> set[str]:

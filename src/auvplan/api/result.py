@@ -139,7 +139,9 @@ class MissionPlan:
         Dimensions ``trajectory`` (vehicles) and ``obs`` (time samples); coordinates ``time``
         (UTC), ``depth`` and, on georeferenced terrain, ``lat``/``lon``; variables ``north``,
         ``east`` [m], ``heading`` [deg], ``u``, ``v`` [m/s], ``r`` [rad/s], ``n_ps``,
-        ``n_sb`` [rev/s] and ``power`` [W] (:mod:`auvplan.io.trajectories_file`).
+        ``n_sb`` [rev/s] and ``power`` [W] (:mod:`auvplan.io.trajectories_file`); a mixed fleet
+        adds its other actuator states (``n_prop`` [rev/s], ``delta_rudder`` [rad], NaN for
+        vehicles without them) and ``vehicle_type``.
 
         Raises
         ------
@@ -160,7 +162,8 @@ class MissionPlan:
         Columns ``vehicle``, ``time`` (UTC), ``t`` [s since the start], then the coordinates
         and variables of :meth:`to_xarray`: ``lat``, ``lon`` (georeferenced terrain only),
         ``depth``, ``north``, ``east``, ``u``, ``v``, ``r``, ``n_ps``, ``n_sb``, ``power``,
-        ``heading``.
+        ``heading`` (a mixed fleet: its other actuator states before ``heading``,
+        ``vehicle_type`` after it).
         """
         dataset = self.to_xarray()
         frame = dataset.to_dataframe().reset_index().drop(columns="obs")

@@ -3,9 +3,12 @@
 The column sets are part of the user-facing contract and only ever grow:
 
 * ``trajectories.csv``: ``vehicle,t,north,east,psi,u,v,r,n_ps,n_sb,c_ps,c_sb,power``
-  (SI units, ``psi`` in rad, ``n_*`` in rev/s, ``power`` in W). Inputs are held constant over
-  each step (zero-order hold); the last row of a vehicle repeats the last input, so that every
-  row is complete.
+  (SI units, ``psi`` in rad, ``n_*`` in rev/s, ``delta_*`` in rad, ``power`` in W). Inputs are
+  held constant over each step (zero-order hold); the last row of a vehicle repeats the last
+  input, so that every row is complete. A fleet with other actuators (a ``remus100``: ``n_prop``,
+  ``delta_rudder``, ``c_prop``, ``c_rudder``) adds its state and input names after MEDUSA's, in
+  model order (:func:`trajectory_columns`); a vehicle's cells of a state it does not have are
+  empty.
 * ``desired.csv``: ``vehicle,t,north,east,psi`` — the timed, deconflicted desired trajectories.
 """
 
@@ -16,17 +19,17 @@ import json
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, Final
 
 import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError, InputError
 from auvplan.terrain.projection import LocalProjection
+from auvplan.vehicle import INPUT_NAMES, STATE_NAMES
 
-TRAJECTORY_COLUMNS = (
-    "vehicle", "t", "north", "east", "psi", "u", "v", "r", "n_ps", "n_sb", "c_ps", "c_sb", "power",
-)  # fmt: skip
+#: The columns of an all-MEDUSA fleet, present in every ``trajectories.csv``.
+TRAJECTORY_COLUMNS: Final = ("vehicle", "t", *STATE_NAMES, *INPUT_NAMES, "power")
 DESIRED_COLUMNS = ("vehicle", "t", "north", "east", "psi")
 
 
@@ -71,15 +74,56 @@ def write_text_files(directory: Path, files: Mapping[str, str]) -> list[Path]:
     return written
 
 
+def union_names(per_vehicle: Sequence[Sequence[str]], first: Sequence[str]) -> tuple[str, ...]:
+    """``first``, then each other name of ``per_vehicle`` in order of first appearance.
+
+    Examples
+    --------
+    >>> union_names([("a", "b"), ("a", "c", "d")], ("a", "b"))
+    ('a', 'b', 'c', 'd')
+    """
+    names = list(first)
+    for vehicle in per_vehicle:
+        names += [name for name in vehicle if name not in names]
+    return tuple(names)
+
+
+def trajectory_columns(
+    state_names: Sequence[Sequence[str]], input_names: Sequence[Sequence[str]]
+) -> tuple[str, ...]:
+    """Header of ``trajectories.csv`` for vehicles with these state and input names.
+
+    ``vehicle, t``, the states (MEDUSA's :data:`~auvplan.vehicle.STATE_NAMES`, then the
+    others in model order), the inputs likewise, ``power``; :data:`TRAJECTORY_COLUMNS` for an
+    all-MEDUSA fleet.
+
+    Examples
+    --------
+    >>> remus = (("north", "east", "psi", "u", "v", "r", "n_prop", "delta_rudder"),)
+    >>> trajectory_columns(remus, (("c_prop", "c_rudder"),))[8:]
+    ('n_ps', 'n_sb', 'n_prop', 'delta_rudder', 'c_ps', 'c_sb', 'c_prop', 'c_rudder', 'power')
+    """
+    return (
+        "vehicle",
+        "t",
+        *union_names(state_names, STATE_NAMES),
+        *union_names(input_names, INPUT_NAMES),
+        "power",
+    )
+
+
 def write_trajectories_csv(
     path: Path,
     names: Sequence[str],
     time: FloatArray,
-    states: FloatArray,
-    inputs: FloatArray,
+    states: FloatArray | Sequence[FloatArray],
+    inputs: FloatArray | Sequence[FloatArray],
     power: FloatArray,
+    *,
+    state_names: Sequence[Sequence[str]] | None = None,
+    input_names: Sequence[Sequence[str]] | None = None,
 ) -> None:
-    """Write ``trajectories.csv``.
+    """Write ``trajectories.csv`` (columns :func:`trajectory_columns`).
 
     Parameters
     ----------
@@ -89,48 +133,79 @@ def write_trajectories_csv(
         Vehicle names, length ``n_vehicles``.
     time : ndarray of shape (n_t,)
         Time [s].
-    states : ndarray of shape (n_vehicles, n_t, 8)
-        ``(north, east, psi, u, v, r, n_ps, n_sb)`` in m, m, rad, m/s, m/s, rad/s, rev/s, rev/s.
-    inputs : ndarray of shape (n_vehicles, n_t - 1, 2)
-        ``(c_ps, c_sb)``, held over each step.
+    states : sequence of ndarray of shape (n_t, n_x_i)
+        Each vehicle's states named by ``state_names[i]`` (SI units, rev/s, rad).
+    inputs : sequence of ndarray of shape (n_t - 1, n_u_i)
+        Each vehicle's inputs named by ``input_names[i]``, held over each step.
     power : ndarray of shape (n_vehicles, n_t)
         Electrical power [W].
+    state_names, input_names : sequence of sequence of str, optional
+        Per vehicle; default MEDUSA's :data:`~auvplan.vehicle.STATE_NAMES` and
+        :data:`~auvplan.vehicle.INPUT_NAMES` for every vehicle.
+
+    Raises
+    ------
+    InputError
+        If an array does not match ``time``, ``names`` or its names.
     """
-    n_vehicles, n_t, _ = states.shape
-    if inputs.shape[:2] != (n_vehicles, n_t - 1) or power.shape != (n_vehicles, n_t):
-        raise InputError(
-            f"inconsistent shapes: states {states.shape}, inputs {inputs.shape}, "
-            f"power {power.shape}"
-        )
-    held = np.concatenate([inputs, inputs[:, -1:, :]], axis=1)
+    state_names = state_names or [STATE_NAMES] * len(names)
+    input_names = input_names or [INPUT_NAMES] * len(names)
+    n_t = time.size
+    for index, name in enumerate(names):
+        state_shape, input_shape = np.shape(states[index]), np.shape(inputs[index])
+        if (
+            state_shape != (n_t, len(state_names[index]))
+            or input_shape != (n_t - 1, len(input_names[index]))
+            or np.shape(power[index]) != (n_t,)
+        ):
+            raise InputError(
+                f"inconsistent shapes for vehicle {name}: time ({n_t},), states {state_shape}, "
+                f"inputs {input_shape}, power {np.shape(power[index])}"
+            )
+    columns = trajectory_columns(state_names, input_names)
     with path.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
-        writer.writerow(TRAJECTORY_COLUMNS)
+        writer.writerow(columns)
         for index, name in enumerate(names):
-            block = np.column_stack([time, states[index], held[index], power[index]])
-            writer.writerows([name, *(repr(float(value)) for value in row)] for row in block)
+            held = np.vstack([inputs[index], inputs[index][-1:]])
+            series = {
+                "t": time,
+                **dict(zip(state_names[index], np.transpose(states[index]), strict=True)),
+                **dict(zip(input_names[index], held.T, strict=True)),
+                "power": power[index],
+            }
+            for k in range(n_t):
+                writer.writerow(
+                    [name, *(repr(float(series[c][k])) if c in series else "" for c in columns[1:])]
+                )
 
 
 def read_trajectories_csv(path: Path) -> dict[str, dict[str, FloatArray]]:
     """Read ``trajectories.csv``: per vehicle (file order), each numeric column by name.
 
+    Empty cells (a state the vehicle does not have) read as NaN.
+
     Raises
     ------
     DataFormatError
-        If the file cannot be read or its header is not :data:`TRAJECTORY_COLUMNS`.
+        If the file cannot be read, its header lacks a column of :data:`TRAJECTORY_COLUMNS`
+        or a cell is not a number.
     """
     import pandas as pd
 
     try:
-        table = pd.read_csv(path, dtype={"vehicle": str}, keep_default_na=False)
+        table = pd.read_csv(path, dtype={"vehicle": str}, keep_default_na=False, na_values=[""])
     except (OSError, ValueError) as error:
         raise DataFormatError(f"{path}: unreadable CSV ({error})") from None
-    if tuple(table.columns) != TRAJECTORY_COLUMNS:
-        raise DataFormatError(f"{path}: header is not {','.join(TRAJECTORY_COLUMNS)}")
+    missing = [column for column in TRAJECTORY_COLUMNS if column not in table.columns]
+    if missing or table.columns[0] != "vehicle":
+        raise DataFormatError(
+            f"{path}: header is not vehicle,t,… with {','.join(TRAJECTORY_COLUMNS[1:])}"
+        )
     try:
         return {
             str(name): {
-                column: rows[column].to_numpy(dtype=np.float64) for column in TRAJECTORY_COLUMNS[1:]
+                column: rows[column].to_numpy(dtype=np.float64) for column in table.columns[1:]
             }
             for name, rows in table.groupby("vehicle", sort=False)
         }

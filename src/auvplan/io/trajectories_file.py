@@ -17,6 +17,13 @@ grid. ``time``, ``lat``, ``lon`` and ``depth`` are the auxiliary coordinates of 
 * ``n_ps``, ``n_sb`` [s-1]: port and starboard propeller speeds (revolutions per second);
 * ``power`` [W]: electrical power drawn from the battery.
 
+A fleet with other actuators (:func:`actuator_series`) adds, after these, each other state by
+its ``trajectories.csv`` name: ``n_<thruster>`` [s-1] and ``delta_<surface>`` [rad] (a
+``remus100``: ``n_prop``, ``delta_rudder``), and ``vehicle_type`` (the vehicle type's name per
+trajectory). A vehicle's samples of a state it does not have (a ``remus100``'s ``n_ps``) are
+NaN, written as the ``_FillValue`` NaN; variables without missing samples have no
+``_FillValue``, so an all-MEDUSA file is unchanged.
+
 On a georeferenced terrain the local frame's north is the north of a transverse Mercator
 projection centred on the map, which differs from true north by the meridian convergence
 (about 1e-4 rad a kilometre off the central meridian); ``heading`` is corrected for it, so it
@@ -75,8 +82,41 @@ _LON_ATTRIBUTES: Final = {
     "units": "degrees_east",
     "axis": "X",
 }
+#: Attributes of an actuator's state by its name prefix: units and a long name ``{}``.
+_ACTUATOR_ATTRIBUTES: Final = {
+    "n_": ("s-1", "speed of propeller {} (revolutions per second)"),
+    "delta_": ("rad", "deflection of control surface {} (positive: bow turns to starboard)"),
+}
 #: Length [m] of the step along ψ used to measure the meridian convergence.
 _HEADING_STEP_M: Final = 1.0
+
+
+def actuator_series(names: Sequence[str]) -> dict[str, dict[str, str]]:
+    """CF attributes of the actuator states ``names`` not in :data:`SERIES`, by name.
+
+    ``n_<thruster>`` [s-1] and ``delta_<surface>`` [rad]
+    (:class:`auvplan.vehicle.ThrusterParams`, :class:`auvplan.vehicle.ControlSurfaceParams`).
+
+    Raises
+    ------
+    DataFormatError
+        For a name that is neither.
+
+    Examples
+    --------
+    >>> actuator_series(["n_ps", "n_prop"])["n_prop"]["units"]
+    's-1'
+    """
+    attributes = {}
+    for name in names:
+        if name in SERIES:
+            continue
+        prefix = next((p for p in _ACTUATOR_ATTRIBUTES if name.startswith(p)), None)
+        if prefix is None:
+            raise DataFormatError(f"state {name!r} is not an actuator state (n_* or delta_*)")
+        units, long_name = _ACTUATOR_ATTRIBUTES[prefix]
+        attributes[name] = {"units": units, "long_name": long_name.format(name[len(prefix) :])}
+    return attributes
 
 
 def true_heading(
@@ -110,6 +150,7 @@ def trajectories_dataset(
     depth: float,
     projection: LocalProjection | None,
     attributes: Mapping[str, Any],
+    vehicle_types: Sequence[str] | None = None,
 ) -> xr.Dataset:
     """The content of ``trajectories.nc`` as :func:`read_trajectories_netcdf` returns it.
 
@@ -124,7 +165,8 @@ def trajectories_dataset(
     time : ndarray of shape (n_t,)
         Time since ``start_time`` [s].
     series : mapping of str to ndarray of shape (n_vehicles, n_t)
-        Every entry of :data:`SERIES` by name, in its unit.
+        Every entry of :data:`SERIES` by name, in its unit, then any other actuator states
+        (:func:`actuator_series`); NaN where a vehicle has no such state.
     psi : ndarray of shape (n_vehicles, n_t)
         Yaw angle [rad], clockwise from the local north.
     start_time : datetime
@@ -135,6 +177,8 @@ def trajectories_dataset(
         Local frame to WGS 84; ``None`` gives no ``lat``/``lon``.
     attributes : mapping
         Extra global attributes (strings or numbers).
+    vehicle_types : sequence of str, optional
+        Each vehicle's type name, written as ``vehicle_type`` when given.
 
     Returns
     -------
@@ -177,9 +221,9 @@ def trajectories_dataset(
         coords["lat"] = (dims, lat, _LAT_ATTRIBUTES)
         coords["lon"] = (dims, lon, _LON_ATTRIBUTES)
     heading_reference = "true north" if projection is not None else "the local frame's north"
-    data = {
+    data: dict[str, Any] = {
         name: (dims, np.asarray(series[name], dtype=np.float64), dict(attrs))
-        for name, attrs in SERIES.items()
+        for name, attrs in {**SERIES, **actuator_series(list(series))}.items()
     }
     data["heading"] = (
         dims,
@@ -190,6 +234,12 @@ def trajectories_dataset(
             "long_name": f"heading, clockwise from {heading_reference}",
         },
     )
+    if vehicle_types is not None:
+        data["vehicle_type"] = (
+            "trajectory",
+            np.array(vehicle_types, dtype=object),
+            {"long_name": "vehicle type (auvplan vehicle file name)"},
+        )
     dataset = xr.Dataset(data, coords=coords)
     dataset.attrs = {
         "Conventions": "CF-1.8",
@@ -200,8 +250,11 @@ def trajectories_dataset(
         **attributes,
     }
     for variable in dataset.variables.values():
-        variable.encoding["_FillValue"] = None
+        is_filled = variable.dtype.kind == "f" and bool(np.isnan(variable.values).any())
+        variable.encoding["_FillValue"] = np.nan if is_filled else None
     dataset["trajectory"].encoding.update(dtype="S1", char_dim_name="name_strlen")
+    if vehicle_types is not None:
+        dataset["vehicle_type"].encoding.update(dtype="S1", char_dim_name="type_strlen")
     dataset["time"].encoding.update(
         units=f"seconds since {start_time.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}",
         calendar="standard",
@@ -234,6 +287,7 @@ def read_trajectories_netcdf(path: Path) -> xr.Dataset:
 
 __all__ = [
     "SERIES",
+    "actuator_series",
     "read_trajectories_netcdf",
     "trajectories_dataset",
     "true_heading",

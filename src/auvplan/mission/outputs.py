@@ -11,6 +11,7 @@ import numpy as np
 from auvplan import __version__
 from auvplan.io.maps_file import write_maps_netcdf
 from auvplan.io.results import (
+    union_names,
     write_desired_csv,
     write_json,
     write_paths_geojson,
@@ -22,7 +23,7 @@ from auvplan.mission.config import resolved_document
 from auvplan.mission.evaluation import OptimizedPlan
 from auvplan.mission.pipeline import MissionResult
 from auvplan.mission.summary import mission_summary
-from auvplan.vehicle import headings, positions
+from auvplan.vehicle import STATE_NAMES, headings, positions
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -79,9 +80,12 @@ def write_mission_files(
     ):
         if plan is not None and stage2 is not None:
             csv_path, netcdf_path = directory / f"{stem}.csv", directory / f"{stem}.nc"
+            models = stage2.layout.models
             write_trajectories_csv(
-                csv_path, names, stage2.time, plan.states, plan.inputs, np.asarray(plan.power)
-            )
+                csv_path, names, stage2.time, plan.states, plan.inputs, np.asarray(plan.power),
+                state_names=[model.state_names for model in models],
+                input_names=[model.input_names for model in models],
+            )  # fmt: skip
             plan_dataset(result, plan).to_netcdf(netcdf_path)
             written += [csv_path, netcdf_path]
     return written
@@ -92,16 +96,27 @@ def plan_dataset(result: MissionResult, plan: OptimizedPlan) -> xr.Dataset:
 
     The dataset of :func:`auvplan.io.trajectories_file.trajectories_dataset`: what
     :func:`~auvplan.io.trajectories_file.read_trajectories_netcdf` reads back from the file
-    that :func:`write_mission_files` writes.
+    that :func:`write_mission_files` writes. The states of :data:`SERIES`, then the fleet's
+    other states (:func:`auvplan.io.results.union_names`), NaN where a vehicle has no such
+    state; ``vehicle_type`` unless every vehicle has MEDUSA's states.
     """
     assert result.deconfliction is not None  # a plan exists only after stage 2
     models = result.deconfliction.layout.models
+    names = union_names([model.state_names for model in models], tuple(SERIES))
     series = {
-        name: np.stack([plan.states[i, :, model.index(name)] for i, model in enumerate(models)])
-        for name in SERIES
-        if name != "power"
+        name: np.stack(
+            [
+                plan.states[i][:, model.index(name)]
+                if name in model.state_names
+                else np.full(plan.states[i].shape[0], np.nan)
+                for i, model in enumerate(models)
+            ]
+        )
+        for name in names
+        if name not in ("power", "psi")
     }
     psi = np.stack([headings(model, plan.states[i]) for i, model in enumerate(models)])
+    is_medusa_layout = all(model.state_names == STATE_NAMES for model in models)
     return trajectories_dataset(
         result.preplan.names,
         result.deconfliction.time,
@@ -117,4 +132,5 @@ def plan_dataset(result: MissionResult, plan: OptimizedPlan) -> xr.Dataset:
             "Information, OCEANS 2013",
             "terrain_weight": plan.terrain_weight,
         },
+        vehicle_types=None if is_medusa_layout else [model.vehicle.name for model in models],
     )

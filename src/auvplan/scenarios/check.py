@@ -9,14 +9,20 @@ pairs; ``maps.nc`` only for the projection when an obstacle centre is in lat/lon
     vehicle keeps ``>= r_c`` from every obstacle's edge, every communication pair stays within
     its range;
 (b) **dynamics**: the per-step defect of the samples against an independent plain-numpy
-    MEDUSA model integrated with the input held (:mod:`auvplan.scenarios._model`), in the
-    mission's true current field when it has a ``[current]``;
-(c) **arrival**: the distance of each vehicle's last sample from its goal.
+    model of each vehicle's own type, integrated with the input held
+    (:mod:`auvplan.scenarios._model`, read by :mod:`auvplan.scenarios._vehicle_file`), in
+    the mission's true current field when it has a ``[current]``;
+(c) **arrival**: the distance of each vehicle's last sample from its goal;
+(d) **state limits**: each vehicle's own actuator limits, ``|n_<thruster>| <= n_max`` and
+    ``|delta_<surface>| <= delta_max``, at every sample including the last. With the input
+    held, ``ṅ = w_c tanh(c)`` has one sign over a step, so the samples bound the whole step.
+
+A mixed fleet's ``trajectories.csv`` has empty cells for states a vehicle does not have; each
+vehicle is read by its own model's state and input names.
 """
 
 from __future__ import annotations
 
-import csv
 import json
 import tomllib
 from collections.abc import Mapping
@@ -32,18 +38,20 @@ from scipy.interpolate import CubicSpline
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError, InputError
 from auvplan.io.currents import read_current
+from auvplan.io.results import read_trajectories_csv
 from auvplan.ocean import CurrentField, UniformCurrent
-from auvplan.scenarios._model import read_medusa_model, step_defects
+from auvplan.scenarios._model import ReferenceModel, step_defects
+from auvplan.scenarios._vehicle_file import read_reference_model
 
-STATE_COLUMNS: Final = ("north", "east", "psi", "u", "v", "r", "n_ps", "n_sb")
-INPUT_COLUMNS: Final = ("c_ps", "c_sb")
 #: Largest per-step position defect [m] accepted (issue 11: 10 mm).
 DEFECT_TOLERANCE_M: Final = 0.01
 #: Largest distance [m] of the last sample from the goal accepted.
 ARRIVAL_TOLERANCE_M: Final = 1.0
 #: Slack [m] on geometric constraints, for rounding in the CSV only.
 GEOMETRY_SLACK_M: Final = 1e-6
-FAILURE_KINDS: Final = ("separation", "obstacle", "comm", "defect", "arrival")
+#: Relative slack on state limits, for rounding in the CSV only.
+LIMIT_SLACK: Final = 1e-9
+FAILURE_KINDS: Final = ("separation", "obstacle", "comm", "defect", "arrival", "state_limit")
 
 
 @dataclass(frozen=True)
@@ -60,7 +68,8 @@ class CheckReport:
 
     ``min_obstacle_clearance_m`` is the smallest distance to each obstacle's edge
     (``"a / obstacle k"``); ``max_state_defect`` the largest absolute defect per state (units
-    of ``trajectories.csv``); ``status`` the plan's status in ``summary.json``
+    of ``trajectories.csv``); ``max_limit_fraction`` the largest ``|x| / limit`` of each
+    vehicle's limited states (1 at the limit); ``status`` the plan's status in ``summary.json``
     (``plan_status``: CONVERGED only when the planner's own between-sample checks pass too).
     """
 
@@ -71,6 +80,7 @@ class CheckReport:
     max_comm_distance_m: dict[str, float]
     max_position_defect_m: dict[str, float]
     max_state_defect: dict[str, dict[str, float]]
+    max_limit_fraction: dict[str, dict[str, float]]
     arrival_error_m: dict[str, float]
     failures: tuple[CheckFailure, ...]
 
@@ -89,22 +99,31 @@ class CheckReport:
         return {**asdict(self), "passed": self.passed, "success": self.success}
 
 
-def read_trajectories(path: Path) -> dict[str, tuple[FloatArray, FloatArray, FloatArray]]:
-    """``trajectories.csv`` as ``{vehicle: (time (n_t,), states (n_t, 8), inputs (n_t-1, 2))}``."""
-    try:
-        with path.open(newline="", encoding="utf-8") as handle:
-            rows = list(csv.DictReader(handle))
-    except FileNotFoundError:
-        raise DataFormatError(f"{path} not found (did the plan reach the optimiser?)") from None
-    by_vehicle: dict[str, list[dict[str, str]]] = {}
-    for row in rows:
-        by_vehicle.setdefault(row["vehicle"], []).append(row)
+def read_trajectories(
+    path: Path, models: Mapping[str, ReferenceModel]
+) -> dict[str, tuple[FloatArray, FloatArray, FloatArray]]:
+    """``trajectories.csv`` as ``{vehicle: (time (n_t,), states (n_t, n_x), inputs (n_t-1, n_u))}``.
+
+    Each vehicle's columns are those of its own model (``models[vehicle]``).
+
+    Raises
+    ------
+    DataFormatError
+        If the file is missing or malformed, or a vehicle lacks a column or a value of its
+        model's states and inputs.
+    """
+    if not path.is_file():
+        raise DataFormatError(f"{path} not found (did the plan reach the optimiser?)")
     result = {}
-    for name, records in by_vehicle.items():
-        table = np.array(
-            [[float(r[c]) for c in ("t", *STATE_COLUMNS, *INPUT_COLUMNS)] for r in records]
-        )
-        result[name] = (table[:, 0], table[:, 1:9], table[:-1, 9:11])
+    for name, columns in read_trajectories_csv(path).items():
+        model = models[name]
+        wanted = (*model.state_names, *model.input_names)
+        missing = [c for c in wanted if c not in columns or np.isnan(columns[c]).any()]
+        if missing:
+            raise DataFormatError(f"{path}: vehicle {name!r} has no values of {', '.join(missing)}")
+        table = np.column_stack([columns[c] for c in ("t", *wanted)])
+        n_x = len(model.state_names)
+        result[name] = (table[:, 0], table[:, 1 : 1 + n_x], table[:-1, 1 + n_x :])
     return result
 
 
@@ -146,7 +165,15 @@ def check(
         raise DataFormatError(f"{output_dir}/summary.json has no optimisation result")
     mission_path = Path(mission) if mission is not None else _recorded_mission(summary)
     document = tomllib.loads(mission_path.read_text(encoding="utf-8"))
-    tracks = read_trajectories(output_dir / "trajectories.csv")
+    vehicles = {vehicle["name"]: vehicle for vehicle in summary["vehicles"]}
+    order = summary["solver"].get("propeller_order")
+    models = {
+        name: read_reference_model(
+            vehicle["type"], propeller_order=order, base_dirs=(mission_path.parent, Path())
+        )
+        for name, vehicle in vehicles.items()
+    }
+    tracks = read_trajectories(output_dir / "trajectories.csv", models)
     names = list(tracks)
     failures: list[CheckFailure] = []
 
@@ -187,21 +214,28 @@ def check(
                 )
             )
 
-    vehicles = {vehicle["name"]: vehicle for vehicle in summary["vehicles"]}
-    order = summary["solver"].get("propeller_order")
     current = _current(document, mission_path.parent, summary, output_dir)
-    position_defects, state_defects, arrival = {}, {}, {}
+    position_defects, state_defects, arrival, fractions = {}, {}, {}, {}
     for name, (t, states, inputs) in tracks.items():
-        model = read_medusa_model(
-            vehicles[name]["type"],
-            propeller_order=order,
-            base_dirs=(mission_path.parent, Path()),
-        )
+        model = models[name]
         defects = step_defects(model, t, states, inputs, current)
         position_defects[name] = float(np.max(np.hypot(defects[:, 0], defects[:, 1]), initial=0.0))
         state_defects[name] = dict(
-            zip(STATE_COLUMNS, np.max(np.abs(defects), axis=0, initial=0.0).tolist(), strict=True)
+            zip(
+                model.state_names,
+                np.max(np.abs(defects), axis=0, initial=0.0).tolist(),
+                strict=True,
+            )
         )
+        fractions[name] = _limit_fractions(model, states)
+        failures += [
+            CheckFailure(
+                "state_limit",
+                f"{name}: |{state}| reaches {fraction:.4g} x its limit {model.limits[state]:g}",
+            )
+            for state, fraction in fractions[name].items()
+            if fraction > 1.0 + LIMIT_SLACK
+        ]
         if position_defects[name] > defect_tolerance_m:
             step = int(np.argmax(np.hypot(defects[:, 0], defects[:, 1])))
             failures.append(
@@ -228,6 +262,7 @@ def check(
         max_comm_distance_m=comm_distances,
         max_position_defect_m=position_defects,
         max_state_defect=state_defects,
+        max_limit_fraction=fractions,
         arrival_error_m=arrival,
         failures=tuple(failures),
     )
@@ -257,6 +292,14 @@ def _current(
         start_time=None if start is None else datetime.fromisoformat(summary["start_time"]),
         depth=float(execution.get("depth_m", 0.0)),
     )
+
+
+def _limit_fractions(model: ReferenceModel, states: FloatArray) -> dict[str, float]:
+    """Largest ``|x| / limit`` over every sample (the last included) of each limited state."""
+    return {
+        state: float(np.max(np.abs(states[:, model.state_names.index(state)])) / limit)
+        for state, limit in model.limits.items()
+    }
 
 
 def _recorded_mission(summary: Mapping[str, Any]) -> Path:

@@ -9,6 +9,7 @@ return a :class:`matplotlib.figure.Figure` and touch no global pyplot state.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from typing import Final
 
 import numpy as np
 from matplotlib.colors import Colormap
@@ -17,9 +18,14 @@ from matplotlib.patches import Circle, Polygon
 
 from auvplan._typing import FloatArray
 from auvplan.terrain.grid import BathymetryGrid
-from auvplan.vehicle import STATE_NAMES
+from auvplan.vehicle import STATE_NAMES, VehicleModel
 from auvplan.viz.geography import add_geographic_axes
 from auvplan.viz.style import lighter, pair_colors, plain_tick_labels, vehicle_colors
+
+#: Line styles of a vehicle's successive actuators in one panel.
+_LINE_STYLES: Final = ("-", "--", ":", "-.")
+#: Legend names of MEDUSA's thrusters (others are labelled with their thruster's name).
+_ACTUATOR_LABELS: Final = {"n_ps": "port", "n_sb": "starboard"}
 
 
 def plot_mission_paths(
@@ -102,32 +108,51 @@ def plot_mission_paths(
 
 
 def plot_time_series(
-    time: FloatArray, names: Sequence[str], states: FloatArray, power: FloatArray
+    time: FloatArray,
+    names: Sequence[str],
+    states: FloatArray | Sequence[FloatArray],
+    power: FloatArray,
+    *,
+    models: Sequence[VehicleModel] | None = None,
 ) -> Figure:
-    """Surge/sway speed, yaw rate, propeller speeds and electrical power against time.
+    """Surge/sway speed, yaw rate, each vehicle's own actuators and electrical power.
 
-    ``states`` has shape ``(n_vehicles, n_t, 8)``; ``power`` ``(n_vehicles, n_t)`` [W].
+    ``states[i]`` has shape ``(n_t, n_x_i)``, the states of ``models[i]`` (default: MEDUSA's
+    :data:`~auvplan.vehicle.STATE_NAMES` for every vehicle); ``power`` ``(n_vehicles, n_t)``
+    [W]. Each propeller speed ``n_<thruster>`` [rev/s] is drawn and labelled with its
+    thruster's name; a fleet with control surfaces gets a panel of deflections [deg].
     """
-    figure = Figure(figsize=(9.0, 9.0), layout="constrained")
-    axes = figure.subplots(4, 1, sharex=True)
-    for k, (name, color) in enumerate(zip(names, vehicle_colors(len(names)), strict=True)):
-        axes[0].plot(time, states[k, :, STATE_NAMES.index("u")], color=color, label=f"{name} u")
-        axes[0].plot(
-            time, states[k, :, STATE_NAMES.index("v")], ":", color=color, label=f"{name} v"
-        )
-        axes[1].plot(time, states[k, :, STATE_NAMES.index("r")], color=color, label=name)
-        axes[2].plot(
-            time, states[k, :, STATE_NAMES.index("n_ps")], color=color, label=f"{name} port"
-        )
-        axes[2].plot(
-            time,
-            states[k, :, STATE_NAMES.index("n_sb")],
-            "--",
-            color=color,
-            label=f"{name} starboard",
-        )
-        axes[3].plot(time, power[k], color=color, label=name)
-    labels = ("speed [m/s]", "yaw rate [rad/s]", "propeller [rev/s]", "electrical power [W]")
+    layouts: list[tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]]
+    if models is None:
+        layouts = [(STATE_NAMES, STATE_NAMES[6:], ())] * len(names)
+    else:
+        layouts = [(m.state_names, m.thruster_states, m.surface_states) for m in models]
+    has_surfaces = any(surfaces for _, _, surfaces in layouts)
+    panels = 5 if has_surfaces else 4
+    figure = Figure(figsize=(9.0, 2.25 * panels), layout="constrained")
+    axes = figure.subplots(panels, 1, sharex=True)
+    colors = vehicle_colors(len(names))
+    for k, (name, (own, thrusters, surfaces)) in enumerate(zip(names, layouts, strict=True)):
+        series = dict(zip(own, np.transpose(states[k]), strict=True))
+        axes[0].plot(time, series["u"], color=colors[k], label=f"{name} u")
+        axes[0].plot(time, series["v"], ":", color=colors[k], label=f"{name} v")
+        axes[1].plot(time, series["r"], color=colors[k], label=name)
+        for j, state in enumerate(thrusters):
+            label = f"{name} {_ACTUATOR_LABELS.get(state, state.removeprefix('n_'))}"
+            style = _LINE_STYLES[j % len(_LINE_STYLES)]
+            axes[2].plot(time, series[state], style, color=colors[k], label=label)
+        for j, state in enumerate(surfaces):
+            label = f"{name} {state.removeprefix('delta_')}"
+            style = _LINE_STYLES[j % len(_LINE_STYLES)]
+            axes[3].plot(time, np.degrees(series[state]), style, color=colors[k], label=label)
+        axes[-1].plot(time, power[k], color=colors[k], label=name)
+    labels = [
+        "speed [m/s]",
+        "yaw rate [rad/s]",
+        "propeller [rev/s]",
+        *(["deflection [deg]"] if has_surfaces else []),
+        "electrical power [W]",
+    ]
     for ax, label in zip(axes, labels, strict=True):
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)

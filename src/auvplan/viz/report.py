@@ -29,7 +29,8 @@ FIGURE_CAPTIONS: Final = {
     "paths_energy_only": "Energy-only optimum (terrain weight 0) against the pre-planned paths.",
     "coordination": "Coordination space of the first two vehicles: collision region and the "
     "deconflicted schedule.",
-    "time_series": "Surge and sway speed, yaw rate, propeller speeds and electrical power.",
+    "time_series": "Surge and sway speed, yaw rate, propeller speeds (and control-surface "
+    "deflections) and electrical power.",
     "separation": "Distance between every pair of vehicles and to every obstacle, on the "
     "closed-loop replay.",
 }
@@ -121,8 +122,9 @@ def mission_figures(result: MissionResult) -> dict[str, Figure]:
         )
     if result.plan is not None and stage2 is not None:
         figures["time_series"] = plot_time_series(
-            stage2.time, preplan.names, result.plan.states, result.plan.power
-        )
+            stage2.time, preplan.names, result.plan.states, result.plan.power,
+            models=stage2.layout.models,
+        )  # fmt: skip
         if result.plan.fine_distances:
             figures["separation"] = plot_separation(
                 result.plan.fine_time, result.plan.fine_distances, 2 * radius
