@@ -52,8 +52,16 @@ def tracking_weights(model: VehicleModel) -> dict[str, float]:
 
 
 def regulator_weights(model: VehicleModel) -> dict[str, float]:
-    """Projection-regulator weights of ``model``'s states by name (:data:`REGULATOR_WEIGHTS`)."""
-    return {**REGULATOR_WEIGHTS, **dict.fromkeys(model.thruster_states, THRUSTER_WEIGHT)}
+    """Projection-regulator weights of ``model``'s states by name (:data:`REGULATOR_WEIGHTS`).
+
+    A control-surface deflection gets ``1 / δ_max²`` (Bryson's rule: full deflection weighs
+    like a metre of position error), so that the projection steers within the surface's range
+    rather than past it.
+    """
+    limits = dict(model.state_limits)
+    surfaces = {name: 1.0 / limits[name] ** 2 for name in model.surface_states}
+    thrusters = dict.fromkeys(model.thruster_states, THRUSTER_WEIGHT)
+    return {**REGULATOR_WEIGHTS, **thrusters, **surfaces}
 
 
 #: Input regularisation R [W per unit c²] (keeps the LQ subproblem strongly convex in c).

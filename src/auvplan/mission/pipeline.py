@@ -22,21 +22,20 @@ import time as wallclock
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
-from functools import cache
 from typing import Any
 
 from auvplan.errors import InputError, SolverError
-from auvplan.io.vehicles import load_vehicle
 from auvplan.mission.assembly import assemble_problem
 from auvplan.mission.config import MissionConfig
 from auvplan.mission.evaluation import OptimizedPlan, evaluate_plan
 from auvplan.mission.fleet import FleetLayout
+from auvplan.mission.models import vehicle_model
 from auvplan.mission.preplan import PreplanStage, run_preplan
 from auvplan.mission.progress import ProgressReporter, no_progress
 from auvplan.mission.still_water import CurrentComparison, compare_with_still_water
 from auvplan.mission.timing import DeconflictStage, run_deconfliction
 from auvplan.optimization import solve_pronto
-from auvplan.vehicle import VehicleModel, build_vehicle_model, top_speed
+from auvplan.vehicle import top_speed
 
 logger = logging.getLogger(__name__)
 
@@ -188,15 +187,6 @@ def fleet_layout(config: MissionConfig) -> FleetLayout:
                 f"top speed of {vehicle.name} ({vehicle.type}), {fastest:.2f} m/s"
             )
     return FleetLayout(names=tuple(vehicle.name for vehicle in config.vehicles), models=models)
-
-
-@cache
-def vehicle_model(vehicle_type: str, propeller_order: int | None) -> VehicleModel:
-    """The model of a vehicle type (cached per type and order; the order is capped)."""
-    params = load_vehicle(vehicle_type)
-    if propeller_order is not None:
-        propeller_order = min(propeller_order, params.propeller.max_order)
-    return build_vehicle_model(params, propeller_order=propeller_order)
 
 
 def run_optimization(

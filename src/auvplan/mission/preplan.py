@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import logging
+import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Final
 
 import numpy as np
 
-from auvplan._typing import FloatArray
+from auvplan._typing import BoolArray, FloatArray
 from auvplan.deconfliction import check_endpoint_clearance
 from auvplan.errors import InfeasibleError, InputError
 from auvplan.io.bathymetry import read_bathymetry
@@ -20,6 +23,7 @@ from auvplan.mission.config import (
     TerrainConfig,
 )
 from auvplan.mission.current import load_current
+from auvplan.mission.models import vehicle_model
 from auvplan.mission.progress import ProgressReporter, no_progress
 from auvplan.ocean import CurrentField
 from auvplan.planning import (
@@ -34,8 +38,13 @@ from auvplan.planning import (
 )
 from auvplan.terrain import BathymetryGrid, MapParameters, TerrainMaps, compute_terrain_maps
 from auvplan.terrain.synthetic import synthetic_bank
+from auvplan.vehicle import turning_radius
 
 logger = logging.getLogger(__name__)
+
+#: Distance from a right-angle corner to the arc of radius ``R`` that rounds it, per unit
+#: ``R``: ``√2 − 1`` (a grid route turns by 90° in two 45° steps a cell or two apart).
+CORNER_CUT: Final = math.sqrt(2.0) - 1.0
 
 Obstacle = CircleObstacle | PolygonObstacle
 
@@ -148,6 +157,24 @@ def goal_keep_outs(
     )
 
 
+def _with_discs(
+    is_blocked: Callable[[FloatArray, FloatArray], BoolArray],
+    discs: tuple[CircleObstacle, ...],
+    radius: float,
+) -> Callable[[FloatArray, FloatArray], BoolArray]:
+    """``is_blocked`` that also blocks points within ``radius`` [m] of the discs' centres."""
+    if not discs:
+        return is_blocked
+    centres = np.array([(disc.north, disc.east) for disc in discs])
+
+    def blocked(north: FloatArray, east: FloatArray) -> BoolArray:
+        near = np.hypot(north[..., None] - centres[:, 0], east[..., None] - centres[:, 1])
+        inside: BoolArray = np.any(near < radius, axis=-1)
+        return is_blocked(north, east) | inside
+
+    return blocked
+
+
 def plan_routes(
     maps: TerrainMaps,
     names: tuple[str, ...],
@@ -157,10 +184,15 @@ def plan_routes(
     *,
     clearance: float,
     planner: PlannerConfig,
+    turning_radii: FloatArray | None = None,
     progress: ProgressReporter = no_progress,
 ) -> tuple[tuple[Route, ...], tuple[FloatArray, ...]]:
     """One A* route per vehicle on the shifted cost map, and its smoothed curve.
 
+    The curve stays within half a cell of the route, or within the corner cut
+    :data:`CORNER_CUT` ``× R`` of a vehicle that turns no tighter than ``R``
+    (``turning_radii`` [m]; e.g. a torpedo AUV's rudder turn), whichever is wider, so that
+    the right-angle turns of the grid route are rounded to the vehicle's turning radius.
     ``progress`` is told of each vehicle's search (stage ``"A*"``, one unit per vehicle).
     """
     geometry = maps.cost_geometry
@@ -187,15 +219,16 @@ def plan_routes(
             try:
                 route = search(keep_out)
             except InfeasibleError:  # the keep-outs close every way: timing must do it
-                route = search(())
+                route, keep_out = search(()), ()
             routes.append(route)
-            # within half a cell of the route, never through a no-go cell
+            # near the route, never through a no-go cell nor within 2 r_c of a kept-out goal
+            radius = 0.0 if turning_radii is None else float(turning_radii[index])
             paths.append(
                 smooth_path(
                     route.points,
                     spacing=0.25 * cell,
-                    max_deviation=0.5 * cell,
-                    is_blocked=is_blocked,
+                    max_deviation=max(0.5 * cell, CORNER_CUT * radius),
+                    is_blocked=_with_discs(is_blocked, keep_out, 2.0 * clearance + 0.25 * cell),
                 )
             )
             logger.info(
@@ -234,9 +267,13 @@ def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progre
     check_endpoint_clearance(names, starts[:, :2], goals[:, :2], 2.0 * config.fleet.safety_radius)
     check_communication_ranges(config.comms, names, starts, goals)
     obstacles, obstacle_names = resolve_obstacles(config, bathymetry)
+    radii = np.array(
+        [turning_radius(vehicle_model(v.type, config.solver.harmonics)) for v in config.vehicles]
+    )
     routes, paths = plan_routes(
         maps, names, starts, goals, obstacles,
-        clearance=config.fleet.safety_radius, planner=config.planner, progress=progress,
+        clearance=config.fleet.safety_radius, planner=config.planner, turning_radii=radii,
+        progress=progress,
     )  # fmt: skip
     return PreplanStage(
         bathymetry=bathymetry,

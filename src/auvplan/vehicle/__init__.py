@@ -44,6 +44,7 @@ from auvplan.vehicle.limits import (
     max_surge_acceleration,
     minimum_useful_speed,
     regulator_floor,
+    turning_radius,
 )
 from auvplan.vehicle.operating import ActuatorRoles, actuator_roles, operating_state
 from auvplan.vehicle.params import (
@@ -155,6 +156,7 @@ __all__ = [
     "torque_coefficient",
     "trim_surge",
     "trim_turn",
+    "turning_radius",
     "vehicle_characteristics",
     "vessel_dynamics",
 ]

@@ -7,6 +7,9 @@ is flyable):
   most ``USEFUL_ENERGY_FACTOR`` times the optimum cruise's: below it the hotel load ``P_b/u``
   dominates and creeping costs more than waiting still; also the speed at which the propellers
   still have a controllable thrust derivative (``∂T/∂n ∝ |n|`` vanishes at rest);
+- **turning radius** — the tightest steady turn's radius over the useful speeds (the larger of
+  those at the minimum useful speed and at the optimum cruise): a rudder-steered vehicle turns
+  widest when slow, a differential-thrust one when fast;
 - **maximum surge acceleration** — ``ACCELERATION_SHARE`` of the acceleration from rest with
   every forward-pushing propeller at ``n_max`` (their bollard force over the surge mass
   ``m − X_u̇``), keeping the rest for steering and disturbance rejection.
@@ -22,7 +25,12 @@ from scipy.optimize import brentq
 
 from auvplan.vehicle.dynamics import VehicleModel
 from auvplan.vehicle.operating import actuator_roles, operating_state
-from auvplan.vehicle.trim import energy_per_metre, optimal_cruise_speed, trim_surge
+from auvplan.vehicle.trim import (
+    energy_per_metre,
+    optimal_cruise_speed,
+    tightest_turn,
+    trim_surge,
+)
 
 #: Energy per metre, relative to the optimum cruise, still counted as useful motion.
 USEFUL_ENERGY_FACTOR: Final = 2.0
@@ -51,6 +59,21 @@ def minimum_useful_speed(model: VehicleModel) -> float:
     if excess(lowest) <= 0.0:  # no hotel load: any speed is useful
         return lowest
     return float(brentq(excess, lowest, cruise.speed, xtol=1e-6))
+
+
+@cache
+def turning_radius(model: VehicleModel) -> float:
+    """Radius [m] of the tightest steady turn at every useful speed (module notes).
+
+    Examples
+    --------
+    >>> from auvplan.io.vehicles import load_vehicle
+    >>> from auvplan.vehicle.dynamics import build_vehicle_model
+    >>> round(turning_radius(build_vehicle_model(load_vehicle("medusa"))), 2)
+    0.73
+    """
+    speeds = (minimum_useful_speed(model), optimal_cruise_speed(model).speed)
+    return max(tightest_turn(model, speed).radius for speed in speeds)
 
 
 def regulator_floor(model: VehicleModel) -> dict[str, float]:
