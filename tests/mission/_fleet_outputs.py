@@ -4,7 +4,7 @@
 result and summarises them: the CSV's SHA-256, and per NetCDF variable its dimensions, type,
 attributes (``_FillValue`` included) and the SHA-256 of its raw stored bytes. The expectation
 ``all_medusa_outputs.json`` was computed by this module with the writers of commit 0f7ae5e
-(before mixed fleets) from the golden mission's arrays: an all-MEDUSA fleet must still write
+(before mixed fleets) from a seeded stand-in plan: an all-MEDUSA fleet must still write
 exactly those files.
 """
 
@@ -24,7 +24,9 @@ from auvplan.io.vehicles import load_vehicle
 from auvplan.mission.outputs import plan_dataset
 from auvplan.vehicle import VehicleModel, build_vehicle_model
 
-GOLDEN = Path(__file__).parents[1] / "regression" / "golden_mission.npz"
+#: Seed and length of the stand-in plan.
+SEED = 20261123
+N_SAMPLES = 121
 EXPECTATION = Path(__file__).parent / "all_medusa_outputs.json"
 START = datetime(2026, 5, 1, 8, 0, 0, tzinfo=UTC)
 DT = 0.5
@@ -45,13 +47,13 @@ def stand_in_result(
 
 
 def golden_medusa_result() -> Any:
-    """Stand-in result of two MEDUSAs flying the golden mission's optimised plan."""
-    golden = np.load(GOLDEN)
+    """Stand-in result of two MEDUSAs with a seeded plan (fixed: independent of the solver)."""
+    rng = np.random.default_rng(SEED)
+    states = rng.normal(size=(2, N_SAMPLES, 8)) * [100.0, 100.0, 1.0, 0.5, 0.1, 0.1, 40.0, 40.0]
+    inputs = rng.uniform(-1.0, 1.0, size=(2, N_SAMPLES - 1, 2))
     model = build_vehicle_model(load_vehicle("medusa"))
-    power = 40.0 + np.abs(golden["states"][..., 6]) + np.abs(golden["states"][..., 7])
-    return stand_in_result(
-        ("blue", "green"), (model, model), golden["states"], golden["inputs"], power
-    )
+    power = 40.0 + np.abs(states[..., 6]) + np.abs(states[..., 7])
+    return stand_in_result(("blue", "green"), (model, model), states, inputs, power)
 
 
 def write_files(result: Any, plan: Any, folder: Path) -> tuple[Path, Path]:

@@ -144,14 +144,21 @@ def solve_ipopt(
     barrier_term: ca.MX = ca.MX(0)
     inequalities: list[ca.MX] = []
     for constraint in problem.constraints:
-        slack = constraint.function.map(n_steps)(current, inputs, params) / constraint.scale
-        if hard_constraints:
-            inequalities.append(ca.vec(slack))
-        if barrier is not None:
-            epsilon, delta = barrier
-            is_hockey = constraint.kind is BarrierKind.HOCKEY
-            values = barrier_expression(slack, delta, is_hockey=is_hockey)
-            barrier_term = barrier_term + epsilon * problem.dt * ca.sum1(ca.sum2(values))
+        slacks = [constraint.function.map(n_steps)(current, inputs, params) / constraint.scale]
+        final = np.flatnonzero(constraint.at_final_node).tolist()
+        if final:  # the components free of u also hold at x_N (last input and parameters)
+            at_end = constraint.function(
+                states[:, n_steps], inputs[:, n_steps - 1], params[:, n_steps - 1]
+            )
+            slacks.append(ca.vertcat(*[at_end[i] for i in final]) / constraint.scale)
+        for slack in slacks:
+            if hard_constraints:
+                inequalities.append(ca.vec(slack))
+            if barrier is not None:
+                epsilon, delta = barrier
+                is_hockey = constraint.kind is BarrierKind.HOCKEY
+                values = barrier_expression(slack, delta, is_hockey=is_hockey)
+                barrier_term = barrier_term + epsilon * problem.dt * ca.sum1(ca.sum2(values))
     variables = ca.vertcat(ca.vec(states), ca.vec(inputs))
     n_ineq = sum(int(g.numel()) for g in inequalities)
     constraints = ca.vertcat(ca.vec(defects), *inequalities)

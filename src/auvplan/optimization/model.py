@@ -46,6 +46,9 @@ class ProntoModel:
         Scale of every constraint component (the barrier sees ``c / scale``).
     is_hockey : ndarray of shape (n_c,)
         Whether each component's barrier is composed with the hockey stick.
+    at_final_node : ndarray of shape (n_c,)
+        Whether each component is also imposed at the final node ``x_N``
+        (:attr:`PathConstraint.at_final_node`).
     """
 
     problem: TrajectoryProblem
@@ -54,6 +57,7 @@ class ProntoModel:
     constraints: ConstraintModel | None
     slack_scales: FloatArray
     is_hockey: BoolArray
+    at_final_node: BoolArray
 
     @property
     def has_constraints(self) -> bool:
@@ -102,6 +106,7 @@ def build_model(problem: TrajectoryProblem, backend: StageBackend | None = None)
     constraints = None
     scales: list[float] = []
     hockey: list[bool] = []
+    final: list[BoolArray] = []
     if problem.constraints:
         constraints = discretize_constraints(
             tuple(c.function for c in problem.constraints),
@@ -112,6 +117,7 @@ def build_model(problem: TrajectoryProblem, backend: StageBackend | None = None)
         for constraint in problem.constraints:
             scales += [constraint.scale] * constraint.n_components
             hockey += [constraint.kind is BarrierKind.HOCKEY] * constraint.n_components
+            final.append(constraint.at_final_node)
     return ProntoModel(
         problem=problem,
         discrete=discrete,
@@ -119,6 +125,7 @@ def build_model(problem: TrajectoryProblem, backend: StageBackend | None = None)
         constraints=constraints,
         slack_scales=np.asarray(scales, dtype=np.float64),
         is_hockey=np.asarray(hockey, dtype=np.bool_),
+        at_final_node=np.concatenate(final) if final else np.zeros(0, dtype=np.bool_),
     )
 
 

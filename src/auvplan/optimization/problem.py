@@ -7,6 +7,7 @@ IPOPT bridge is
 
     \min_{x, u}\; \sum_{k=0}^{N-1} \Big[ L(x_k, u_k, p_k)
         + ε\, dt \sum_j b_j\big(c_j(x_k, u_k, p_k) / \text{scale}_j\big) \Big] + m(x_N)
+        + ε\, dt \sum_{j \in \mathcal{F}} b_j\big(c_j(x_N, u_{N-1}, p_{N-1}) / \text{scale}_j\big)
     \quad \text{s.t.}\quad x_{k+1} = F(x_k, u_k, p_k),\; x_0 = x0,
 
 with ``F`` the flow of the dynamics over the control interval ``dt``, approximated by
@@ -14,7 +15,8 @@ with ``F`` the flow of the dynamics over the control interval ``dt``, approximat
 running-cost rate along the same substeps (see :mod:`auvplan.optimization.integration`),
 ``b_j`` the approximate log barrier composed with the hockey stick (``kind="hockey"``) or not
 (``kind="plain"``), see :mod:`auvplan.optimization.barrier`. Path constraints are imposed at
-the nodes ``k = 0..N-1`` (where an input exists); ``x_N`` is steered by the terminal cost.
+the nodes ``k = 0..N-1`` and, for their components free of ``u``, at the final node ``x_N``
+too (the set ``F``, with ``u_{N-1}``, ``p_{N-1}`` held; :attr:`PathConstraint.at_final_node`).
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from typing import Literal, Protocol, runtime_checkable
 import casadi as ca
 import numpy as np
 
-from auvplan._typing import FloatArray
+from auvplan._typing import BoolArray, FloatArray
 from auvplan.errors import InputError
 from auvplan.optimization.barrier import BarrierKind
 from auvplan.optimization.integration import check_substeps
@@ -93,6 +95,17 @@ class PathConstraint:
         """Number of constraint components ``n_c``."""
         return int(self.function.numel_out(0))
 
+    @property
+    def at_final_node(self) -> BoolArray:
+        """Which components are also imposed at the final node ``x_N``: those free of ``u``.
+
+        The final state has no input of its own; a component that depends only on ``x`` (and
+        ``p``) is evaluated there with the last stage's parameters.
+        """
+        depends = np.zeros(self.n_components, dtype=np.bool_)
+        depends[np.asarray(self.function.sparsity_jac(1, 0).row(), dtype=np.int64)] = True
+        return ~depends
+
 
 def _as_matrix(value: FloatArray, size: int, name: str) -> FloatArray:
     array = np.asarray(value, dtype=np.float64)
@@ -128,7 +141,7 @@ class TrajectoryProblem:
     stage_parameters : ndarray of shape (n_steps, n_p)
         Per-stage parameters ``p_k`` (held over the step); default: no parameters.
     constraints : tuple of PathConstraint
-        Path constraints, imposed at nodes ``k = 0..N-1``.
+        Path constraints, imposed at nodes ``k = 0..N-1`` (and at ``N``, see module notes).
     regulator_Q : ndarray of shape (n_x, n_x) or (n_x,)
         State weight of the projection regulator (diagonal when 1-D); default identity.
     regulator_R : ndarray of shape (n_u, n_u) or (n_u,)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from auvplan._typing import FloatArray
+from auvplan._typing import BoolArray, FloatArray
 from auvplan.optimization import _kernels
 from auvplan.optimization.barrier import composed_barrier, hockey_stick
 from auvplan.optimization.model import ProntoModel
@@ -61,15 +61,35 @@ def _barrier_terms(
     return parts[0], parts[1], parts[2], argument
 
 
+def constraint_nodes(
+    model: ProntoModel, trajectory: Trajectory
+) -> tuple[FloatArray, FloatArray, FloatArray, BoolArray]:
+    """Where the path constraints are imposed: stages ``0..N−1`` and the final node ``N``.
+
+    Returns the states ``(N+1, n_x)``, inputs and parameters ``(N+1, ·)`` (node ``N`` holds
+    the last stage's) and the mask ``(N+1, n_c)`` of imposed components (at node ``N`` only
+    those free of ``u``, :attr:`ProntoModel.at_final_node`).
+    """
+    params = model.problem.parameters
+    inputs = np.concatenate([trajectory.inputs, trajectory.inputs[-1:]])
+    imposed = np.ones((trajectory.n_steps + 1, model.slack_scales.size), dtype=np.bool_)
+    imposed[-1] = model.at_final_node
+    return trajectory.states, inputs, np.concatenate([params, params[-1:]]), imposed
+
+
+def _scaled_slacks(model: ProntoModel, trajectory: Trajectory) -> tuple[FloatArray, BoolArray]:
+    """Scaled slacks ``c / scale`` at the constraint nodes, and the imposed mask."""
+    assert model.constraints is not None
+    states, inputs, params, imposed = constraint_nodes(model, trajectory)
+    return model.constraints.values(states, inputs, params) / model.slack_scales, imposed
+
+
 def min_slack(model: ProntoModel, trajectory: Trajectory) -> float:
     """Smallest scaled constraint slack ``min_{k,j} c_kj / scale_j`` (``inf`` without any)."""
     if not model.has_constraints:
         return float("inf")
-    assert model.constraints is not None
-    values = model.constraints.values(
-        trajectory.states[:-1], trajectory.inputs, model.problem.parameters
-    )
-    return float(np.min(values / model.slack_scales))
+    slack, imposed = _scaled_slacks(model, trajectory)
+    return float(np.min(slack[imposed]))
 
 
 def evaluate_cost(
@@ -89,7 +109,8 @@ def evaluate_cost(
     Returns
     -------
     parts : CostParts
-        ``running = Σ L_k``, ``terminal = m(x_N)``, ``barrier = ε dt Σ_{k,j} b_j(s_kj)``.
+        ``running = Σ L_k``, ``terminal = m(x_N)``, ``barrier = ε dt Σ_{k,j} b_j(s_kj)``
+        over the constraint nodes ``k = 0..N`` (:func:`constraint_nodes`).
         Non-finite trajectories give ``inf`` parts.
     min_slack : float
         ``min_{k,j} c_kj / scale_j`` (``inf`` without constraints).
@@ -107,12 +128,10 @@ def evaluate_cost(
         barrier = 0.0
         smallest = float("inf")
         if model.has_constraints:
-            assert model.constraints is not None
-            values = model.constraints.values(trajectory.states[:-1], trajectory.inputs, params)
-            slack = values / model.slack_scales
+            slack, imposed = _scaled_slacks(model, trajectory)
             value, _, _, _ = _barrier_terms(model, slack, delta)
-            barrier = float(epsilon * model.problem.dt * np.sum(value))
-            smallest = float(np.min(slack))
+            barrier = float(epsilon * model.problem.dt * np.sum(value, where=imposed))
+            smallest = float(np.min(slack[imposed]))
     parts = CostParts(running, terminal, barrier)
     if not np.isfinite(parts.total):
         return CostParts(np.inf, np.inf, np.inf), -np.inf
@@ -135,9 +154,10 @@ class Linearization:
         Objective parts at the trajectory.
     min_slack : float
         Smallest scaled slack; ``min_argument`` the smallest barrier argument ``z``.
-    barrier_outer : ndarray of shape (N, n_c)
+    barrier_outer : ndarray of shape (N + 1, n_c)
         ``ε dt b''(s) / scale²`` (weights of ``c_x c_xᵀ``); ``barrier_weight`` is
-        ``ε dt b'(s) / scale`` (weights of ``∇²c``); ``c_x``, ``c_u`` the constraint Jacobians.
+        ``ε dt b'(s) / scale`` (weights of ``∇²c``); ``c_x``, ``c_u`` the constraint Jacobians;
+        at the constraint nodes ``0..N`` (:func:`constraint_nodes`; zero where not imposed).
     """
 
     A: FloatArray
@@ -165,7 +185,8 @@ def linearize(
     Notes
     -----
     With slack ``s = c / scale`` and ``b`` the composed barrier,
-    ``a_k = L_x + ε dt Σ_j b'_j c_{x,j} / scale_j`` (likewise ``b_k``).
+    ``a_k = L_x + ε dt Σ_j b'_j c_{x,j} / scale_j`` (likewise ``b_k``); the final node's
+    barrier adds to ``m_x`` (its Hessian to ``P_N``, :func:`second_order_weights`).
     """
     problem = model.problem
     states, inputs, params = trajectory.states[:-1], trajectory.inputs, problem.parameters
@@ -175,28 +196,30 @@ def linearize(
         stage_cost = stage_cost + problem.dt * value
         l_x = l_x + problem.dt * gradient
     terminal, m_x, m_xx = model.terminal.evaluate(trajectory.states[-1])
-    n_stages = trajectory.n_steps
+    n_nodes = trajectory.n_steps + 1
     n_c = model.constraints.n_c if model.constraints is not None else 0
-    outer = np.zeros((n_stages, n_c))
-    weight = np.zeros((n_stages, n_c))
-    c_x = np.zeros((n_stages, n_c, problem.n_states))
-    c_u = np.zeros((n_stages, n_c, problem.n_inputs))
+    outer = np.zeros((n_nodes, n_c))
+    weight = np.zeros((n_nodes, n_c))
+    c_x = np.zeros((n_nodes, n_c, problem.n_states))
+    c_u = np.zeros((n_nodes, n_c, problem.n_inputs))
     barrier = 0.0
     smallest = min_argument = float("inf")
     if model.has_constraints:
         assert model.constraints is not None
-        values, c_x, c_u = model.constraints.jacobians(states, inputs, params)
+        node_states, node_inputs, node_params, imposed = constraint_nodes(model, trajectory)
+        values, c_x, c_u = model.constraints.jacobians(node_states, node_inputs, node_params)
         scale = model.slack_scales
         slack = values / scale
         value, first, second, argument = _barrier_terms(model, slack, delta)
         factor = epsilon * problem.dt
-        barrier = float(factor * np.sum(value))
-        weight = factor * first / scale
-        outer = factor * second / (scale * scale)
-        l_x = l_x + np.einsum("kj,kji->ki", weight, c_x)
-        l_u = l_u + np.einsum("kj,kji->ki", weight, c_u)
-        smallest = float(np.min(slack))
-        min_argument = float(np.min(argument))
+        barrier = float(factor * np.sum(value, where=imposed))
+        weight = np.where(imposed, factor * first / scale, 0.0)
+        outer = np.where(imposed, factor * second / (scale * scale), 0.0)
+        l_x = l_x + np.einsum("kj,kji->ki", weight[:-1], c_x[:-1])
+        l_u = l_u + np.einsum("kj,kji->ki", weight[:-1], c_u[:-1])
+        m_x = m_x + weight[-1] @ c_x[-1]  # components free of u: no c_u at node N
+        smallest = float(np.min(slack[imposed]))
+        min_argument = float(np.min(argument[imposed]))
     return Linearization(
         A=f_x,
         B=f_u,
@@ -246,19 +269,33 @@ def _with_barrier_hessians(
 ) -> StageWeights:
     """``blocks`` plus the node costs' and the barrier's Hessians.
 
-    The barrier Hessian is ``Σ_j [w''_j c_j' c_j'ᵀ + w'_j ∇²c_j]``, a node cost's ``dt ∇²r``.
+    The barrier Hessian is ``Σ_j [w''_j c_j' c_j'ᵀ + w'_j ∇²c_j]``, a node cost's ``dt ∇²r``;
+    the final node's barrier Hessian (in ``x`` only) is added to ``P_N = m_xx``.
     """
     q, s, r = blocks
+    p_final = lin.m_xx
     for term in model.problem.node_costs:
         q = q + model.problem.dt * term.derivatives(trajectory.states[:-1])[2]
     if model.has_constraints:
         assert model.constraints is not None
+        states, inputs, params, _ = constraint_nodes(model, trajectory)
+        stages, final = slice(None, -1), slice(-1, None)
         h_xx, h_xu, h_uu = model.constraints.weighted_hessians(
-            trajectory.states[:-1], trajectory.inputs, model.problem.parameters, lin.barrier_weight
+            states[stages], inputs[stages], params[stages], lin.barrier_weight[stages]
         )
         q, s, r = q + h_xx, s + h_xu, r + h_uu
-        model.constraints.add_outer_products(lin.barrier_outer, lin.c_x, lin.c_u, (q, s, r))
-    return StageWeights(q, s, r, lin.m_xx)
+        model.constraints.add_outer_products(
+            lin.barrier_outer[stages], lin.c_x[stages], lin.c_u[stages], (q, s, r)
+        )
+        end = model.constraints.weighted_hessians(
+            states[final], inputs[final], params[final], lin.barrier_weight[final]
+        )
+        end_xx = end[0] + lin.m_xx
+        model.constraints.add_outer_products(
+            lin.barrier_outer[final], lin.c_x[final], lin.c_u[final], (end_xx, end[1], end[2])
+        )
+        p_final = end_xx[0]
+    return StageWeights(q, s, r, p_final)
 
 
 def second_order_weights(
