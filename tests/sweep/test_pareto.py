@@ -132,7 +132,7 @@ def test_overall_front_matches_loop_and_points_compare_with_energy_only(
     np.testing.assert_allclose(points["improvement"], 1.0 - points[TAN_COLUMN] / 4.0)
     best = trade_off(view, energy_budget=0.15, target=0.2)
     candidates = points[~points["is_reference"]]
-    within = candidates[candidates["energy_increase"] <= 0.15]
+    within = candidates[(candidates["energy_increase"] <= 0.15) & (candidates["improvement"] > 0)]
     reaching = candidates[candidates["improvement"] >= 0.2]
     for name, chosen, column, pick in (
         ("best_within_budget", within, "improvement", max),

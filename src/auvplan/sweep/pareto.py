@@ -155,8 +155,8 @@ def trade_off(
     Returns
     -------
     dict
-        ``best_within_budget``: the point of largest improvement with ``energy_increase <=
-        energy_budget``; ``cheapest_reaching_target``: the point of least energy increase
+        ``best_within_budget``: the point of largest (positive) improvement with
+        ``energy_increase <= energy_budget``; ``cheapest_reaching_target``: the point of least energy increase
         with ``improvement >= target``; each a record of the points table, or None.
 
     Examples
@@ -172,7 +172,9 @@ def trade_off(
     candidates = points[
         points["converged"] & ~points["is_reference"] & points["improvement"].notna()
     ]
-    within = candidates[candidates["energy_increase"] <= energy_budget]
+    within = candidates[
+        (candidates["energy_increase"] <= energy_budget) & (candidates["improvement"] > 0.0)
+    ]
     reaching = candidates[candidates["improvement"] >= target]
     return {
         "best_within_budget": _record(within, "improvement", largest=True),
