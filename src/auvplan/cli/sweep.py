@@ -260,14 +260,13 @@ def _print_trade_off(best: dict[str, dict[str, Any] | None], view: ParetoView | 
             f" ({point['group']})" if point["group"] else ""
         )
         return (
-            f"{where}: {objective} {100 * point['improvement']:+.1f} % better for "
+            f"{where}: {objective} {100 * point['improvement']:.1f} % better for "
             f"{100 * point['energy_increase']:+.1f} % energy"
         )
 
-    print(
-        f"vs the energy-only plan, best within +10 % energy: {describe(best['best_within_budget'])}"
-    )
-    print(f"cheapest plan {objective} >= 30 % better: {describe(best['cheapest_reaching_target'])}")
+    within, reaching = best["best_within_budget"], best["cheapest_reaching_target"]
+    print(f"vs the energy-only plan, best within +10 % energy: {describe(within)}")
+    print(f"cheapest plan with {objective} >= 30 % better: {describe(reaching)}")
 
 
 def _counts(records: Sequence[RunRecord]) -> dict[str, Any]:

@@ -156,8 +156,9 @@ def trade_off(
     -------
     dict
         ``best_within_budget``: the point of largest (positive) improvement with
-        ``energy_increase <= energy_budget``; ``cheapest_reaching_target``: the point of least energy increase
-        with ``improvement >= target``; each a record of the points table, or None.
+        ``energy_increase <= energy_budget``; ``cheapest_reaching_target``: the point of least
+        energy increase with ``improvement >= target``; each a record of the points table, or
+        None.
 
     Examples
     --------
