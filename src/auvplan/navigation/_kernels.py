@@ -152,6 +152,7 @@ def particle_filter(
     spare_n = np.empty(n_particles)
     spare_e = np.empty(n_particles)
     jitter = roughening / np.sqrt(n_particles)
+    sums = np.zeros(7)  # of the weighted moments (_add_moments)
     shift = 0.0
     rough_n = rough_e = 0.0
     n_resamples = 0
@@ -169,7 +170,7 @@ def particle_filter(
         # one fused pass: predict (with the last resampling's roughening), weigh, moments
         best = -np.inf
         ref_n = ref_e = 0.0
-        s = s2 = s_n = s_e = s_nn = s_ee = s_ne = 0.0
+        sums[:] = 0.0
         for i in range(n_particles):
             if k > 0:
                 north[i] += step_n + sigma_n * rng.standard_normal()
@@ -186,14 +187,7 @@ def particle_filter(
             best = max(best, log_w[i])
             w = np.exp(log_w[i])
             weight[i] = w
-            dn, de = north[i] - ref_n, east[i] - ref_e
-            s += w
-            s2 += w * w
-            s_n += w * dn
-            s_e += w * de
-            s_nn += w * dn * dn
-            s_ee += w * de * de
-            s_ne += w * dn * de
+            _add_moments(sums, w, north[i] - ref_n, east[i] - ref_e)
         if best == -np.inf:  # no particle can explain the soundings: leave them out
             n_skipped += 1
             log_w[:] = prior
@@ -204,11 +198,7 @@ def particle_filter(
             weight[:] = np.exp(log_w - best)
             s, s2, mean_n, mean_e, p_nn, p_ee, p_ne = _weighted_moments(weight, north, east)
         else:
-            m_n, m_e = s_n / s, s_e / s
-            mean_n, mean_e = ref_n + m_n, ref_e + m_e
-            p_nn = max(s_nn / s - m_n * m_n, 0.0)
-            p_ee = max(s_ee / s - m_e * m_e, 0.0)
-            p_ne = s_ne / s - m_n * m_e
+            s, s2, mean_n, mean_e, p_nn, p_ee, p_ne = _moments(sums, ref_n, ref_e)
         shift = best
         estimate[k, 0], estimate[k, 1] = mean_n, mean_e
         covariance[k, 0], covariance[k, 1], covariance[k, 2] = p_nn, p_ee, p_ne
@@ -264,27 +254,39 @@ def _weighted_moments(
     Returns ``sum w, sum w², mean north, mean east, P_nn, P_ee, P_ne``; the sums run about
     particle 0, so that the covariance loses no digits to the mean's magnitude.
     """
-    ref_n, ref_e = north[0], east[0]
-    s = s2 = s_n = s_e = s_nn = s_ee = s_ne = 0.0
+    sums = np.zeros(7)
     for i in range(weight.size):
-        w = weight[i]
-        dn, de = north[i] - ref_n, east[i] - ref_e
-        s += w
-        s2 += w * w
-        s_n += w * dn
-        s_e += w * de
-        s_nn += w * dn * dn
-        s_ee += w * de * de
-        s_ne += w * dn * de
-    m_n, m_e = s_n / s, s_e / s
+        _add_moments(sums, weight[i], north[i] - north[0], east[i] - east[0])
+    return _moments(sums, north[0], east[0])
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _add_moments(sums: FloatArray, w: float, dn: float, de: float) -> None:
+    """Add a particle of weight ``w`` at ``(dn, de)`` from the reference to the 7 ``sums``."""
+    sums[0] += w
+    sums[1] += w * w
+    sums[2] += w * dn
+    sums[3] += w * de
+    sums[4] += w * dn * dn
+    sums[5] += w * de * de
+    sums[6] += w * dn * de
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _moments(
+    sums: FloatArray, ref_n: float, ref_e: float
+) -> tuple[float, float, float, float, float, float, float]:
+    """``sum w, sum w², mean north, mean east, P_nn, P_ee, P_ne`` from the sums about ``ref``."""
+    s = sums[0]
+    m_n, m_e = sums[2] / s, sums[3] / s
     return (
         s,
-        s2,
+        sums[1],
         ref_n + m_n,
         ref_e + m_e,
-        max(s_nn / s - m_n * m_n, 0.0),
-        max(s_ee / s - m_e * m_e, 0.0),
-        s_ne / s - m_n * m_e,
+        max(sums[4] / s - m_n * m_n, 0.0),
+        max(sums[5] / s - m_e * m_e, 0.0),
+        sums[6] / s - m_n * m_e,
     )
 
 
