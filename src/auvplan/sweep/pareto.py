@@ -188,7 +188,10 @@ def _record(points: pd.DataFrame, column: str, *, largest: bool) -> dict[str, An
     if points.empty:
         return None
     index = points[column].idxmax() if largest else points[column].idxmin()
-    return {str(key): value for key, value in points.loc[index].items()}
+    return {  # plain Python values (numpy scalars unwrapped), ready for JSON
+        str(key): value.item() if isinstance(value, np.generic) else value
+        for key, value in points.loc[index].items()
+    }
 
 
 def _front(points: pd.DataFrame, objective: str, maximize: bool) -> BoolArray:
