@@ -31,9 +31,24 @@ goal = { north = 250.0, east = 320.0 }
 """
 
 
-@pytest.fixture
-def tiny_mission(tmp_path: Path) -> Path:
-    """A two-vehicle mission on a 300 m x 400 m grid (``--stage preplan`` takes < 1 s)."""
+#: One vehicle for 300 s at a 2 s control interval: a full plan in a few seconds.
+TINY_FULL_MISSION = """
+[terrain]
+file = "grid.nc"
+[fleet]
+horizon_s = 300.0
+safety_radius_m = 5.0
+[[vehicle]]
+name = "blue"
+start = { north = 10.0, east = 200.0, heading_deg = 0.0 }
+goal = { north = 150.0, east = 220.0 }
+[solver]
+dt_s = 2.0
+"""
+
+
+def _write_tiny_mission(folder: Path, text: str) -> Path:
+    """``text`` as ``folder/mission.toml`` next to its 300 m x 400 m grid ``grid.nc``."""
     north = SPACING * np.arange(N_ROWS)
     east = SPACING * np.arange(N_COLS)
     depth = 30.0 + 10.0 * np.sin(north[:, None] / 40.0) * np.cos(east[None, :] / 55.0)
@@ -41,10 +56,22 @@ def tiny_mission(tmp_path: Path) -> Path:
     xr.Dataset(
         {"depth": (("north", "east"), depth, {"units": "m", "positive": "down"})},
         coords={"north": ("north", north, {"units": "m"}), "east": ("east", east, {"units": "m"})},
-    ).to_netcdf(tmp_path / "grid.nc")
-    path = tmp_path / "mission.toml"
-    path.write_text(TINY_MISSION, encoding="utf-8")
+    ).to_netcdf(folder / "grid.nc")
+    path = folder / "mission.toml"
+    path.write_text(text, encoding="utf-8")
     return path
+
+
+@pytest.fixture
+def tiny_mission(tmp_path: Path) -> Path:
+    """A two-vehicle mission on a 300 m x 400 m grid (``--stage preplan`` takes < 1 s)."""
+    return _write_tiny_mission(tmp_path, TINY_MISSION)
+
+
+@pytest.fixture
+def tiny_full_mission(tmp_path: Path) -> Path:
+    """One vehicle on the same grid, cheap enough to plan in full in the fast suite."""
+    return _write_tiny_mission(tmp_path, TINY_FULL_MISSION)
 
 
 @pytest.fixture

@@ -7,7 +7,14 @@ import pandas as pd
 import pytest
 from matplotlib.figure import Figure
 
-from auvplan.sweep import TAN_COLUMN, RunRecord, non_dominated, pareto_view, sweep_frame
+from auvplan.sweep import (
+    TAN_COLUMN,
+    RunRecord,
+    non_dominated,
+    pareto_view,
+    sweep_frame,
+    trade_off,
+)
 from auvplan.viz.sweep import plot_pareto
 
 
@@ -63,7 +70,8 @@ def test_points_average_mission_seeds_and_rank_converged_only() -> None:
     figure = plot_pareto(view)
     assert isinstance(figure, Figure)
     assert figure.axes[0].get_xlabel() == "fleet energy [kJ]"
-    assert sum(len(c.get_offsets()) for c in figure.axes[0].collections) == 4
+    # 4 points, and the star on the energy-only one
+    assert sum(len(c.get_offsets()) for c in figure.axes[0].collections) == 5
 
 
 def test_filled_tan_column_switches_objective_and_scenarios_group_by_seed() -> None:
@@ -88,3 +96,63 @@ def test_no_points_without_energy() -> None:
     )
     assert pareto_view(frame, ["weights.terrain"], seeds_are_missions=False) is None
     assert isinstance(frame, pd.DataFrame)
+
+
+def test_overall_front_matches_loop_and_points_compare_with_energy_only(
+    rng: np.random.Generator,
+) -> None:
+    weights, informations = (0.0, 0.5, 1.0, 3.0), (0.0, 30.0)
+    records = [
+        RunRecord(
+            f"w{w}i{i}",
+            {"weights.terrain": w, "weights.information": i},
+            None,
+            "CONVERGED",
+            energy=100.0 if w == 0.0 else float(rng.uniform(100.0, 130.0)),
+            terrain_information=0.5,
+            folder=None,
+        )
+        for i in informations
+        for w in weights
+    ]
+    keys = ["weights.terrain", "weights.information"]
+    frame = sweep_frame(records, keys)
+    frame[TAN_COLUMN] = [
+        4.0 if w == 0.0 else rng.uniform(2.5, 4.5) for _ in informations for w in weights
+    ]
+    view = pareto_view(frame, keys, seeds_are_missions=False)
+    assert view is not None
+    points = view.points
+    expected = _dominated_by_loop(
+        points["energy_J"].to_numpy(), points[TAN_COLUMN].to_numpy(), maximize=False
+    )
+    assert points["on_overall_front"].tolist() == expected
+    assert points["is_reference"].tolist() == [w == 0.0 for _ in informations for w in weights]
+    np.testing.assert_allclose(points["energy_increase"], points["energy_J"] / 100.0 - 1.0)
+    np.testing.assert_allclose(points["improvement"], 1.0 - points[TAN_COLUMN] / 4.0)
+    best = trade_off(view, energy_budget=0.15, target=0.2)
+    candidates = points[~points["is_reference"]]
+    within = candidates[(candidates["energy_increase"] <= 0.15) & (candidates["improvement"] > 0)]
+    reaching = candidates[candidates["improvement"] >= 0.2]
+    for name, chosen, column, pick in (
+        ("best_within_budget", within, "improvement", max),
+        ("cheapest_reaching_target", reaching, "energy_increase", min),
+    ):
+        if chosen.empty:
+            assert best[name] is None
+        else:
+            assert best[name] is not None
+            assert best[name][column] == pick(chosen[column])
+    axes = plot_pareto(view).axes[0]
+    assert "energy-only plan (terrain weight 0)" in axes.get_legend_handles_labels()[1]
+
+
+def test_no_reference_without_a_zero_terrain_weight() -> None:
+    frame = sweep_frame(
+        [_record(1.0, 0, 120.0, 0.6), _record(3.0, 0, 130.0, 0.7)], ["weights.terrain"]
+    )
+    view = pareto_view(frame, ["weights.terrain"], seeds_are_missions=False)
+    assert view is not None
+    assert not view.points["is_reference"].any()
+    assert view.points["improvement"].isna().all()
+    assert trade_off(view) == {"best_within_budget": None, "cheapest_reaching_target": None}

@@ -16,9 +16,12 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from auvplan.cli.figure_options import add_figure_options
+
+if TYPE_CHECKING:  # the sweep package (pandas) is imported only when a command runs
+    from auvplan.sweep.navigation import NavigationOptions
 
 
 def register(subparsers: argparse._SubParsersAction[Any]) -> None:
@@ -33,8 +36,18 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
     parser.add_argument(
         "output", metavar="OUTPUT_DIR", type=Path, help="output folder of 'plan' or 'demo'"
     )
-    parser.add_argument("--runs", type=int, default=100, help="Monte-Carlo runs (default 100)")
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    add_navigation_options(parser)
+    parser.add_argument("--no-figure", action="store_true", help="write navigation.json only")
+    add_figure_options(parser)
+    parser.set_defaults(run=run)
+
+
+def add_navigation_options(parser: argparse.ArgumentParser) -> None:
+    """The navigation system's options, shared by ``evaluate`` and ``sweep --evaluate``."""
+    parser.add_argument(
+        "--runs", type=int, default=100, help="Monte-Carlo runs per vehicle and plan (default 100)"
+    )
     parser.add_argument(
         "--sensor",
         choices=("altimeter", "multibeam"),
@@ -66,25 +79,26 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
         help="updates with sigma <= 5 m in a row that count as converged (default 200, "
         "MB-System's rule)",
     )
-    parser.add_argument("--no-figure", action="store_true", help="write navigation.json only")
-    add_figure_options(parser)
-    parser.set_defaults(run=run)
 
 
-def run(args: argparse.Namespace) -> int:
-    """Evaluate the folder's plans and write the results; returns the exit code."""
+def navigation_options(
+    args: argparse.Namespace, *, seed: int, threads: int | None = None
+) -> NavigationOptions:
+    """The :class:`~auvplan.sweep.NavigationOptions` of :func:`add_navigation_options`'s args.
+
+    Raises
+    ------
+    InputError
+        If ``--runs`` is below 1 or a model value is out of its range.
+    """
     from auvplan.errors import InputError
-    from auvplan.io.output import staged_output_dir
-    from auvplan.io.plan_folder import read_plan_folder
-    from auvplan.io.results import write_json
     from auvplan.navigation import (
         DeadReckoningModel,
         NavigationSettings,
         ParticleFilterOptions,
         SensorModel,
-        Track,
     )
-    from auvplan.navigation.evaluation import VehiclePlan, evaluate_plans, navigation_summary
+    from auvplan.sweep.navigation import NavigationOptions
 
     if args.runs < 1:
         raise InputError(f"--runs must be >= 1, got {args.runs}")
@@ -95,33 +109,29 @@ def run(args: argparse.Namespace) -> int:
         update_period=args.update_period,
         convergence_updates=args.convergence_updates,
     )
+    return NavigationOptions(settings, n_runs=args.runs, seed=seed, threads=threads)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Evaluate the folder's plans and write the results; returns the exit code."""
+    from auvplan.io.output import staged_output_dir
+    from auvplan.io.plan_folder import read_plan_folder
+    from auvplan.io.results import write_json
+    from auvplan.sweep.navigation import evaluate_folder
+
+    options = navigation_options(args, seed=args.seed)
     folder = read_plan_folder(args.output)
-    plans = {
-        label: {
-            name: VehiclePlan(Track(v.time, v.positions, v.heading), v.energy)
-            for name, v in vehicles.items()
-        }
-        for label, vehicles in folder.plans.items()
-    }
-    n_tracks = sum(len(vehicles) for vehicles in plans.values())
+    n_tracks = sum(len(vehicles) for vehicles in folder.plans.values())
     with _progress(n_tracks * args.runs, args.runs, quiet=args.quiet) as progress:
-        evaluations = evaluate_plans(
-            folder.bathymetry, plans, settings, n_runs=args.runs, seed=args.seed, progress=progress
-        )
-    document = navigation_summary(
-        evaluations,
-        settings,
-        n_runs=args.runs,
-        seed=args.seed,
-        plan_records={label: folder.plan_record(label) for label in plans},
-    )
+        navigation = evaluate_folder(folder, options, progress=progress)
+    document = navigation.document
     figure = None
     if not args.no_figure:
         from auvplan.viz.navigation import plot_navigation
         from auvplan.viz.report import render_figure
 
         figure = render_figure(
-            plot_navigation(folder.bathymetry, evaluations),
+            plot_navigation(folder.bathymetry, navigation.evaluations),
             figure_format=args.figure_format,
             dpi=args.dpi,
         )

@@ -11,11 +11,20 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from auvplan.cli.evaluate import add_navigation_options, navigation_options
 from auvplan.cli.plan import EXIT_NOT_CONVERGED, STAGES
 
 if TYPE_CHECKING:  # the command line imports the sweep package only when it runs
     from auvplan.scenarios import Scenario
-    from auvplan.sweep import MissionBase, RunRecord, SweepProgress, SweepRun, VaryAxis
+    from auvplan.sweep import (
+        MissionBase,
+        NavigationOptions,
+        ParetoView,
+        RunRecord,
+        SweepProgress,
+        SweepRun,
+        VaryAxis,
+    )
 
 #: ``MISSION`` naming the public scenario family instead of a file.
 SCENARIOS = "scenarios"
@@ -71,6 +80,19 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
     )
     parser.add_argument("--stage", choices=STAGES, default="full", help="stop each run here")
     parser.add_argument("--figures", action="store_true", help="also write each run's figures")
+    navigation = parser.add_argument_group(
+        "navigation (--evaluate)",
+        "fly each plan through the terrain-aided navigation simulator, as 'auvplan evaluate' "
+        "does, and put its TAN RMSE into the table and pareto.png; the Monte-Carlo seed is the "
+        "row's seed (--seeds), else 0",
+    )
+    navigation.add_argument(
+        "--evaluate",
+        action="store_true",
+        help="write navigation.json into every run folder (those with one of the same "
+        "settings are kept)",
+    )
+    add_navigation_options(navigation)
     parser.add_argument(
         "--data-dir",
         type=Path,
@@ -92,6 +114,9 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("nothing to sweep: give --vary KEY=V1,V2,... and/or --seeds")
     if args.workers is not None and args.workers < 1:
         raise InputError(f"--workers must be at least 1, got {args.workers}")
+    if args.evaluate and args.stage != "full":
+        raise InputError(f"--evaluate needs the full plan, not --stage {args.stage}")
+    navigation = _navigation(args)
     require_dask()
     seeds: tuple[int | None, ...] = (None,) if args.seeds is None else parse_seeds(args.seeds)
     base_of, scenario_files = _bases(args, seeds, scenarios=scenarios)
@@ -99,8 +124,8 @@ def run(args: argparse.Namespace) -> int:
     for base, scenario in scenario_files:  # only once every run is valid
         scenario.write(base.base_dir)
     started = time.perf_counter()
-    records = _run(args, runs)
-    return _finish(args, axes, records, seeds, time.perf_counter() - started)
+    records = _run(args, runs, navigation)
+    return _finish(args, axes, records, seeds, time.perf_counter() - started, navigation)
 
 
 def _bases(
@@ -116,7 +141,22 @@ def _bases(
     return (lambda seed: bases[seed][0]), list(bases.values())
 
 
-def _run(args: argparse.Namespace, runs: Sequence[SweepRun]) -> list[RunRecord]:
+def _navigation(args: argparse.Namespace) -> NavigationOptions | None:
+    """The evaluation of ``--evaluate``: local workers share the cores, remote ones get 1 each."""
+    if not args.evaluate:
+        return None
+    threads = 1
+    if args.scheduler is None:
+        from auvplan.navigation.montecarlo import available_cpus
+
+        cpus = available_cpus()
+        threads = max(1, cpus // (args.workers or cpus))
+    return navigation_options(args, seed=0, threads=threads)
+
+
+def _run(
+    args: argparse.Namespace, runs: Sequence[SweepRun], navigation: NavigationOptions | None
+) -> list[RunRecord]:
     from auvplan.sweep import RunOptions, run_sweep
 
     write_figures = None
@@ -125,7 +165,10 @@ def _run(args: argparse.Namespace, runs: Sequence[SweepRun]) -> list[RunRecord]:
 
         write_figures = save_mission_figures
     options = RunOptions(
-        stage=args.stage, write_figures=write_figures, quiet_logs=args.scheduler is None
+        stage=args.stage,
+        write_figures=write_figures,
+        quiet_logs=args.scheduler is None,
+        navigation=navigation,
     )
     with _progress(len(runs), quiet=args.quiet) as progress:
         return run_sweep(
@@ -140,14 +183,18 @@ def _finish(
     records: Sequence[RunRecord],
     seeds: tuple[int | None, ...],
     wall_s: float,
+    navigation: NavigationOptions | None,
 ) -> int:
-    """Write sweep.csv/json and pareto.png, print the one-line summary, return the exit code."""
+    """Write sweep.csv/json and the Pareto files, print the summary, return the exit code."""
     from auvplan.io.output import staged_output_file
     from auvplan.sweep import (
         add_run_columns,
+        json_rows,
         navigation_columns,
         pareto_view,
         sweep_frame,
+        trade_off,
+        write_pareto_table,
         write_sweep_files,
     )
 
@@ -162,12 +209,14 @@ def _finish(
         "scheduler": args.scheduler,
         "workers": args.workers,
         "figures": args.figures,
+        "navigation": None if navigation is None else navigation.settings_document,
     }
     counts = _counts(records)
     output = args.output.resolve()
+    best = None if view is None else trade_off(view)
     written = write_sweep_files(
         frame, output, spec=spec, counts=counts, wall_time_s=wall_s,
-        pareto=None if view is None else view.points.to_dict(orient="records"),
+        pareto=None if view is None else json_rows(view.points), trade_off=best,
     )  # fmt: skip
     if view is not None:
         from auvplan.viz.sweep import plot_pareto
@@ -175,17 +224,49 @@ def _finish(
         with staged_output_file(output / "pareto.png") as staging:
             plot_pareto(view).savefig(staging, dpi=150)
         written.append(output / "pareto.png")
+        written += write_pareto_table(
+            view.points, output, label_key=view.label_key, objective=view.objective
+        )
     if not args.quiet:
+        for record in records:
+            if record.navigation_error:
+                print(f"navigation of {record.run_id} failed: {record.navigation_error}")
         statuses = ", ".join(f"{count} {status}" for status, count in counts["status"].items())
         print(
             f"sweep: {counts['runs']} runs ({counts['ran']} ran, {counts['skipped']} skipped "
             f"as finished before, {counts['failed']} failed): {statuses}; {wall_s:.1f} s"
         )
+        if best is not None:
+            _print_trade_off(best, view)
         print("wrote: " + ", ".join(str(path) for path in written))
     if counts["runs"] and counts["failed"] == counts["runs"]:
         print(f"auvplan: every run of the sweep failed (see {written[0]})", file=sys.stderr)
         return EXIT_NOT_CONVERGED
     return 0
+
+
+def _print_trade_off(best: dict[str, dict[str, Any] | None], view: ParetoView | None) -> None:
+    """One line each: the best point within +10 % energy, the cheapest reaching -30 %."""
+    if view is None or view.points["improvement"].isna().all():
+        return
+    from auvplan.sweep import TAN_COLUMN
+
+    objective = "TAN RMSE" if view.objective == TAN_COLUMN else "terrain information"
+
+    def describe(point: dict[str, Any] | None) -> str:
+        if point is None:
+            return "none"
+        where = f"{view.label_key} = {point['label']}" + (
+            f" ({point['group']})" if point["group"] else ""
+        )
+        return (
+            f"{where}: {objective} {100 * point['improvement']:.1f} % better for "
+            f"{100 * point['energy_increase']:+.1f} % energy"
+        )
+
+    within, reaching = best["best_within_budget"], best["cheapest_reaching_target"]
+    print(f"vs the energy-only plan, best within +10 % energy: {describe(within)}")
+    print(f"cheapest plan with {objective} >= 30 % better: {describe(reaching)}")
 
 
 def _counts(records: Sequence[RunRecord]) -> dict[str, Any]:

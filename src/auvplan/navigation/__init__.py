@@ -14,6 +14,7 @@ from auvplan.navigation.evaluation import (
     VehiclePlan,
     evaluate_plans,
     navigation_summary,
+    settings_document,
 )
 from auvplan.navigation.filter import FilterTrace, ParticleFilterOptions, run_particle_filter
 from auvplan.navigation.metrics import convergence_time, has_diverged, nees, rmse
@@ -60,6 +61,7 @@ __all__ = [
     "rmse",
     "run_monte_carlo",
     "run_particle_filter",
+    "settings_document",
     "simulate_odometry",
     "simulate_soundings",
 ]

@@ -9,7 +9,8 @@ The particle filter (:func:`particle_filter`) is the bootstrap filter of Gordon,
 Smith (1993) on the state ``(north, east)``: every update moves each particle by the measured
 dead-reckoning increment plus Gaussian process noise, weights it by the Gaussian likelihood of
 the soundings against the map, and resamples systematically when the effective sample size
-falls below a fraction of the particle count, followed by roughening. All random numbers come
+falls below a fraction of the particle count, followed by roughening. Prediction, weighting
+and the weighted moments share one pass over the particles. All random numbers come
 from the ``numpy.random.Generator`` passed in, so a run is reproducible from its seed whatever
 thread runs it (the kernels release the GIL).
 """
@@ -122,7 +123,9 @@ def particle_filter(
     roughening : float
         Roughening constant ``K_r``: after resampling each coordinate gets Gaussian jitter of
         standard deviation :math:`K_r E N^{-1/2}`, ``E`` the spread (max - min) of the
-        particles along it (Gordon et al. 1993, Sec. 4, with ``d = 2``).
+        particles along it (Gordon et al. 1993, Sec. 4, with ``d = 2``). The jitter is drawn
+        with the next prediction's process noise, as one normal of the summed variance (the
+        same distribution, half the draws; the moments are taken before resampling).
     rng : numpy.random.Generator
         The run's random stream.
     estimate, covariance, ess : ndarray
@@ -149,22 +152,31 @@ def particle_filter(
     spare_n = np.empty(n_particles)
     spare_e = np.empty(n_particles)
     jitter = roughening / np.sqrt(n_particles)
+    sums = np.zeros(7)  # of the weighted moments (_add_moments)
     shift = 0.0
+    rough_n = rough_e = 0.0
     n_resamples = 0
     n_skipped = 0
     for k in range(soundings.shape[0]):
         has_beam = False
         for b in range(n_beams):
             has_beam = has_beam or not np.isnan(soundings[k, b])
-        step_n = step_e = sigma = 0.0
+        step_n = step_e = sigma_n = sigma_e = 0.0
         if k > 0:
-            step_n, step_e, sigma = increments[k - 1, 0], increments[k - 1, 1], process_sigma[k - 1]
-        # one fused pass: predict and weigh, w = exp(log w) <= 1 (log w <= shift = 0, loglik <= 0)
+            step_n, step_e = increments[k - 1, 0], increments[k - 1, 1]
+            sigma_n = np.sqrt(process_sigma[k - 1] ** 2 + rough_n**2)
+            sigma_e = np.sqrt(process_sigma[k - 1] ** 2 + rough_e**2)
+            rough_n = rough_e = 0.0
+        # one fused pass: predict (with the last resampling's roughening), weigh, moments
         best = -np.inf
+        ref_n = ref_e = 0.0
+        sums[:] = 0.0
         for i in range(n_particles):
             if k > 0:
-                north[i] += step_n + sigma * rng.standard_normal()
-                east[i] += step_e + sigma * rng.standard_normal()
+                north[i] += step_n + sigma_n * rng.standard_normal()
+                east[i] += step_e + sigma_e * rng.standard_normal()
+            if i == 0:
+                ref_n, ref_e = north[0], east[0]
             prior[i] = log_w[i] - shift
             log_w[i] = prior[i]
             if has_beam:
@@ -173,16 +185,21 @@ def particle_filter(
                     origin_n, origin_e, inv_n, inv_e,
                 )  # fmt: skip
             best = max(best, log_w[i])
-            weight[i] = np.exp(log_w[i])
+            w = np.exp(log_w[i])
+            weight[i] = w
+            _add_moments(sums, w, north[i] - ref_n, east[i] - ref_e)
         if best == -np.inf:  # no particle can explain the soundings: leave them out
             n_skipped += 1
             log_w[:] = prior
             best = np.max(log_w)
             weight[:] = np.exp(log_w - best)
+            s, s2, mean_n, mean_e, p_nn, p_ee, p_ne = _weighted_moments(weight, north, east)
         elif best < _UNDERFLOW_LOG_WEIGHT:  # rare: weigh relative to the best particle
             weight[:] = np.exp(log_w - best)
+            s, s2, mean_n, mean_e, p_nn, p_ee, p_ne = _weighted_moments(weight, north, east)
+        else:
+            s, s2, mean_n, mean_e, p_nn, p_ee, p_ne = _moments(sums, ref_n, ref_e)
         shift = best
-        s, s2, mean_n, mean_e, p_nn, p_ee, p_ne = _weighted_moments(weight, north, east)
         estimate[k, 0], estimate[k, 1] = mean_n, mean_e
         covariance[k, 0], covariance[k, 1], covariance[k, 2] = p_nn, p_ee, p_ne
         ess[k] = s * s / s2
@@ -190,8 +207,8 @@ def particle_filter(
             _systematic_resample(weight, s, north, east, spare_n, spare_e, rng)
             north, spare_n = spare_n, north
             east, spare_e = spare_e, east
-            _roughen(north, jitter, rng)
-            _roughen(east, jitter, rng)
+            rough_n = jitter * (np.max(north) - np.min(north))
+            rough_e = jitter * (np.max(east) - np.min(east))
             log_w[:] = 0.0
             shift = 0.0
             n_resamples += 1
@@ -237,27 +254,39 @@ def _weighted_moments(
     Returns ``sum w, sum w², mean north, mean east, P_nn, P_ee, P_ne``; the sums run about
     particle 0, so that the covariance loses no digits to the mean's magnitude.
     """
-    ref_n, ref_e = north[0], east[0]
-    s = s2 = s_n = s_e = s_nn = s_ee = s_ne = 0.0
+    sums = np.zeros(7)
     for i in range(weight.size):
-        w = weight[i]
-        dn, de = north[i] - ref_n, east[i] - ref_e
-        s += w
-        s2 += w * w
-        s_n += w * dn
-        s_e += w * de
-        s_nn += w * dn * dn
-        s_ee += w * de * de
-        s_ne += w * dn * de
-    m_n, m_e = s_n / s, s_e / s
+        _add_moments(sums, weight[i], north[i] - north[0], east[i] - east[0])
+    return _moments(sums, north[0], east[0])
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _add_moments(sums: FloatArray, w: float, dn: float, de: float) -> None:
+    """Add a particle of weight ``w`` at ``(dn, de)`` from the reference to the 7 ``sums``."""
+    sums[0] += w
+    sums[1] += w * w
+    sums[2] += w * dn
+    sums[3] += w * de
+    sums[4] += w * dn * dn
+    sums[5] += w * de * de
+    sums[6] += w * dn * de
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _moments(
+    sums: FloatArray, ref_n: float, ref_e: float
+) -> tuple[float, float, float, float, float, float, float]:
+    """``sum w, sum w², mean north, mean east, P_nn, P_ee, P_ne`` from the sums about ``ref``."""
+    s = sums[0]
+    m_n, m_e = sums[2] / s, sums[3] / s
     return (
         s,
-        s2,
+        sums[1],
         ref_n + m_n,
         ref_e + m_e,
-        max(s_nn / s - m_n * m_n, 0.0),
-        max(s_ee / s - m_e * m_e, 0.0),
-        s_ne / s - m_n * m_e,
+        max(sums[4] / s - m_n * m_n, 0.0),
+        max(sums[5] / s - m_e * m_e, 0.0),
+        sums[6] / s - m_n * m_e,
     )
 
 
@@ -288,12 +317,3 @@ def _systematic_resample(
         out_n[i] = north[j]
         out_e[i] = east[j]
         pointer += step
-
-
-@numba.njit(cache=True, nogil=True)
-def _roughen(values: FloatArray, jitter: float, rng: np.random.Generator) -> None:
-    """Add Gaussian noise of standard deviation ``jitter * (max - min)`` to every value."""
-    sigma = jitter * (np.max(values) - np.min(values))
-    if sigma > 0.0:
-        for i in range(values.size):
-            values[i] += sigma * rng.standard_normal()

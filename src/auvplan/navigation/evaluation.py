@@ -132,7 +132,7 @@ def navigation_summary(
     records = plan_records or {}
     document: dict[str, Any] = {
         "auvplan_version": __version__,
-        "settings": _settings(settings, n_runs, seed),
+        "settings": settings_document(settings, n_runs=n_runs, seed=seed),
         "plans": {},
     }
     for label, evaluation in evaluations.items():
@@ -195,7 +195,11 @@ def _vehicle_details(result: MonteCarloResult) -> dict[str, Any]:
     }
 
 
-def _settings(settings: NavigationSettings, n_runs: int, seed: int) -> dict[str, Any]:
+def settings_document(settings: NavigationSettings, *, n_runs: int, seed: int) -> dict[str, Any]:
+    """``navigation.json``'s ``settings``: every model parameter, the run count and the seed.
+
+    Two evaluations with equal documents give equal results (the seed fixes every draw).
+    """
     return {
         "n_runs": n_runs,
         "seed": seed,

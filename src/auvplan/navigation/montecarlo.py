@@ -245,7 +245,7 @@ def run_monte_carlo(
     def one_run(child: np.random.SeedSequence) -> tuple[FloatArray, ...]:
         return _simulate_run(grid, samples, offsets, variances, settings, child)
 
-    n_workers = min(n_runs, workers or _available_cpus())
+    n_workers = min(n_runs, workers or available_cpus())
     outcomes = []
     with ThreadPoolExecutor(max_workers=n_workers) as pool:
         for outcome in pool.map(one_run, children):
@@ -308,8 +308,8 @@ def _simulate_run(
     )
 
 
-def _available_cpus() -> int:
-    """CPUs this process may run on."""
+def available_cpus() -> int:
+    """CPUs this process may run on (the default thread count of :func:`run_monte_carlo`)."""
     if hasattr(os, "sched_getaffinity"):
         return max(1, len(os.sched_getaffinity(0)))
     return max(1, os.cpu_count() or 1)

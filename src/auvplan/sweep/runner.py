@@ -12,6 +12,13 @@ with ``sweep_run.json`` (:mod:`auvplan.sweep.table`). A run whose folder already
 finished run is not submitted again (resumable sweeps); a run that raises writes no folder
 and is tried again by the next invocation.
 
+With :attr:`RunOptions.navigation` each plan is then flown through the TAN simulator
+(:mod:`auvplan.sweep.navigation`) in the same task, which adds ``navigation.json`` to its
+folder; a finished run whose folder lacks that file (or holds one of other settings) is
+submitted for the evaluation alone (:func:`execute_evaluation`). The Monte-Carlo seed is the
+run's seed (``--seeds``), else the options' own. An evaluation that fails leaves the plan as
+it is and sets the record's ``navigation_error``.
+
 dask is imported only when a sweep runs; without it, the error names the extra to install.
 """
 
@@ -33,13 +40,20 @@ from pathlib import Path
 from typing import Any, Final
 
 from auvplan.errors import AuvplanError, InputError
+from auvplan.sweep.navigation import (
+    NavigationOptions,
+    evaluate_run_folder,
+    has_plan,
+    is_evaluated,
+)
 from auvplan.sweep.spec import SweepRun
 from auvplan.sweep.table import RUN_RECORD_FILE, RunRecord, read_run_folder, run_record_document
 
 #: Folder of the run folders inside the sweep's output folder.
 RUNS_FOLDER: Final = "runs"
-#: Status of a run whose worker process died (crash, out of memory).
+#: Status of a run whose worker process died (crash, out of memory), and the reason given.
 WORKER_DIED: Final = "worker died"
+WORKER_DIED_REASON: Final = "its worker process died (a crash, or killed for memory)"
 #: Seconds to wait for a ``--scheduler`` to answer.
 CONNECT_TIMEOUT_S: Final = 10.0
 INSTALL_HINT: Final = "pip install 'auvplan[sweep]'"
@@ -58,12 +72,14 @@ class RunOptions:
     ``write_figures`` (e.g. :func:`auvplan.viz.report.save_mission_figures`, a module-level
     function so that it pickles by reference) adds figures to each run folder; ``quiet_logs``
     keeps the runs' log records out of the worker's stderr (they are still collected into
-    each record's ``messages``).
+    each record's ``messages``); ``navigation`` (``--evaluate``) evaluates each plan's
+    terrain-aided navigation (module notes).
     """
 
     stage: str = "full"
     write_figures: FigureWriter | None = None
     quiet_logs: bool = True
+    navigation: NavigationOptions | None = None
 
 
 @dataclass(frozen=True)
@@ -122,17 +138,21 @@ def run_sweep(
     """
     directory = Path(directory).resolve()
     records: dict[str, RunRecord] = {}
+    to_evaluate: set[str] = set()
     for run in runs:
         finished = read_run_folder(run_folder(directory, run), run)
         if finished is not None:
             records[run.run_id] = replace(finished, skipped=True)
-    pending = [run for run in runs if run.run_id not in records]
+            if _needs_evaluation(finished, run, options.navigation):
+                to_evaluate.add(run.run_id)
+    pending = [run for run in runs if run.run_id not in records or run.run_id in to_evaluate]
     report = progress or (lambda _event: None)
     if not pending:
         report(SweepProgress(len(runs), len(records), 0, 0, 0))
         return [records[run.run_id] for run in runs]
     for run in pending:
-        _remove_stale_staging(run_folder(directory, run))
+        if run.run_id not in to_evaluate:
+            _remove_stale_staging(run_folder(directory, run))
     with _dask_client(scheduler, n_workers) as (client, as_completed, killed_worker):
 
         def event(finished: int, failed: int, record: RunRecord | None = None) -> SweepProgress:
@@ -146,7 +166,11 @@ def run_sweep(
         batch = uuid.uuid4().hex[:8]  # keys unique on a shared scheduler
         futures = {
             client.submit(
-                execute_run, run, run_folder(directory, run), options,
+                *(
+                    (execute_evaluation, records[run.run_id], run, options.navigation)
+                    if run.run_id in to_evaluate
+                    else (execute_run, run, run_folder(directory, run), options)
+                ),
                 key=f"auvplan-run-{batch}-{index}", pure=False,
             ): run
             for index, run in enumerate(pending)
@@ -159,11 +183,12 @@ def run_sweep(
             except killed_worker:
                 _remove_stale_staging(run_folder(directory, run))
                 record = RunRecord(
-                    run.run_id, run.values, run.seed, WORKER_DIED,
-                    "its worker process died (a crash, or killed for memory)",
-                )  # fmt: skip
+                    run.run_id, run.values, run.seed, WORKER_DIED, WORKER_DIED_REASON
+                )
             except Exception as error:  # noqa: BLE001 (the cluster lost the task: a row)
                 record = _failure(run, error)
+            if run.run_id in to_evaluate and record.failed:  # the plan is still there
+                record = replace(records[run.run_id], navigation_error=record.reason)
             records[run.run_id] = record
             n_failed += record.failed
             report(event(n_finished, n_failed, record))
@@ -205,17 +230,58 @@ def execute_run(run: SweepRun, folder: Path, options: RunOptions) -> RunRecord:
     record = read_run_folder(folder, run)
     if record is None:
         raise InputError(f"run {run.run_id}: its folder {folder} cannot be read back")
+    if _needs_evaluation(record, run, options.navigation):
+        return execute_evaluation(record, run, options.navigation)
     return record
+
+
+def execute_evaluation(
+    record: RunRecord, run: SweepRun, options: NavigationOptions | None
+) -> RunRecord:
+    """Evaluate the navigation along a finished run's plan; ``record`` with its outcome.
+
+    Writes ``navigation.json`` into the run's folder. A failure (an
+    :class:`~auvplan.errors.AuvplanError`, e.g. a track that starts off the map) sets
+    ``navigation_error`` and leaves the folder as it was; any other exception is a bug and
+    propagates.
+    """
+    if options is None or record.folder is None:
+        return record
+    try:
+        evaluate_run_folder(record.folder, _run_options(options, run))
+    except Exception as error:  # noqa: BLE001 (a failed evaluation is the row's note)
+        return replace(record, navigation_error=_reason(error))
+    return record
+
+
+def _run_options(options: NavigationOptions, run: SweepRun) -> NavigationOptions:
+    """``options`` with the run's seed, when it has one."""
+    return options if run.seed is None else replace(options, seed=run.seed)
+
+
+def _needs_evaluation(record: RunRecord, run: SweepRun, options: NavigationOptions | None) -> bool:
+    """Whether ``--evaluate`` asks for a navigation.json that the run's folder lacks."""
+    folder = record.folder
+    if options is None or folder is None or record.failed or not has_plan(folder):
+        return False
+    return not is_evaluated(folder, _run_options(options, run))
 
 
 def _failure(run: SweepRun, error: BaseException, *, wall_s: float | None = None) -> RunRecord:
     """The record of a run that raised ``error``."""
+    return RunRecord(
+        run.run_id, run.values, run.seed, type(error).__name__, _reason(error), wall_s=wall_s
+    )
+
+
+def _reason(error: BaseException) -> str:
+    """One line for ``error``; one that is not an AuvplanError is a bug and says where."""
     reason = " ".join(str(error).split()) or type(error).__name__
     if not isinstance(error, AuvplanError):
         frame = traceback.extract_tb(error.__traceback__)[-1:] if error.__traceback__ else []
         where = f" at {Path(frame[0].filename).name}:{frame[0].lineno}" if frame else ""
         reason = f"{reason} (unexpected{where}: a bug, please report it)"
-    return RunRecord(run.run_id, run.values, run.seed, type(error).__name__, reason, wall_s=wall_s)
+    return reason
 
 
 def _remove_stale_staging(folder: Path) -> None:
@@ -262,7 +328,7 @@ def _dask_client(scheduler: str | None, n_workers: int | None) -> Iterator[tuple
             n_workers=n_workers,
             threads_per_worker=1,
             processes=True,
-            dashboard_address=None,
+            dashboard_address=":0",  # a free port: no clash with another cluster's 8787
             silence_logs=logging.ERROR,
         ) as cluster,
         distributed.Client(cluster) as client,
@@ -335,6 +401,7 @@ __all__ = [
     "WORKER_DIED",
     "RunOptions",
     "SweepProgress",
+    "execute_evaluation",
     "execute_run",
     "require_dask",
     "run_folder",

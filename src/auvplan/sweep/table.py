@@ -19,9 +19,9 @@ tell), ``tan_rmse_m``, ``energy_J.<vehicle>`` per vehicle, and ``folder``.
 **Adding columns per run** (the hook for later evaluations): :func:`add_run_columns` calls a
 function ``columns(folder) -> {column: value}`` on every run folder and fills (or adds) those
 columns. :func:`navigation_columns` is the one the sweep always applies: it reads
-``navigation.json`` (written by ``auvplan evaluate RUN_FOLDER``) and fills ``tan_rmse_m``
-(``plans.terrain_aware.rmse_m``), so evaluating the run folders and running the same
-``auvplan sweep`` command again (every run is skipped) refreshes the table and the figure.
+``navigation.json`` (written by ``auvplan sweep --evaluate`` or ``auvplan evaluate
+RUN_FOLDER``) and fills ``tan_rmse_m`` (``plans.terrain_aware.rmse_m``) and its companions
+``tan_rmse_std_m``, ``tan_pcrb_m``, ``dead_reckoning_rmse_m`` (appended after ``folder``).
 """
 
 from __future__ import annotations
@@ -42,14 +42,19 @@ from auvplan.errors import DataFormatError
 from auvplan.io.output import staged_output_file
 from auvplan.io.results import write_json
 from auvplan.io.text import read_json
+from auvplan.sweep.navigation import NAVIGATION_FILE
 from auvplan.sweep.spec import SweepRun
 
 #: The sweep's own record in each run folder.
 RUN_RECORD_FILE: Final = "sweep_run.json"
 SUMMARY_FILE: Final = "summary.json"
-#: The navigation evaluation's file in a run folder (``auvplan evaluate``).
-NAVIGATION_FILE: Final = "navigation.json"
 TAN_COLUMN: Final = "tan_rmse_m"
+#: Further columns from ``navigation.json``: column -> key of ``plans.terrain_aware``.
+NAVIGATION_EXTRAS: Final = {
+    "tan_rmse_std_m": "rmse_std_m",
+    "tan_pcrb_m": "pcrb_rms_m",
+    "dead_reckoning_rmse_m": "dead_reckoning_rmse_m",
+}
 #: Status of runs stopped by ``--stage`` before the optimiser.
 STAGE_STATUS: Final = {"preplan": "PREPLANNED", "deconflict": "DECONFLICTED"}
 #: Status of a plan whose optimiser produced nothing (summary.json) — a failed run.
@@ -69,7 +74,8 @@ class RunRecord:
     memory; each is ``None`` when the run has none (failed, or stopped by ``--stage``).
     ``folder`` is the run's output folder (``None`` when it failed before writing one);
     ``skipped`` tells a run finished by an earlier invocation; ``messages`` are the warnings
-    the run logged.
+    the run logged; ``navigation_error`` says why its navigation evaluation (``--evaluate``)
+    failed, if it did.
     """
 
     run_id: str
@@ -86,6 +92,7 @@ class RunRecord:
     folder: Path | None = None
     skipped: bool = False
     messages: tuple[str, ...] = ()
+    navigation_error: str | None = None
 
     @property
     def failed(self) -> bool:
@@ -214,7 +221,11 @@ def add_run_columns(
 
 
 def navigation_columns(folder: Path) -> dict[str, float | None]:
-    """``tan_rmse_m`` from the run folder's ``navigation.json`` (none while it is absent).
+    """TAN columns from the run folder's ``navigation.json`` (none while it is absent).
+
+    ``tan_rmse_m`` is ``plans.terrain_aware.rmse_m``; when the file has them, also
+    ``tan_rmse_std_m`` (spread of the runs' RMSE), ``tan_pcrb_m`` (RMS posterior Cramér-Rao
+    bound) and ``dead_reckoning_rmse_m`` [m].
 
     Raises
     ------
@@ -227,10 +238,15 @@ def navigation_columns(folder: Path) -> dict[str, float | None]:
         return {}
     document = read_json(path, what="navigation file")
     try:
-        rmse = document["plans"]["terrain_aware"]["rmse_m"]
+        plan = document["plans"]["terrain_aware"]
+        rmse = plan["rmse_m"]
     except (KeyError, TypeError):
         raise DataFormatError(f"{path}: no plans.terrain_aware.rmse_m") from None
-    return {TAN_COLUMN: None if rmse is None else float(rmse)}
+    columns: dict[str, float | None] = {TAN_COLUMN: None if rmse is None else float(rmse)}
+    for column, key in NAVIGATION_EXTRAS.items():
+        if plan.get(key) is not None:
+            columns[column] = float(plan[key])
+    return columns
 
 
 def write_sweep_files(
@@ -244,14 +260,58 @@ def write_sweep_files(
     table, document = directory / "sweep.csv", directory / "sweep.json"
     with staged_output_file(table) as staging:
         frame.to_csv(staging, index=False)
-    rows = [
-        {key: _json_cell(value) for key, value in row.items()}
-        for row in frame.to_dict(orient="records")
-    ]
-    content = {"auvplan_version": __version__, "spec": spec, **sections, "runs": rows}
+    content = {"auvplan_version": __version__, "spec": spec, **sections, "runs": json_rows(frame)}
     with staged_output_file(document) as staging:  # dates, paths, pandas NA as text
         write_json(json.loads(json.dumps(content, default=str)), staging)
     return [table, document]
+
+
+def json_rows(frame: pd.DataFrame) -> list[dict[str, Any]]:
+    """The rows of ``frame`` as JSON objects (missing cells ``None``, numpy scalars unwrapped)."""
+    return [
+        {str(key): _json_cell(value) for key, value in row.items()}
+        for row in frame.to_dict(orient="records")
+    ]
+
+
+def write_pareto_table(
+    points: pd.DataFrame, directory: Path, *, label_key: str | None, objective: str
+) -> list[Path]:
+    """Write the trade-off points as ``pareto.csv`` and ``pareto.md``; returns the two paths.
+
+    ``points`` is :attr:`auvplan.sweep.ParetoView.points`. The markdown table shows per point
+    its group, label, energy [kJ] and its change against the energy-only plan [%], the
+    objective and its improvement [%], the runs averaged, and the front it lies on.
+    """
+    csv_file, markdown = directory / "pareto.csv", directory / "pareto.md"
+    with staged_output_file(csv_file) as staging:
+        points.to_csv(staging, index=False)
+    header = [
+        "group", label_key or "label", "energy [kJ]", "energy vs energy-only",
+        objective, "improvement", "runs", "converged", "front",
+    ]  # fmt: skip
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for _, point in points.iterrows():
+        front = "overall" if point["on_overall_front"] else ("group" if point["on_front"] else "")
+        cells = [
+            str(point["group"]) or "-",
+            "energy-only" if point["is_reference"] else str(point["label"]),
+            f"{point['energy_J'] / 1e3:.1f}",
+            _percent(point["energy_increase"]),
+            f"{point[objective]:.3f}",
+            _percent(point["improvement"]),
+            str(point["n_runs"]),
+            "yes" if point["converged"] else "no",
+            front,
+        ]
+        lines.append("| " + " | ".join(cells) + " |")
+    with staged_output_file(markdown) as staging:
+        staging.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return [csv_file, markdown]
+
+
+def _percent(fraction: float) -> str:
+    return "" if math.isnan(fraction) else f"{100.0 * fraction:+.1f} %"
 
 
 def _cell(value: Any) -> Any:
@@ -273,9 +333,11 @@ __all__ = [
     "TAN_COLUMN",
     "RunRecord",
     "add_run_columns",
+    "json_rows",
     "navigation_columns",
     "read_run_folder",
     "run_record_document",
     "sweep_frame",
+    "write_pareto_table",
     "write_sweep_files",
 ]

@@ -23,7 +23,9 @@ def plot_pareto(view: ParetoView, *, title: str = "") -> Figure:
     Energy is in kJ; when the groups are different missions (the scenario family), each
     group's energy is in percent above that group's least instead, so missions of different
     size share the axis. Converged plans are filled markers, others
-    hollow; each point is annotated with its label value (``weights.terrain``).
+    hollow; each point is annotated with its label value (``weights.terrain``). Energy-only
+    plans (terrain weight 0) carry a black star; for one mission swept in several groups the
+    front over all points is a dashed black line.
 
     Parameters
     ----------
@@ -54,12 +56,23 @@ def plot_pareto(view: ParetoView, *, title: str = "") -> Figure:
         front = members["on_front"].to_numpy(bool)
         order = energy[front].argsort()
         axes.plot(energy[front][order], objective[front][order], "-", color=color, lw=1.4)
+        reference = members["is_reference"].to_numpy(bool)
+        axes.scatter(
+            energy[reference], objective[reference], marker="*", s=220, color="black",
+            zorder=4, label="energy-only plan (terrain weight 0)" if index == 0 else None,
+        )  # fmt: skip
         if annotate:
             for x, y, label in zip(energy, objective, members["label"], strict=True):
                 axes.annotate(
                     f"{label:g}" if isinstance(label, float) else str(label), (x, y),
                     textcoords="offset points", xytext=(5, 4), fontsize=8,
                 )  # fmt: skip
+    overall = points[points["on_overall_front"]].sort_values("energy_J")
+    if len(groups) > 1 and not overall.empty:
+        axes.plot(
+            overall["energy_J"] / 1e3, overall[view.objective], "--", color="black", lw=1.0,
+            zorder=2, label="front over all points",
+        )  # fmt: skip
     axes.set_xlabel("fleet energy above the group's least [%]" if relative else "fleet energy [kJ]")
     axes.set_ylabel(_AXIS_LABELS.get(view.objective, view.objective))
     axes.grid(alpha=0.3)

@@ -1,0 +1,151 @@
+"""Terrain-aided navigation of plan output folders: ``auvplan evaluate`` and ``sweep --evaluate``.
+
+:func:`evaluate_folder` flies every vehicle of every plan of an output folder of
+``plan``/``demo`` (or of a sweep's run, as :func:`auvplan.io.plan_folder.read_plan_folder`
+reads it) through the Monte-Carlo TAN simulator (:func:`auvplan.navigation.evaluate_plans`)
+and returns the evaluations with their ``navigation.json`` document.
+:func:`evaluate_run_folder` does that for one sweep run and writes ``navigation.json``
+(atomically) next to its plan; :func:`is_evaluated` tells whether a folder's
+``navigation.json`` was made with the same settings, run count and seed, so a resumed sweep
+evaluates only the folders that lack it.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Final
+
+from auvplan.errors import DataFormatError
+from auvplan.io.output import staged_output_file
+from auvplan.io.plan_folder import TRAJECTORY_FILES, PlanFolder, read_plan_folder
+from auvplan.io.results import write_json
+from auvplan.io.text import read_json
+from auvplan.navigation import (
+    NavigationSettings,
+    PlanNavigation,
+    Track,
+    VehiclePlan,
+    evaluate_plans,
+    navigation_summary,
+    settings_document,
+)
+from auvplan.navigation.evaluation import EvaluationProgress
+
+#: The evaluation's file in an output folder.
+NAVIGATION_FILE: Final = "navigation.json"
+
+
+@dataclass(frozen=True)
+class NavigationOptions:
+    """How a folder's plans are evaluated.
+
+    ``settings`` is the simulated navigation system, ``n_runs`` the Monte-Carlo runs per
+    vehicle and plan, ``seed`` their base seed (a sweep uses each row's seed instead when it
+    has ``--seeds``), ``threads`` the threads of the Monte-Carlo runs (default: every CPU the
+    process may use).
+    """
+
+    settings: NavigationSettings = field(default_factory=NavigationSettings)
+    n_runs: int = 100
+    seed: int = 0
+    threads: int | None = None
+
+    @property
+    def settings_document(self) -> dict[str, Any]:
+        """``navigation.json``'s ``settings`` for these options."""
+        return settings_document(self.settings, n_runs=self.n_runs, seed=self.seed)
+
+
+@dataclass(frozen=True)
+class FolderNavigation:
+    """The navigation of a folder's plans by plan label, and the ``navigation.json`` document."""
+
+    evaluations: dict[str, PlanNavigation]
+    document: dict[str, Any]
+
+
+def evaluate_folder(
+    folder: PlanFolder, options: NavigationOptions, *, progress: EvaluationProgress | None = None
+) -> FolderNavigation:
+    """Evaluate every plan of a read output folder (module notes); nothing is written.
+
+    Raises
+    ------
+    InputError
+        If a track cannot be flown (too short, or it starts where the map has no depth).
+    """
+    plans = {
+        label: {
+            name: VehiclePlan(Track(v.time, v.positions, v.heading), v.energy)
+            for name, v in vehicles.items()
+        }
+        for label, vehicles in folder.plans.items()
+    }
+    evaluations = evaluate_plans(
+        folder.bathymetry,
+        plans,
+        options.settings,
+        n_runs=options.n_runs,
+        seed=options.seed,
+        workers=options.threads,
+        progress=progress,
+    )
+    document = navigation_summary(
+        evaluations,
+        options.settings,
+        n_runs=options.n_runs,
+        seed=options.seed,
+        plan_records={label: folder.plan_record(label) for label in plans},
+    )
+    return FolderNavigation(evaluations, document)
+
+
+def has_plan(path: Path) -> bool:
+    """Whether ``path`` holds a plan to fly (the optimised ``trajectories.csv``)."""
+    return (path / TRAJECTORY_FILES["terrain_aware"]).is_file()
+
+
+def is_evaluated(path: Path, options: NavigationOptions) -> bool:
+    """Whether ``path/navigation.json`` exists and was made with ``options`` (settings, seed)."""
+    target = path / NAVIGATION_FILE
+    if not target.is_file():
+        return False
+    try:
+        document = read_json(target, what="navigation file")
+    except DataFormatError:
+        return False
+    expected = json.loads(json.dumps(options.settings_document))
+    return isinstance(document, Mapping) and document.get("settings") == expected
+
+
+def evaluate_run_folder(path: Path, options: NavigationOptions) -> Path:
+    """Evaluate a run folder's plan and write its ``navigation.json`` (all or nothing).
+
+    Returns the file written.
+
+    Raises
+    ------
+    DataFormatError
+        If the folder or one of its files is missing or malformed.
+    InputError
+        If a track cannot be flown (:func:`evaluate_folder`).
+    """
+    document = evaluate_folder(read_plan_folder(path), options).document
+    target = path / NAVIGATION_FILE
+    with staged_output_file(target) as staging:
+        write_json(document, staging)
+    return target
+
+
+__all__ = [
+    "NAVIGATION_FILE",
+    "FolderNavigation",
+    "NavigationOptions",
+    "evaluate_folder",
+    "evaluate_run_folder",
+    "has_plan",
+    "is_evaluated",
+]
