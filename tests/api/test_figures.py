@@ -108,3 +108,20 @@ def test_tick_labels_are_plain_numbers() -> None:
     labels = [label for label in labels if label]
     assert "40" in labels
     assert not any("times" in label or "^" in label or "e+" in label for label in labels)
+
+
+def test_current_arrows_show_the_field_over_the_whole_map() -> None:
+    from auvplan.ocean import UniformCurrent
+    from auvplan.viz.current import ARROWS_ALONG, add_current_arrows
+
+    grid = BathymetryGrid(np.full((20, 30), 30.0), GridGeometry(20, 30, 5.0, 5.0))
+    path = np.array([[10.0, 10.0], [80.0, 120.0]])
+    figure = plot_mission_paths(grid, ["a"], [path], [path], safety_radius=2.0)
+    add_current_arrows(figure, grid, UniformCurrent(0.15, -0.26))
+    (arrows,) = figure.axes[0].collections[-1:]
+    assert len(arrows.U) == ARROWS_ALONG * round(ARROWS_ALONG * 20 / 30)
+    np.testing.assert_allclose(arrows.U, -0.26)
+    np.testing.assert_allclose(arrows.V, 0.15)
+    offsets = arrows.get_offsets()
+    assert offsets[:, 0].min() > 0.0 and offsets[:, 0].max() < 150.0  # east inside the map
+    assert offsets[:, 1].min() > 0.0 and offsets[:, 1].max() < 100.0  # north inside the map

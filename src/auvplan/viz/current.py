@@ -44,15 +44,18 @@ def add_current_arrows(
     g = bathymetry.geometry
     (south, north), (west, east) = g.north_bounds, g.east_bounds
     step = max(north - south, east - west) / ARROWS_ALONG
-    grid_north, grid_east = np.meshgrid(
-        np.arange(south + step / 2, north, step),
-        np.arange(west + step / 2, east, step),
-        indexing="ij",
+    grid_north, grid_east = (
+        axis.ravel()
+        for axis in np.meshgrid(
+            np.arange(south + step / 2, north, step),
+            np.arange(west + step / 2, east, step),
+            indexing="ij",
+        )
     )
     v_n, v_e = current.velocity(grid_north, grid_east, np.full(grid_north.size, time))
     fastest = float(np.max(np.hypot(v_n, v_e), initial=0.0))
     arrows = axes.quiver(
-        grid_east.ravel(), grid_north.ravel(), v_e, v_n, color="white", alpha=0.8,
+        grid_east, grid_north, v_e, v_n, color="white", alpha=0.8,
         angles="xy", scale_units="xy", scale=max(fastest, 1e-9) / (0.8 * step), zorder=2,
         width=0.003,
     )  # fmt: skip
