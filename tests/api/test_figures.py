@@ -123,5 +123,7 @@ def test_current_arrows_show_the_field_over_the_whole_map() -> None:
     np.testing.assert_allclose(arrows.U, -0.26)
     np.testing.assert_allclose(arrows.V, 0.15)
     offsets = arrows.get_offsets()
-    assert offsets[:, 0].min() > 0.0 and offsets[:, 0].max() < 150.0  # east inside the map
-    assert offsets[:, 1].min() > 0.0 and offsets[:, 1].max() < 100.0  # north inside the map
+    assert offsets[:, 0].min() > 0.0
+    assert offsets[:, 0].max() < 150.0
+    assert offsets[:, 1].min() > 0.0
+    assert offsets[:, 1].max() < 100.0

@@ -34,6 +34,8 @@ from auvplan.planning import (
     blocked_cells,
     blocked_lookup,
     plan_route,
+    resample_polyline,
+    skirt_discs,
     smooth_path,
 )
 from auvplan.terrain import BathymetryGrid, MapParameters, TerrainMaps, compute_terrain_maps
@@ -45,6 +47,9 @@ logger = logging.getLogger(__name__)
 #: Distance from a right-angle corner to the arc of radius ``R`` that rounds it, per unit
 #: ``R``: ``√2 − 1`` (a grid route turns by 90° in two 45° steps a cell or two apart).
 CORNER_CUT: Final = math.sqrt(2.0) - 1.0
+#: Radius of the disc about another vehicle's goal that a path skirts, per ``2 r_c`` (10 %
+#: over the deconfliction grid's largest margin, 5 % of ``2 r_c``, plus the chords' sagitta).
+GOAL_SKIRT: Final = 1.2
 
 Obstacle = CircleObstacle | PolygonObstacle
 
@@ -157,6 +162,32 @@ def goal_keep_outs(
     )
 
 
+def _skirt_goals(
+    path: FloatArray,
+    goals: FloatArray,
+    index: int,
+    clearance: float,
+    cell: float,
+    is_blocked: Callable[[FloatArray, FloatArray], BoolArray],
+) -> FloatArray:
+    """``path`` of vehicle ``index`` detoured along the rims of the other goals' discs.
+
+    The discs have radius :data:`GOAL_SKIRT` ``× 2 r_c`` (``2 r_c = 2 · clearance``), shrunk
+    where the vehicle's own start or goal is nearer; a repaired path is resampled every
+    ``min(cell / 4, r_c / 2)`` so that its chords stay outside too (:func:`skirt_discs`).
+    """
+    own = np.array([path[0], path[-1]])
+    others = np.array([goal[:2] for other, goal in enumerate(goals) if other != index])
+    if len(others) == 0:
+        return path
+    nearest = np.min(np.hypot(*(own[:, None, :] - others[None, :, :]).transpose(2, 0, 1)), axis=0)
+    radii = np.minimum(GOAL_SKIRT * 2.0 * clearance, (1.0 - 1e-6) * nearest)
+    skirted = skirt_discs(path, others, radii, is_blocked=is_blocked)
+    if skirted is path:
+        return path
+    return resample_polyline(skirted, min(0.25 * cell, 0.5 * clearance))
+
+
 def _with_discs(
     is_blocked: Callable[[FloatArray, FloatArray], BoolArray],
     discs: tuple[CircleObstacle, ...],
@@ -223,14 +254,13 @@ def plan_routes(
             routes.append(route)
             # near the route, never through a no-go cell nor within 2 r_c of a kept-out goal
             radius = 0.0 if turning_radii is None else float(turning_radii[index])
-            paths.append(
-                smooth_path(
-                    route.points,
-                    spacing=0.25 * cell,
-                    max_deviation=max(0.5 * cell, CORNER_CUT * radius),
-                    is_blocked=_with_discs(is_blocked, keep_out, 2.0 * clearance + 0.25 * cell),
-                )
+            path = smooth_path(
+                route.points,
+                spacing=0.25 * cell,
+                max_deviation=max(0.5 * cell, CORNER_CUT * radius),
+                is_blocked=_with_discs(is_blocked, keep_out, 2.0 * clearance + 0.25 * cell),
             )
+            paths.append(_skirt_goals(path, goals, index, clearance, cell, is_blocked))
             logger.info(
                 "A* %s: %d cells, cost %.1f, %d expanded", name, len(route.cells), route.cost,
                 route.n_expanded,

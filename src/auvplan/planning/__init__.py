@@ -12,7 +12,8 @@ from auvplan.planning.obstacles import (
 )
 from auvplan.planning.problem import EdgeModel, PathResult, PlanningProblem, SearchStatus
 from auvplan.planning.route import Route, blocked_cells, blocked_lookup, plan_route
-from auvplan.planning.smoothing import path_headings, path_length, smooth_path
+from auvplan.planning.skirt import skirt_discs
+from auvplan.planning.smoothing import path_headings, path_length, resample_polyline, smooth_path
 
 __all__ = [
     "CircleObstacle",
@@ -32,5 +33,7 @@ __all__ = [
     "path_length",
     "plan_astar",
     "plan_route",
+    "resample_polyline",
+    "skirt_discs",
     "smooth_path",
 ]

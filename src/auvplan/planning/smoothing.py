@@ -143,11 +143,11 @@ def smooth_path(
     grid_path = points
     # fit to the simplified polyline, resampled every max_deviation so that the spline has
     # data along the straight stretches (not only at their corners)
-    fit_points = _resample_polyline(_simplify(grid_path, 0.5 * max_deviation), max_deviation)
+    fit_points = resample_polyline(_simplify(grid_path, 0.5 * max_deviation), max_deviation)
     if len(fit_points) >= 3:
         curve = _fit_within_bounds(
             fit_points,
-            _resample_polyline(grid_path, resolution),
+            resample_polyline(grid_path, resolution),
             spacing,
             max_deviation,
             resolution,
@@ -157,7 +157,7 @@ def smooth_path(
             return curve
         logger.info("smooth_path: no spline passed the checks; returning the polyline")
     n_steps = max(1, round(path_length(grid_path) / spacing))
-    return _resample_polyline(grid_path, 0.0, n_steps=n_steps)
+    return resample_polyline(grid_path, 0.0, n_steps=n_steps)
 
 
 def _fit_within_bounds(
@@ -196,7 +196,7 @@ def _fit_within_bounds(
         n_steps = max(1, round(path_length(dense) / spacing))
         curve = _resample_spline(tck, chord[-1], fit_points, resolution, n_steps=n_steps)
         # the straight chords between output samples must avoid no-go cells too
-        chords = _resample_polyline(curve, resolution)
+        chords = resample_polyline(curve, resolution)
         bad = np.vstack(
             (
                 dense[polyline_tree.query(dense)[0] > limit],
@@ -266,7 +266,7 @@ def _uniform_steps(length: float, resolution: float, n_steps: int | None) -> Flo
     return np.linspace(0.0, length, n_steps + 1)
 
 
-def _resample_polyline(
+def resample_polyline(
     points: FloatArray, resolution: float, *, n_steps: int | None = None
 ) -> FloatArray:
     """Points at equal arc-length steps along a polyline (exact vertices at both ends)."""
