@@ -78,3 +78,31 @@ def test_routes_keep_out_of_the_other_vehicles_goals() -> None:
     ]
     # vehicle 2's own goal is 6 m from vehicle 0's: that disc would cover it and is left out
     assert [(d.north, d.east) for d in goal_keep_outs(starts, goals, 2, 5.0, 2.0)] == [(100.0, 0.0)]
+
+
+def test_a_torpedo_path_leaves_along_its_start_heading() -> None:
+    """The A* route leaves diagonally (37 deg); a REMUS 100 starting north (turning radius
+    44 m) gets a path that leaves within 15 deg of north, a MEDUSA keeps the route's way."""
+    mission = """
+[terrain]
+synthetic = true
+[fleet]
+horizon_s = 900.0
+safety_radius_m = 5.0
+[[vehicle]]
+name = "t"
+type = "TYPE"
+start = { north = 10.0, east = 100.0, heading_deg = 0.0, speed = 0.5 }
+goal = { north = 350.0, east = 500.0, heading_deg = 90.0 }
+[solver]
+dt_s = 1.0
+"""
+
+    def leaving_bearing(vehicle: str) -> float:
+        config = parse_mission(tomllib.loads(mission.replace("TYPE", vehicle)))
+        path = pipeline.run_preplan(config).paths[0]
+        ahead = path[np.argmax(np.hypot(*(path - path[0]).T) > 15.0)] - path[0]
+        return float(np.degrees(np.arctan2(ahead[1], ahead[0])))
+
+    assert abs(leaving_bearing("remus100")) < 15.0
+    assert leaving_bearing("medusa") > 30.0

@@ -162,6 +162,30 @@ def goal_keep_outs(
     )
 
 
+def _lead_in(
+    points: FloatArray,
+    heading: float,
+    radius: float,
+    spacing: float,
+    is_blocked: Callable[[FloatArray, FloatArray], BoolArray],
+) -> FloatArray:
+    """The route polyline leaving its start along the start ``heading`` [rad].
+
+    For a vehicle that turns no tighter than ``radius`` [m]: the start pose is the optimiser's fixed initial state, so a path that leaves it at an
+    angle asks a rudder-steered vehicle for a turn it cannot make (a REMUS 100 turns on 44 m),
+    and the projection saturates the rudder. A point ``radius`` ahead of the start along the
+    heading replaces the route points nearer than that; skipped where that point is blocked,
+    and for a vehicle whose turns are shorter than the path's sample ``spacing`` [m].
+    """
+    if radius < spacing or len(points) < 2:
+        return points
+    ahead = points[0] + radius * np.array([np.cos(heading), np.sin(heading)])
+    if is_blocked(ahead[:1], ahead[1:])[0]:
+        return points
+    kept = np.hypot(*(points[1:-1] - points[0]).T) > radius
+    return np.vstack([points[:1], ahead[None, :], points[1:-1][kept], points[-1:]])
+
+
 def _skirt_goals(
     path: FloatArray,
     goals: FloatArray,
@@ -255,7 +279,7 @@ def plan_routes(
             # near the route, never through a no-go cell nor within 2 r_c of a kept-out goal
             radius = 0.0 if turning_radii is None else float(turning_radii[index])
             path = smooth_path(
-                route.points,
+                _lead_in(route.points, starts[index, 2], radius, 0.25 * cell, is_blocked),
                 spacing=0.25 * cell,
                 max_deviation=max(0.5 * cell, CORNER_CUT * radius),
                 is_blocked=_with_discs(is_blocked, keep_out, 2.0 * clearance + 0.25 * cell),
