@@ -223,3 +223,48 @@ def test_independent_checker_flies_the_true_current(tmp_path: Path) -> None:
     assert report.passed, report.failures
     assert report.max_position_defect_m["blue"] < 1e-3
     assert check(out, mission=still).max_position_defect_m["blue"] > 0.1
+
+
+@dataclasses.dataclass(frozen=True)
+class _ShearCurrent:
+    """Eastward ``speed`` north of ``north_split`` [m], westward south of it (a test field)."""
+
+    speed: float
+    north_split: float
+
+    def velocity(
+        self, north: np.ndarray, east: np.ndarray, time: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        north = np.asarray(north, dtype=np.float64)
+        return np.zeros(north.shape), np.where(north > self.north_split, self.speed, -self.speed)
+
+    def gradient(self, north: np.ndarray, east: np.ndarray, time: np.ndarray) -> np.ndarray:
+        return np.zeros((np.size(north), 2, 2))
+
+
+def test_routes_ride_the_current_round_an_island() -> None:
+    """Eastward water north of an island and westward south of it: the eastbound route
+    passes north, the westbound one south, each paying U/(U + c) of its still-water cost."""
+    from auvplan.mission.current import current_move_factor
+    from auvplan.planning import CircleObstacle, EdgeModel, plan_route
+
+    geometry = GridGeometry(21, 41, 10.0, 10.0)
+    cost = np.ones(geometry.shape)
+    island = (CircleObstacle(100.0, 200.0, 40.0),)
+    current, water = _ShearCurrent(0.3, 100.0), 0.6
+    factor = current_move_factor(geometry, current, water)
+
+    def route(start: tuple[float, float], goal: tuple[float, float], **kw: Any) -> Any:
+        return plan_route(
+            cost, geometry, start, goal, obstacles=island, edge_model=EdgeModel.CROSSED, **kw
+        )
+
+    east = route((100.0, 0.0), (100.0, 400.0), move_factor=factor)
+    west = route((100.0, 400.0), (100.0, 0.0), move_factor=factor)
+    assert np.all(east.points[1:-1, 0] >= 100.0)
+    assert np.all(west.points[1:-1, 0] <= 100.0)
+    still_east = route((100.0, 0.0), (100.0, 400.0))
+    # along the straight east-west stretches the move costs U / (U + c) = 2/3 of still water
+    assert east.cost < still_east.cost * 0.8
+    # a westward move north of the island goes against the current: U / (U - c) = 2
+    np.testing.assert_allclose(factor[3][15, 5], water / (water - 0.3))  # westward, north half

@@ -39,21 +39,30 @@ def build_graph(
     model: str,
     spacing_north: float = 1.0,
     spacing_east: float = 1.0,
+    factor: np.ndarray | None = None,
 ) -> csr_matrix:
-    """Directed 8-connected grid graph as a sparse matrix; node = row * n_cols + col."""
+    """Directed 8-connected grid graph as a sparse matrix; node = row * n_cols + col.
+
+    ``factor[k, r, c]`` multiplies the weight of move ``MOVES[k]`` into cell ``(r, c)``; a
+    non-finite factor drops the edge.
+    """
     n_rows, n_cols = cost.shape
     sources, targets, weights = [], [], []
     for row in range(n_rows):
         for col in range(n_cols):
             if not is_passable(cost, blocked, row, col):
                 continue
-            for d_row, d_col in MOVES:
+            for k, (d_row, d_col) in enumerate(MOVES):
                 r, c = row + d_row, col + d_col
                 if 0 <= r < n_rows and 0 <= c < n_cols and is_passable(cost, blocked, r, c):
+                    scale = 1.0 if factor is None else float(factor[k, r, c])
+                    if not math.isfinite(scale):
+                        continue
                     sources.append(row * n_cols + col)
                     targets.append(r * n_cols + c)
                     weights.append(
-                        edge_weight(cost, (row, col), (r, c), model, spacing_north, spacing_east)
+                        scale
+                        * edge_weight(cost, (row, col), (r, c), model, spacing_north, spacing_east)
                     )
     n = n_rows * n_cols
     return csr_matrix((weights, (sources, targets)), shape=(n, n))

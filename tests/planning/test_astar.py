@@ -238,3 +238,72 @@ def test_cost_equals_dijkstra_on_larger_grids(seed: int, model: EdgeModel) -> No
             assert_valid_path(problem, result.cells)
         else:
             assert result.status is SearchStatus.UNREACHABLE
+
+
+def with_move_factors(problem: PlanningProblem, seed: int, spread: float) -> PlanningProblem:
+    """``problem`` with random move factors in ``[1/spread, spread]``, some moves barred."""
+    rng = np.random.default_rng(seed)
+    factor = np.exp(rng.uniform(-np.log(spread), np.log(spread), (8, *problem.shape)))
+    factor[rng.random(factor.shape) < 0.1] = np.inf
+    factor[rng.random(factor.shape) < 0.02] = np.nan
+    return PlanningProblem(
+        problem.cost, problem.blocked, problem.start, problem.goal, problem.spacing_north,
+        problem.spacing_east, factor,
+    )  # fmt: skip
+
+
+@settings(max_examples=120, deadline=None, derandomize=True)
+@given(
+    problem=problems,
+    seed=st.integers(0, 2**32 - 1),
+    spread=st.sampled_from([1.0, 1.5, 10.0]),
+    model=st.sampled_from(list(EdgeModel)),
+    queue=st.sampled_from(QUEUES),
+)
+def test_cost_with_move_factors_equals_dijkstra(
+    problem: PlanningProblem, seed: int, spread: float, model: EdgeModel, queue: str
+) -> None:
+    """A current's direction-dependent weights: still the exact optimum of the directed graph."""
+    problem = with_move_factors(problem, seed, spread)
+    graph = ref.build_graph(
+        problem.cost, problem.blocked, model.value, problem.spacing_north, problem.spacing_east,
+        problem.move_factor,
+    )  # fmt: skip
+    expected = ref.dijkstra_cost(graph, problem.shape[1], problem.start)[
+        problem.goal[0] * problem.shape[1] + problem.goal[1]
+    ]
+    try:
+        result = search_grid(problem, edge_model=model, queue=queue)  # type: ignore[arg-type]
+    except InputError:
+        assert queue == "buckets"
+        return
+    if not np.isfinite(expected):
+        assert result.status is SearchStatus.UNREACHABLE
+        return
+    assert result.cost == pytest.approx(expected, rel=1e-12, abs=0.0)
+    assert_valid_path(problem, result.cells)
+    h = heuristic_map(problem, edge_model=model)
+    to_go = ref.cost_to_go(graph, problem.shape[1], problem.goal).reshape(problem.shape)
+    finite = np.isfinite(to_go)
+    assert np.all(h[finite] <= to_go[finite] * (1 + 1e-12))  # admissible with the factors
+
+
+def test_unit_move_factors_change_nothing() -> None:
+    problem = random_problem(7, 12, 13, 0.2, 10.0, is_anisotropic=True)
+    ones = PlanningProblem(
+        problem.cost, problem.blocked, problem.start, problem.goal, problem.spacing_north,
+        problem.spacing_east, np.ones((8, *problem.shape)),
+    )  # fmt: skip
+    for model in EdgeModel:
+        plain, factored = plan_astar(problem, edge_model=model), plan_astar(ones, edge_model=model)
+        assert factored.cost == plain.cost
+        np.testing.assert_array_equal(factored.cells, plain.cells)
+
+
+def test_move_factor_is_validated() -> None:
+    with pytest.raises(
+        InputError, match=r"move_factor must be a float64 array of shape \(8, 2, 3\)"
+    ):
+        PlanningProblem(np.ones((2, 3)), None, (0, 0), (1, 2), move_factor=np.ones((8, 3, 2)))
+    with pytest.raises(InputError, match="move_factor must be > 0"):
+        PlanningProblem(np.ones((2, 3)), None, (0, 0), (1, 2), move_factor=np.zeros((8, 2, 3)))

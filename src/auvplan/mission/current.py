@@ -4,10 +4,13 @@ The pre-planned paths are fixed curves; in a current ``v_c`` a vehicle moving at
 through the water covers them at the ground speed of :func:`auvplan.ocean.ground_speed`.
 :func:`path_ground_speeds` evaluates it along a path (current at ``t = 0``: the deconfliction
 works on geometry and time laws before the times are known), and :func:`check_crossable`
-refuses a path on which the cross-path current is stronger than the vehicle.
+refuses a path on which the cross-path current is stronger than the vehicle. Before there is
+a path, :func:`current_move_factor` weighs each A* move by the time it takes in the current.
 """
 
 from __future__ import annotations
+
+from typing import Final
 
 import numpy as np
 
@@ -16,9 +19,21 @@ from auvplan.errors import InfeasibleError
 from auvplan.io.currents import read_current
 from auvplan.mission.config import MissionConfig
 from auvplan.ocean import CurrentField, UniformCurrent, ground_speed
-from auvplan.terrain import BathymetryGrid
+from auvplan.planning.problem import MOVES
+from auvplan.terrain import BathymetryGrid, GridGeometry
 
-__all__ = ["check_crossable", "load_current", "mean_ground_speed", "path_ground_speeds"]
+__all__ = [
+    "MIN_GROUND_FRACTION",
+    "check_crossable",
+    "current_move_factor",
+    "load_current",
+    "mean_ground_speed",
+    "path_ground_speeds",
+]
+
+#: Slowest ground speed of an A* move, per speed through the water: a move the current slows
+#: below this is barred (the vehicle would spend ten times the energy per metre on it).
+MIN_GROUND_FRACTION: Final = 0.1
 
 
 def load_current(config: MissionConfig, bathymetry: BathymetryGrid) -> CurrentField | None:
@@ -101,3 +116,35 @@ def check_crossable(
             f"north/east is stronger than its {water_speed:.2f} m/s through the water"
         )
     return speeds[lengths > 0.0]
+
+
+def current_move_factor(
+    geometry: GridGeometry, current: CurrentField, water_speed: float
+) -> FloatArray:
+    r"""Factor ``U_w / s`` of each A* move's weight in the current, shape ``(8, n_rows, n_cols)``.
+
+    At ``U_w`` through the water a move along unit vector ``t̂`` takes ``U_w / s`` times its
+    still-water time (and energy), ``s`` the ground speed of :func:`auvplan.ocean.ground_speed`
+    with the current at the centre of the cell entered at ``t = 0``. Moves on which the
+    current is stronger across than ``U_w``, or holds the vehicle below
+    :data:`MIN_GROUND_FRACTION` ``U_w``, get ``inf`` (A* avoids them).
+
+    Examples
+    --------
+    >>> from auvplan.ocean import UniformCurrent
+    >>> factor = current_move_factor(GridGeometry(1, 1, 1.0, 1.0), UniformCurrent(0.0, 0.5), 1.0)
+    >>> factor[[4, 3], 0, 0].tolist()  # east with the current, west against it
+    [0.6666666666666666, 2.0]
+    """
+    rows, cols = np.meshgrid(np.arange(geometry.n_rows), np.arange(geometry.n_cols), indexing="ij")
+    north, east = geometry.to_world(rows.ravel(), cols.ravel())
+    velocity = np.column_stack(current.velocity(north, east, np.zeros(north.size)))
+    factor = np.empty((len(MOVES), north.size))
+    for k, (d_row, d_col) in enumerate(MOVES):
+        step = np.array([d_row * geometry.spacing_north, d_col * geometry.spacing_east])
+        tangent = np.broadcast_to(step / np.hypot(*step), velocity.shape)
+        speed = ground_speed(water_speed, velocity, tangent)
+        with np.errstate(invalid="ignore"):
+            fast_enough = speed >= MIN_GROUND_FRACTION * water_speed
+        factor[k] = np.where(fast_enough, water_speed / np.where(fast_enough, speed, 1.0), np.inf)
+    return factor.reshape(len(MOVES), geometry.n_rows, geometry.n_cols)

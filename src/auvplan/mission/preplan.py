@@ -22,7 +22,7 @@ from auvplan.mission.config import (
     Position,
     TerrainConfig,
 )
-from auvplan.mission.current import load_current
+from auvplan.mission.current import current_move_factor, load_current
 from auvplan.mission.models import vehicle_model
 from auvplan.mission.progress import ProgressReporter, no_progress
 from auvplan.ocean import CurrentField
@@ -40,7 +40,7 @@ from auvplan.planning import (
 )
 from auvplan.terrain import BathymetryGrid, MapParameters, TerrainMaps, compute_terrain_maps
 from auvplan.terrain.synthetic import synthetic_bank
-from auvplan.vehicle import turning_radius
+from auvplan.vehicle import optimal_cruise_speed, turning_radius
 
 logger = logging.getLogger(__name__)
 
@@ -162,6 +162,29 @@ def goal_keep_outs(
     )
 
 
+def courses_over_ground(
+    starts: FloatArray, speeds: FloatArray, current: CurrentField | None
+) -> FloatArray:
+    """Course over ground [rad] of each start pose ``(north, east, ψ)`` at its surge [m/s].
+
+    In still water the heading; in a current the direction of ``u (cos ψ, sin ψ) + v_c`` at
+    ``t = 0`` (the heading where that is under 1 mm/s).
+
+    Examples
+    --------
+    >>> from auvplan.ocean import UniformCurrent
+    >>> pose = np.array([[0.0, 0.0, 0.0]])
+    >>> float(np.degrees(courses_over_ground(pose, np.array([0.5]), UniformCurrent(0.0, 0.5))[0]))
+    45.0
+    """
+    if current is None:
+        return starts[:, 2].copy()
+    v_n, v_e = current.velocity(starts[:, 0], starts[:, 1], np.zeros(len(starts)))
+    north = speeds * np.cos(starts[:, 2]) + v_n
+    east = speeds * np.sin(starts[:, 2]) + v_e
+    return np.where(np.hypot(north, east) > 1e-3, np.arctan2(east, north), starts[:, 2])
+
+
 def _lead_in(
     points: FloatArray,
     heading: float,
@@ -171,11 +194,12 @@ def _lead_in(
 ) -> FloatArray:
     """The route polyline leaving its start along the start ``heading`` [rad].
 
-    For a vehicle that turns no tighter than ``radius`` [m]: the start pose is the optimiser's fixed initial state, so a path that leaves it at an
-    angle asks a rudder-steered vehicle for a turn it cannot make (a REMUS 100 turns on 44 m),
-    and the projection saturates the rudder. A point ``radius`` ahead of the start along the
-    heading replaces the route points nearer than that; skipped where that point is blocked,
-    and for a vehicle whose turns are shorter than the path's sample ``spacing`` [m].
+    For a vehicle that turns no tighter than ``radius`` [m]: the start pose is the
+    optimiser's fixed initial state, so a path that leaves it at an angle asks a
+    rudder-steered vehicle for a turn it cannot make (a REMUS 100 turns on 44 m), and the
+    projection saturates the rudder. A point ``radius`` ahead of the start along the heading
+    replaces the route points nearer than that; skipped where that point is blocked, and for
+    a vehicle whose turns are shorter than the path's sample ``spacing`` [m].
     """
     if radius < spacing or len(points) < 2:
         return points
@@ -240,6 +264,9 @@ def plan_routes(
     clearance: float,
     planner: PlannerConfig,
     turning_radii: FloatArray | None = None,
+    start_courses: FloatArray | None = None,
+    current: CurrentField | None = None,
+    water_speeds: FloatArray | None = None,
     progress: ProgressReporter = no_progress,
 ) -> tuple[tuple[Route, ...], tuple[FloatArray, ...]]:
     """One A* route per vehicle on the shifted cost map, and its smoothed curve.
@@ -247,18 +274,33 @@ def plan_routes(
     The curve stays within half a cell of the route, or within the corner cut
     :data:`CORNER_CUT` ``× R`` of a vehicle that turns no tighter than ``R``
     (``turning_radii`` [m]; e.g. a torpedo AUV's rudder turn), whichever is wider, so that
-    the right-angle turns of the grid route are rounded to the vehicle's turning radius.
+    the right-angle turns of the grid route are rounded to the vehicle's turning radius, and
+    leaves the start along ``start_courses`` [rad] (default: the start headings).
+    In a ``current``, each move weighs the time it takes at the vehicle's speed through the
+    water (``water_speeds`` [m/s]; :func:`~auvplan.mission.current.current_move_factor`), so
+    routes ride favourable water and avoid moves the current bars.
     ``progress`` is told of each vehicle's search (stage ``"A*"``, one unit per vehicle).
     """
     geometry = maps.cost_geometry
     cell = min(geometry.spacing_north, geometry.spacing_east)
     blocked = blocked_cells(maps.shifted_cost, geometry, obstacles=obstacles, clearance=clearance)
     is_blocked = blocked_lookup(geometry, blocked)
+    courses = starts[:, 2] if start_courses is None else start_courses
     routes, paths = [], []
     with progress("A*", total=len(names)) as advance:
         for index, name in enumerate(names):
+            factor = (
+                None
+                if current is None or water_speeds is None
+                else current_move_factor(geometry, current, float(water_speeds[index]))
+            )
 
-            def search(extra: tuple[Obstacle, ...], index: int = index, name: str = name) -> Route:
+            def search(
+                extra: tuple[Obstacle, ...],
+                index: int = index,
+                name: str = name,
+                factor: FloatArray | None = factor,
+            ) -> Route:
                 return plan_route(
                     maps.shifted_cost,
                     geometry,
@@ -267,6 +309,7 @@ def plan_routes(
                     obstacles=obstacles + extra,
                     clearance=clearance,
                     edge_model=EdgeModel(planner.edge_model),
+                    move_factor=factor,
                     name=name,
                 )
 
@@ -279,7 +322,7 @@ def plan_routes(
             # near the route, never through a no-go cell nor within 2 r_c of a kept-out goal
             radius = 0.0 if turning_radii is None else float(turning_radii[index])
             path = smooth_path(
-                _lead_in(route.points, starts[index, 2], radius, 0.25 * cell, is_blocked),
+                _lead_in(route.points, float(courses[index]), radius, 0.25 * cell, is_blocked),
                 spacing=0.25 * cell,
                 max_deviation=max(0.5 * cell, CORNER_CUT * radius),
                 is_blocked=_with_discs(is_blocked, keep_out, 2.0 * clearance + 0.25 * cell),
@@ -321,12 +364,19 @@ def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progre
     check_endpoint_clearance(names, starts[:, :2], goals[:, :2], 2.0 * config.fleet.safety_radius)
     check_communication_ranges(config.comms, names, starts, goals)
     obstacles, obstacle_names = resolve_obstacles(config, bathymetry)
-    radii = np.array(
-        [turning_radius(vehicle_model(v.type, config.solver.harmonics)) for v in config.vehicles]
-    )
+    models = [vehicle_model(v.type, config.solver.harmonics) for v in config.vehicles]
+    start_speeds = np.array([v.start.speed for v in config.vehicles])
+    cruise = config.fleet.cruise_speed
     routes, paths = plan_routes(
         maps, names, starts, goals, obstacles,
-        clearance=config.fleet.safety_radius, planner=config.planner, turning_radii=radii,
+        clearance=config.fleet.safety_radius, planner=config.planner,
+        turning_radii=np.array([turning_radius(model) for model in models]),
+        start_courses=courses_over_ground(starts, start_speeds, current),
+        current=current,
+        water_speeds=None if current is None else np.array(
+            [cruise if cruise is not None else optimal_cruise_speed(model).speed
+             for model in models]
+        ),
         progress=progress,
     )  # fmt: skip
     return PreplanStage(
@@ -334,7 +384,7 @@ def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progre
         maps=maps,
         names=names,
         starts=starts,
-        start_speeds=np.array([v.start.speed for v in config.vehicles]),
+        start_speeds=start_speeds,
         goals=goals,
         obstacles=obstacles,
         obstacle_names=obstacle_names,

@@ -8,7 +8,12 @@ and no bounds check is needed. Impassable cells (and the ring) have cost ``inf``
 Edge weight of a move ``u -> v`` with step length :math:`\ell_k` [m]:
 
 * ``crossed == False`` (paper): :math:`w = c_v`;
-* ``crossed == True``: :math:`w = \ell_k (c_u + c_v) / 2`.
+* ``crossed == True``: :math:`w = \ell_k (c_u + c_v) / 2`;
+
+each times the move's factor :math:`f_{k,v}` (``factor[k, v * factor_stride]``: stride 0 with
+a ``(8, 1)`` array of ones when there is none; e.g. a current's ``U_w / s`` ratio of
+through-water to ground speed, ``inf`` for a move the vehicle cannot make). The heuristic's
+rate :math:`\rho` and the bucket width below then use :math:`c_{min} f_{min}`.
 
 Heuristic at a cell ``(r, c)`` with :math:`a = |r - r_g|`, :math:`b = |c - c_g|`,
 :math:`k = \min(a, b)` and a rate :math:`\rho \le c_{min}`:
@@ -166,14 +171,20 @@ def astar_heap(
     spacing_north: float,
     spacing_east: float,
     rate: float,
+    factor: FloatArray,
+    factor_stride: int,
 ) -> tuple[IntArray, float, int]:  # pragma: no cover - compiled
     """A* with a binary heap on the padded flat grid ``cost`` of row length ``n_cols``.
 
-    ``rate`` is the heuristic's cost per cell (paper) or per metre (crossed), ``<= c_min``.
-    Returns the path as flat padded indices from start to goal (empty if unreachable), its
-    cost (``inf`` if unreachable) and the number of expanded cells.
+    ``rate`` is the heuristic's cost per cell (paper) or per metre (crossed), ``<= c_min
+    f_min``; ``factor`` ``(8, n)`` and ``factor_stride`` as in the module notes. Returns the
+    path as flat padded indices from start to goal (empty if unreachable), its cost (``inf``
+    if unreachable) and the number of expanded cells.
     """
-    return _astar(cost, n_cols, start, goal, crossed, spacing_north, spacing_east, rate, 0, 0.0)
+    return _astar(
+        cost, n_cols, start, goal, crossed, spacing_north, spacing_east, rate, factor,
+        factor_stride, 0, 0.0,
+    )  # fmt: skip
 
 
 @njit(cache=True)
@@ -186,6 +197,8 @@ def astar_buckets(
     spacing_north: float,
     spacing_east: float,
     rate: float,
+    factor: FloatArray,
+    factor_stride: int,
     n_buckets: int,
     width: float,
 ) -> tuple[IntArray, float, int]:  # pragma: no cover - compiled
@@ -196,8 +209,9 @@ def astar_buckets(
     arguments and returns as :func:`astar_heap`.
     """
     return _astar(
-        cost, n_cols, start, goal, crossed, spacing_north, spacing_east, rate, n_buckets, width
-    )
+        cost, n_cols, start, goal, crossed, spacing_north, spacing_east, rate, factor,
+        factor_stride, n_buckets, width,
+    )  # fmt: skip
 
 
 @njit(cache=True)
@@ -210,6 +224,8 @@ def _astar(
     spacing_north: float,
     spacing_east: float,
     rate: float,
+    factor: FloatArray,
+    factor_stride: int,
     n_buckets: int,
     width: float,
 ) -> tuple[IntArray, float, int]:  # pragma: no cover - compiled
@@ -306,7 +322,8 @@ def _astar(
             v = u + offsets[k]
             if closed[v]:
                 continue
-            g_v = g_u + (length[k] * 0.5 * (c_u + cost[v]) if crossed else cost[v])
+            w = length[k] * 0.5 * (c_u + cost[v]) if crossed else cost[v]
+            g_v = g_u + w * factor[k, v * factor_stride]
             if g_v >= g[v]:
                 continue
             g[v] = g_v

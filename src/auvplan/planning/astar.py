@@ -41,7 +41,7 @@ import numpy as np
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
 from auvplan.planning._kernel import astar_buckets, astar_heap, finite_range, heuristic_grid
-from auvplan.planning.problem import EdgeModel, PathResult, PlanningProblem, SearchStatus
+from auvplan.planning.problem import MOVES, EdgeModel, PathResult, PlanningProblem, SearchStatus
 
 #: Largest number of buckets of the bucket queue before falling back to the binary heap.
 MAX_BUCKETS: Final = 256
@@ -92,7 +92,8 @@ def heuristic_map(problem: PlanningProblem, *, edge_model: EdgeModel) -> FloatAr
     Parameters
     ----------
     problem : PlanningProblem
-        Grid and goal; :math:`c_{min}` is the smallest cost of a passable cell.
+        Grid and goal; :math:`c_{min}` is the smallest cost of a passable cell (times the
+        smallest move factor, if any).
     edge_model : EdgeModel
         ``PAPER``: :math:`c_{min}` times the Chebyshev distance to the goal in cells.
         ``CROSSED``: :math:`c_{min}` times the octile distance to the goal in metres.
@@ -111,6 +112,10 @@ def heuristic_map(problem: PlanningProblem, *, edge_model: EdgeModel) -> FloatAr
            [4., 2., 0.]])
     """
     cost_min, _ = finite_range(np.where(problem.passable, problem.cost, np.inf).ravel())
+    if problem.move_factor is not None:
+        cost_min *= finite_range(
+            np.where(np.isnan(problem.move_factor), np.inf, problem.move_factor).ravel()
+        )[0]
     n_rows, n_cols = problem.shape
     return heuristic_grid(
         n_rows,
@@ -143,10 +148,14 @@ def search_grid(
     if (n_rows + 2) * (n_cols + 2) >= 2**31 - 1:
         raise InputError(f"grid {n_rows} x {n_cols} is too large (more than 2**31 cells)")
     padded = _padded_cost(problem)
+    factor, factor_stride = _padded_factor(problem)
+    factor_min, factor_max = finite_range(factor.ravel())
     width = n_cols + 2
     start = (problem.start[0] + 1) * width + problem.start[1] + 1
     goal = (problem.goal[0] + 1) * width + problem.goal[1] + 1
     cost_min, cost_max = finite_range(padded.ravel())
+    if factor_min < np.inf:  # edge weights range over [c_min f_min, c_max f_max]
+        cost_min, cost_max = cost_min * factor_min, cost_max * factor_max
     crossed = edge_model is EdgeModel.CROSSED
     spacing_north, spacing_east = float(problem.spacing_north), float(problem.spacing_east)
     layout = (
@@ -160,8 +169,9 @@ def search_grid(
         )
     if layout is None:
         path, cost, n_expanded = astar_heap(
-            padded.ravel(), width, start, goal, crossed, spacing_north, spacing_east, cost_min
-        )
+            padded.ravel(), width, start, goal, crossed, spacing_north, spacing_east, cost_min,
+            factor, factor_stride,
+        )  # fmt: skip
     else:
         alpha, n_buckets, bucket_width = layout
         path, cost, n_expanded = astar_buckets(
@@ -173,6 +183,8 @@ def search_grid(
             spacing_north,
             spacing_east,
             alpha * cost_min,
+            factor,
+            factor_stride,
             n_buckets,
             bucket_width,
         )
@@ -221,6 +233,19 @@ def _bucket_layout(
         if n_buckets <= MAX_BUCKETS:
             return alpha, n_buckets, width
     return None
+
+
+def _padded_factor(problem: PlanningProblem) -> tuple[FloatArray, int]:
+    """Move factors ``(8, n_padded)`` with NaN as ``inf``, and their stride (module notes).
+
+    Without factors: a ``(8, 1)`` array of ones and stride 0.
+    """
+    if problem.move_factor is None:
+        return np.ones((len(MOVES), 1)), 0
+    n_rows, n_cols = problem.shape
+    padded = np.full((len(MOVES), n_rows + 2, n_cols + 2), np.inf)
+    padded[:, 1:-1, 1:-1] = np.where(np.isnan(problem.move_factor), np.inf, problem.move_factor)
+    return padded.reshape(len(MOVES), -1), 1
 
 
 def _padded_cost(problem: PlanningProblem) -> FloatArray:

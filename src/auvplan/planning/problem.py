@@ -14,6 +14,10 @@ weight of an edge is fixed by the :class:`EdgeModel`:
     :math:`\ell = \Delta_{north}`, :math:`\Delta_{east}` or
     :math:`\sqrt{\Delta_{north}^2 + \Delta_{east}^2}` (scikit-image's ``MCP_Geometric``).
 
+An optional ``move_factor`` of shape ``(8, n_rows, n_cols)`` multiplies the weight of the move
+:data:`MOVES` ``[k]`` into each cell (e.g. the ratio ``U_w / s`` of through-water to ground
+speed in a current; ``inf`` or NaN: that move cannot be made).
+
 Diagonal moves are allowed whenever the cell entered is passable, whatever its two orthogonal
 neighbours are (no corner-cutting rule, as in scikit-image's MCP and pyastar2d). Obstacles are
 rasterised with a clearance (:func:`auvplan.planning.obstacles.obstacle_mask`) so that a
@@ -24,11 +28,15 @@ from __future__ import annotations
 
 import enum
 from dataclasses import dataclass
+from typing import Final
 
 import numpy as np
 
 from auvplan._typing import BoolArray, FloatArray, IntArray
 from auvplan.errors import InputError
+
+#: The 8 moves ``(d_row, d_col)`` of the grid graph, in the order of ``move_factor``.
+MOVES: Final = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1))
 
 
 class EdgeModel(enum.Enum):
@@ -68,6 +76,9 @@ class PlanningProblem:
         ``(row, col)`` of the start and goal cells; both must be in bounds and passable.
     spacing_north, spacing_east : float
         Cell spacing [m] (used by ``EdgeModel.CROSSED`` only), both ``> 0``.
+    move_factor : ndarray of shape (8, n_rows, n_cols), or None
+        Factor of the weight of move ``MOVES[k]`` into each cell, ``> 0`` (inf or NaN: the
+        move is impossible); ``None``: 1 everywhere.
 
     Raises
     ------
@@ -90,6 +101,7 @@ class PlanningProblem:
     goal: tuple[int, int]
     spacing_north: float = 1.0
     spacing_east: float = 1.0
+    move_factor: FloatArray | None = None
 
     def __post_init__(self) -> None:
         cost = self.cost
@@ -115,6 +127,18 @@ class PlanningProblem:
             raise InputError(
                 f"spacing must be > 0, got {self.spacing_north!r} x {self.spacing_east!r} m"
             )
+        factor = self.move_factor
+        if factor is not None and (
+            not isinstance(factor, np.ndarray)
+            or factor.dtype != np.float64
+            or factor.shape != (len(MOVES), *cost.shape)
+        ):
+            raise InputError(
+                f"move_factor must be a float64 array of shape {(len(MOVES), *cost.shape)}, "
+                f"got {getattr(factor, 'dtype', type(factor))} of shape {np.shape(factor)}"
+            )
+        if factor is not None and np.any(factor <= 0.0):
+            raise InputError(f"move_factor must be > 0, got minimum {float(np.nanmin(factor))!r}")
         for name, cell in (("start", self.start), ("goal", self.goal)):
             row, col = int(cell[0]), int(cell[1])
             if not (0 <= row < cost.shape[0] and 0 <= col < cost.shape[1]):

@@ -152,6 +152,7 @@ def plan_route(
     obstacles: Sequence[CircleObstacle | PolygonObstacle] = (),
     clearance: float = 0.0,
     edge_model: EdgeModel = EdgeModel.PAPER,
+    move_factor: FloatArray | None = None,
     name: str = "vehicle",
 ) -> Route:
     r"""Optimal 8-connected route of one vehicle from ``start`` to ``goal`` on a cost map.
@@ -170,6 +171,9 @@ def plan_route(
         Distance [m] kept from obstacles, ``>= 0``.
     edge_model : EdgeModel
         Edge weights of the grid graph.
+    move_factor : ndarray of shape (8, n_rows, n_cols), or None
+        Factors of the moves' weights (:class:`~auvplan.planning.problem.PlanningProblem`),
+        e.g. :func:`auvplan.mission.current.current_move_factor`.
     name : str
         Vehicle name used in error messages and stored in the result.
 
@@ -209,6 +213,7 @@ def plan_route(
             cells["goal"],
             geometry.spacing_north,
             geometry.spacing_east,
+            move_factor,
         )
     except InputError as error:
         raise InputError(f"{name}: {error}") from error
@@ -216,7 +221,8 @@ def plan_route(
     if not result.success:
         raise InfeasibleError(
             f"{name}: goal ({goal[0]:g}, {goal[1]:g}) m is unreachable from start "
-            f"({start[0]:g}, {start[1]:g}) m (land, no-data cells and obstacles separate them)"
+            f"({start[0]:g}, {start[1]:g}) m (land, no-data cells and obstacles separate them"
+            f"{'; or the current bars the way' if move_factor is not None else ''})"
         )
     north, east = geometry.to_world(result.cells[:, 0], result.cells[:, 1])
     points = np.column_stack((north, east))
