@@ -245,14 +245,14 @@ class _ShearCurrent:
 def test_routes_ride_the_current_round_an_island() -> None:
     """Eastward water north of an island and westward south of it: the eastbound route
     passes north, the westbound one south, each paying U/(U + c) of its still-water cost."""
-    from auvplan.mission.current import current_move_factor
+    from auvplan.mission.current import cell_currents, current_move_factor
     from auvplan.planning import CircleObstacle, EdgeModel, plan_route
 
     geometry = GridGeometry(21, 41, 10.0, 10.0)
     cost = np.ones(geometry.shape)
     island = (CircleObstacle(100.0, 200.0, 40.0),)
     current, water = _ShearCurrent(0.3, 100.0), 0.6
-    factor = current_move_factor(geometry, current, water)
+    factor = current_move_factor(geometry, cell_currents(geometry, current), water)
 
     def route(start: tuple[float, float], goal: tuple[float, float], **kw: Any) -> Any:
         return plan_route(

@@ -24,6 +24,7 @@ from auvplan.terrain import BathymetryGrid, GridGeometry
 
 __all__ = [
     "MIN_GROUND_FRACTION",
+    "cell_currents",
     "check_crossable",
     "current_move_factor",
     "load_current",
@@ -118,28 +119,33 @@ def check_crossable(
     return speeds[lengths > 0.0]
 
 
+def cell_currents(geometry: GridGeometry, current: CurrentField) -> FloatArray:
+    """The current ``(v_N, v_E)`` [m/s] at every cell centre at ``t = 0``, shape ``(n, 2)``."""
+    rows, cols = np.meshgrid(np.arange(geometry.n_rows), np.arange(geometry.n_cols), indexing="ij")
+    north, east = geometry.to_world(rows.ravel(), cols.ravel())
+    return np.column_stack(current.velocity(north, east, np.zeros(north.size)))
+
+
 def current_move_factor(
-    geometry: GridGeometry, current: CurrentField, water_speed: float
+    geometry: GridGeometry, velocity: FloatArray, water_speed: float
 ) -> FloatArray:
     r"""Factor ``U_w / s`` of each A* move's weight in the current, shape ``(8, n_rows, n_cols)``.
 
     At ``U_w`` through the water a move along unit vector ``t̂`` takes ``U_w / s`` times its
     still-water time (and energy), ``s`` the ground speed of :func:`auvplan.ocean.ground_speed`
-    with the current at the centre of the cell entered at ``t = 0``. Moves on which the
-    current is stronger across than ``U_w``, or holds the vehicle below
+    with the current ``velocity`` at the centre of the cell entered (:func:`cell_currents`).
+    Moves on which the current is stronger across than ``U_w``, or holds the vehicle below
     :data:`MIN_GROUND_FRACTION` ``U_w``, get ``inf`` (A* avoids them).
 
     Examples
     --------
     >>> from auvplan.ocean import UniformCurrent
-    >>> factor = current_move_factor(GridGeometry(1, 1, 1.0, 1.0), UniformCurrent(0.0, 0.5), 1.0)
+    >>> grid = GridGeometry(1, 1, 1.0, 1.0)
+    >>> factor = current_move_factor(grid, cell_currents(grid, UniformCurrent(0.0, 0.5)), 1.0)
     >>> factor[[4, 3], 0, 0].tolist()  # east with the current, west against it
     [0.6666666666666666, 2.0]
     """
-    rows, cols = np.meshgrid(np.arange(geometry.n_rows), np.arange(geometry.n_cols), indexing="ij")
-    north, east = geometry.to_world(rows.ravel(), cols.ravel())
-    velocity = np.column_stack(current.velocity(north, east, np.zeros(north.size)))
-    factor = np.empty((len(MOVES), north.size))
+    factor = np.empty((len(MOVES), len(velocity)))
     for k, (d_row, d_col) in enumerate(MOVES):
         step = np.array([d_row * geometry.spacing_north, d_col * geometry.spacing_east])
         tangent = np.broadcast_to(step / np.hypot(*step), velocity.shape)

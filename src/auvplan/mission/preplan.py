@@ -22,7 +22,7 @@ from auvplan.mission.config import (
     Position,
     TerrainConfig,
 )
-from auvplan.mission.current import current_move_factor, load_current
+from auvplan.mission.current import cell_currents, current_move_factor, load_current
 from auvplan.mission.models import vehicle_model
 from auvplan.mission.progress import ProgressReporter, no_progress
 from auvplan.ocean import CurrentField
@@ -286,13 +286,14 @@ def plan_routes(
     blocked = blocked_cells(maps.shifted_cost, geometry, obstacles=obstacles, clearance=clearance)
     is_blocked = blocked_lookup(geometry, blocked)
     courses = starts[:, 2] if start_courses is None else start_courses
+    velocity = None if current is None else cell_currents(geometry, current)
     routes, paths = [], []
     with progress("A*", total=len(names)) as advance:
         for index, name in enumerate(names):
             factor = (
                 None
-                if current is None or water_speeds is None
-                else current_move_factor(geometry, current, float(water_speeds[index]))
+                if velocity is None or water_speeds is None
+                else current_move_factor(geometry, velocity, float(water_speeds[index]))
             )
 
             def search(

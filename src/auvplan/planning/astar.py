@@ -113,9 +113,7 @@ def heuristic_map(problem: PlanningProblem, *, edge_model: EdgeModel) -> FloatAr
     """
     cost_min, _ = finite_range(np.where(problem.passable, problem.cost, np.inf).ravel())
     if problem.move_factor is not None:
-        cost_min *= finite_range(
-            np.where(np.isnan(problem.move_factor), np.inf, problem.move_factor).ravel()
-        )[0]
+        cost_min *= finite_range(_padded_factor(problem)[0].ravel())[0]
     n_rows, n_cols = problem.shape
     return heuristic_grid(
         n_rows,
