@@ -97,7 +97,7 @@ def build_case(name: str, folder: Path) -> tuple[AssembledProblem, ProntoOptions
     preplan = run_preplan(config)
     layout = fleet_layout(config)
     deconfliction = run_deconfliction(
-        layout, preplan.paths, preplan.starts[:, 2], fleet=config.fleet,
+        layout, preplan.paths, preplan.starts[:, 2], preplan.goals[:, 2], fleet=config.fleet,
         settings=config.deconfliction, dt=config.solver.dt,
     )  # fmt: skip
     assembled = assemble_problem(

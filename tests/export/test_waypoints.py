@@ -10,7 +10,7 @@ from shapely import LineString
 
 from auvplan.errors import InputError
 from auvplan.export.plan import VehicleTrack
-from auvplan.export.waypoints import thin_track
+from auvplan.export.waypoints import synchronized_distances, thin_track
 
 from ._plans import synthetic_track
 
@@ -91,3 +91,20 @@ def test_thinning_compresses_a_smooth_track() -> None:
 def test_bad_tolerance_names_the_key(tolerance: float) -> None:
     with pytest.raises(InputError, match="tolerance_m"):
         thin_track(synthetic_track("a", 0.0), tolerance)
+
+
+def test_a_zero_tolerance_terminates_when_the_last_leg_rounds() -> None:
+    """Interpolating to the last sample rounds; the kept samples' distances are exactly 0."""
+    steps = [(1.2456566508179518, 1.2558427732033879, 10), (5e-324, -0.8375291082797736, 20),
+             (1.0838656588728839, -2.7412365237798872, 27), (1e-300, 0.6351925565456384, 26),
+             (0.9120863355851956, -2.595644752699721, 6)]  # fmt: skip
+    velocity = np.concatenate(
+        [np.tile([s * np.cos(psi), s * np.sin(psi)], (n, 1)) for s, psi, n in steps]
+    )
+    points = np.vstack([[0.0, 0.0], np.cumsum(velocity * 0.5, axis=0)])
+    track = _track(points[:, 0], points[:, 1], 0.5)
+    kept = thin_track(track, 0.0).index
+    points = np.column_stack([track.north, track.east])
+    distances, _ = synchronized_distances(track.time, points, kept)
+    assert np.all(distances[kept] == 0.0)
+    assert distances.max() == 0.0

@@ -15,6 +15,7 @@ from auvplan.optimization.barrier import (
     hockey_stick,
     log_barrier,
 )
+from auvplan.optimization.pronto import infeasible_restart_delta
 
 
 def _central(fun, z: np.ndarray, h: float = 1e-6) -> np.ndarray:
@@ -102,3 +103,17 @@ def test_casadi_expression_equals_numpy(is_hockey: bool) -> None:
 def test_rejects_non_positive_delta() -> None:
     with pytest.raises(InputError, match="delta"):
         log_barrier(np.ones(2), 0.0)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    delta=st.floats(1e-4, 1.0),
+    violation=st.floats(0.0, 100.0),
+)
+def test_an_infeasible_restart_pulls_harder_at_the_boundary(delta: float, violation: float) -> None:
+    """The re-solve's barrier slope at ``s = 0`` beats the old one at the violation."""
+    smaller = infeasible_restart_delta(delta, -violation)
+    assert 0.0 < smaller <= 0.5 * delta
+    _, old_pull, _ = log_barrier(np.array([-violation]), delta)
+    _, new_pull, _ = log_barrier(np.array([0.0]), smaller)
+    assert abs(new_pull[0]) >= 2.0 * abs(old_pull[0]) * (1 - 1e-12)

@@ -58,7 +58,7 @@ def _constraint_slacks(
 def test_unconstrained_cost_equals_ipopt(make_problem, n_substeps: int) -> None:
     problem = dataclasses.replace(make_problem(), n_substeps=n_substeps)
     guess = zero_guess(problem)
-    result = solve_pronto(problem, guess, options=ProntoOptions(tol=1e-10))
+    result = solve_pronto(problem, guess, options=ProntoOptions(tol=1e-10, rtol=1e-12))
     assert result.status is ProntoStatus.CONVERGED, result.message
     assert result.barrier_cost == 0.0
     reference = solve_ipopt(problem, result.history and guess)

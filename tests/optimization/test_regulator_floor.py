@@ -47,7 +47,7 @@ def test_floor_makes_the_rest_state_steerable() -> None:
 def test_floor_changes_the_path_not_the_optimum() -> None:
     problem = unicycle_problem()
     floored = dataclasses.replace(problem, regulator_floor=SPEED_FLOOR)
-    options = ProntoOptions(tol=1e-10)
+    options = ProntoOptions(tol=1e-10, rtol=1e-12)
     exact = solve_pronto(problem, zero_guess(problem), options=options)
     with_floor = solve_pronto(floored, zero_guess(floored), options=options)
     assert exact.success

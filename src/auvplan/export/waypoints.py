@@ -101,7 +101,9 @@ def synchronized_distances(
     start, end = kept[leg], kept[leg + 1]
     fraction = (time - time[start]) / (time[end] - time[start])
     interpolated = points[start] + fraction[:, None] * (points[end] - points[start])
-    return np.hypot(*(interpolated - points).T), leg
+    distances = np.hypot(*(interpolated - points).T)
+    distances[kept] = 0.0  # exactly: the last sample's interpolation may round
+    return distances, leg
 
 
 def thin_track(track: VehicleTrack, tolerance: float) -> Waypoints:

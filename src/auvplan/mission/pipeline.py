@@ -115,6 +115,7 @@ def run_mission(
             layout,
             preplan.paths,
             preplan.starts[:, 2],
+            preplan.goals[:, 2],
             fleet=config.fleet,
             settings=config.deconfliction,
             dt=config.solver.dt,

@@ -33,10 +33,12 @@ from auvplan.mission.fleet import FleetLayout
 from auvplan.ocean import CurrentField, through_water
 from auvplan.planning import path_length
 from auvplan.vehicle import (
+    VehicleModel,
     max_surge_acceleration,
     minimum_useful_speed,
     reference_states,
     top_speed,
+    turning_radius,
 )
 
 logger = logging.getLogger(__name__)
@@ -45,6 +47,9 @@ logger = logging.getLogger(__name__)
 SPEED_MARGIN: Final = 0.85
 #: Speed-raising rounds when deconfliction overruns a fixed horizon.
 HORIZON_ATTEMPTS: Final = 4
+#: Fraction of the steady turn rate on the tightest turning radius that the desired heading
+#: uses to turn from the start heading and onto the goal heading.
+TURN_RATE_FRACTION: Final = 0.5
 #: Largest working memory [bytes] the optimiser may need before the mission is refused.
 MEMORY_BUDGET: Final = 16 * 2**30
 #: Dense arrays of size ``(n_x + n_u)²`` the optimiser keeps per solver step (Jacobians,
@@ -122,6 +127,7 @@ def run_deconfliction(
     layout: FleetLayout,
     paths: tuple[FloatArray, ...],
     start_headings: FloatArray,
+    goal_headings: FloatArray,
     *,
     fleet: FleetConfig,
     settings: DeconflictionConfig,
@@ -136,8 +142,9 @@ def run_deconfliction(
         The vehicles.
     paths : tuple of ndarray of shape (n_i, 2)
         Smoothed pre-planned paths, north/east [m].
-    start_headings : ndarray of shape (n_vehicles,)
-        Start headings [rad] (the desired headings are unwrapped next to them).
+    start_headings, goal_headings : ndarray of shape (n_vehicles,)
+        Start and goal headings [rad]; the desired headings turn from and onto them
+        (:func:`desired_states`).
     fleet, settings : FleetConfig, DeconflictionConfig
         Timing, safety radius and coordination-space settings.
     dt : float
@@ -190,7 +197,9 @@ def run_deconfliction(
     n_steps = check_problem_size(layout, horizon, dt)
     coordination = retime_for_arrival(coordination, problem, horizon)
     time = dt * np.arange(n_steps + 1, dtype=np.float64)
-    desired = desired_states(layout, problem, coordination, time, start_headings, current)
+    desired = desired_states(
+        layout, problem, coordination, time, (start_headings, goal_headings), current
+    )
     logger.info(
         "deconfliction (%s%s): horizon %.1f s, delays %s s, min separation %.2f m",
         coordination.method,
@@ -236,14 +245,16 @@ def desired_states(
     problem: CoordinationProblem,
     coordination: CoordinationResult,
     time: FloatArray,
-    start_headings: FloatArray,
+    end_headings: tuple[FloatArray, FloatArray],
     current: CurrentField | None = None,
 ) -> tuple[FloatArray, ...]:
     """Each vehicle's reference state along its timed path, on ``time``.
 
     In a current the surge is the speed through the water and the heading crabs into the
     current (:func:`auvplan.ocean.through_water`); where the vehicle would drift with the water
-    (under 1 mm/s through it) the path's heading is kept.
+    (under 1 mm/s through it) the path's heading is kept. ``end_headings`` (start and goal
+    headings [rad] per vehicle): the heading turns from the start heading and onto the goal
+    heading at a rate the vehicle can fly (:func:`turn_in_and_out`).
     """
     positions = timed_positions(coordination, problem, time)
     headings = timed_headings(coordination, problem, time)
@@ -256,9 +267,47 @@ def desired_states(
             drift = np.column_stack(current.velocity(positions[i][:, 0], positions[i][:, 1], time))
             speed, crab = through_water(velocity, drift)
             path_heading = np.where(speed > 1e-3, crab, path_heading)
-        psi = np.unwrap(path_heading)
-        # keep the first desired heading within pi of the start heading
-        psi += 2 * np.pi * np.round((start_headings[i] - psi[0]) / (2 * np.pi))
+        ends = (float(end_headings[0][i]), float(end_headings[1][i]))
+        psi = turn_in_and_out(np.unwrap(path_heading), time, ends, speed, model)
         pose = np.column_stack([positions[i], psi])
         desired.append(reference_states(model, pose, speed, np.gradient(psi, time)))
     return tuple(desired)
+
+
+def turn_in_and_out(
+    psi: FloatArray,
+    time: FloatArray,
+    ends: tuple[float, float],
+    speed: FloatArray,
+    model: VehicleModel,
+) -> FloatArray:
+    """Headings [rad] ``psi`` blended from the start heading and onto the goal heading.
+
+    ``ψ_d(t) = ψ(t) + w_0(t) Δ_0 + w_T(t) Δ_T`` with ``Δ_0 = ψ_0 - ψ(0)`` and
+    ``Δ_T = ψ_goal - ψ(T)`` (each wrapped into ``(-π, π]``) and half-cosine weights falling
+    from 1 at ``t = 0`` over ``τ_0`` and rising to 1 at ``T`` over ``τ_T``. A half-cosine turn
+    of ``Δ`` has peak rate ``π |Δ| / (2 τ)``; ``τ`` makes it ``TURN_RATE_FRACTION`` of the
+    steady rate ``U / R`` at that end's speed ``U`` (at least the minimum useful speed) on the
+    vehicle's turning radius ``R``, capped at a third of the horizon each. The result starts
+    at the start heading (unwrapped next to it) and ends at the goal heading.
+    """
+    start, goal = ends
+    psi = psi + 2 * np.pi * np.round((start - psi[0]) / (2 * np.pi))
+    radius = turning_radius(model)
+    floor = minimum_useful_speed(model)
+    elapsed = time - time[0]
+    horizon = float(elapsed[-1])
+    for offset, end_speed, age in (
+        (_wrapped(start - psi[0]), speed[0], elapsed),
+        (_wrapped(goal - psi[-1]), speed[-1], horizon - elapsed),
+    ):
+        rate = TURN_RATE_FRACTION * max(float(end_speed), floor) / radius
+        tau = min(0.5 * np.pi * abs(offset) / rate, horizon / 3.0)
+        if tau > 0.0:
+            psi = psi + offset * 0.5 * (1.0 + np.cos(np.pi * np.minimum(age / tau, 1.0)))
+    return psi
+
+
+def _wrapped(angle: float) -> float:
+    """``angle`` [rad] wrapped into ``(-π, π]``."""
+    return float(np.pi - (np.pi - angle) % (2 * np.pi))

@@ -45,8 +45,9 @@ def convexify(
 
     Only stages that fail a Cholesky test above the floor change. ``groups`` (index sets of
     ``z = (x, u)`` that tile it, e.g. one per vehicle) speeds this up without changing the
-    result: a stage with no entry outside the groups' diagonal blocks is block-diagonal, so
-    its blocks are clipped one by one (:func:`auvplan.optimization._kernels.clip_stage_weights`).
+    result: at each stage the groups coupled by nonzero entries form components and each
+    component's block is clipped on its own
+    (:func:`auvplan.optimization._kernels.clip_stage_weights`).
 
     Returns
     -------

@@ -89,7 +89,7 @@ class ProntoOptions:
     delta_feasible_max : float
         Cap on ``δ`` once feasible.
     max_infeasible_restarts : int
-        How often a barrier level is re-solved with ``δ`` halved when it ends infeasible.
+        How often a barrier level is re-solved with a smaller ``δ`` when it ends infeasible.
     eigenvalue_floor : float
         Smallest eigenvalue kept by the convexified model (per stage, relative to ``dt``).
     terminal_regulator : TerminalRegulator or {"dare", "weight"}
@@ -110,7 +110,7 @@ class ProntoOptions:
     """
 
     tol: float = 1e-6
-    rtol: float = 1e-8
+    rtol: float = 1e-6
     inner_tol: float = 1e-4
     inner_rtol: float = 1e-6
     max_iter: int = 200

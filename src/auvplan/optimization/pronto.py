@@ -162,6 +162,19 @@ def _iterate_level(
             )
 
 
+def infeasible_restart_delta(delta: float, smallest: float) -> float:
+    """``δ`` for re-solving a level whose minimiser has smallest scaled slack ``smallest <= 0``.
+
+    Where the minimiser violates a constraint by ``v = -smallest``, the barrier's pull
+    ``ε |β'_δ(-v)| = ε (v + 2δ) / δ²`` balances what violating gains. The re-solve's pull at
+    the boundary, ``ε |β'_δ'(0)| = 2ε / δ'``, exceeds that gain when
+    ``δ' < 2δ² / (v + 2δ)``; half of it is taken (and at most ``δ / 2``), so a deep violation
+    is cured in one re-solve instead of a halving per level.
+    """
+    violation = max(-smallest, 0.0)
+    return min(0.5 * delta, delta**2 / (violation + 2.0 * delta))
+
+
 def _continuation(
     model: ProntoModel,
     state: _State,
@@ -181,15 +194,19 @@ def _continuation(
                 status = _iterate_level(model, state, epsilon, tol, options, start, callback)
                 if status is not None or not model.has_constraints:
                     break
-                if min_slack(model, state.trajectory) > 0.0:
+                smallest = min_slack(model, state.trajectory)
+                if smallest > 0.0:
                     break
                 if restarts >= options.max_infeasible_restarts:
                     status = ProntoStatus.INFEASIBLE
                     break
                 restarts += 1
-                state.delta *= 0.5
+                state.delta = infeasible_restart_delta(state.delta, smallest)
                 logger.info(
-                    "level eps=%.1e ended infeasible: delta halved to %.2e", epsilon, state.delta
+                    "level eps=%.1e ended infeasible (slack %.3g): delta reduced to %.2e",
+                    epsilon,
+                    smallest,
+                    state.delta,
                 )
             if status is not None:
                 return status, "", epsilon
@@ -243,7 +260,8 @@ def solve_pronto(
     :meth:`ProntoOptions.epsilon_levels`; ``δ`` starts at ``delta_initial`` and is shrunk below
     the smallest barrier argument once the trajectory is strictly feasible, after which
     infeasible line-search candidates are rejected. A level that ends infeasible is re-solved
-    with ``δ`` halved (at most ``max_infeasible_restarts`` times).
+    with ``δ`` reduced by :func:`infeasible_restart_delta` (at most
+    ``max_infeasible_restarts`` times).
     """
     options = options if options is not None else ProntoOptions()
     check_guess(problem, guess)
