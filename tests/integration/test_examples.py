@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from auvplan.cli.main import main
 from auvplan.mission.config import load_mission
 from auvplan.mission.pipeline import run_mission
+from auvplan.scenarios import check
 
 pytestmark = pytest.mark.slow
 
@@ -37,3 +40,20 @@ def test_example_mission(name: str) -> None:
     for comm in config.comms:
         i, j = config.vehicle_index(comm.pair[0]), config.vehicle_index(comm.pair[1])
         assert np.hypot(*(states[i, :, :2] - states[j, :, :2]).T).max() <= comm.max_range
+
+
+def test_mixed_fleet_in_a_current_converges_and_saves_energy(tmp_path: Path) -> None:
+    """Two MEDUSAs and two REMUS 100s in a 0.3 m/s current (issue 15's done-when mission)."""
+    mission = MISSIONS / "mixed_fleet_current.toml"
+    config = load_mission(mission)
+    if config.terrain.file is not None and not config.terrain.file.is_file():
+        pytest.skip(f"bathymetry not found: {config.terrain.file}")
+    folder = tmp_path / "out"
+    assert main(["-q", "plan", str(mission), "-o", str(folder), "--compare-no-current"]) == 0
+    summary = json.loads((folder / "summary.json").read_text(encoding="utf-8"))
+    assert summary["optimization"]["status"] == "CONVERGED"
+    comparison = summary["current_comparison"]
+    assert comparison["still_water_plan"]["status"] == "CONVERGED"
+    assert comparison["saving_J"] > 0.05 * comparison["total_energy_still_water_plan_J"]
+    report = check(folder, mission=mission)  # flown in the true current by each own model
+    assert report.success, report.failures

@@ -33,8 +33,6 @@ TYPES = {"blue": "medusa", "red": "remus100"}
 @pytest.fixture(scope="module")
 def output(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("mixed") / "out"
-    # 3: the plan is written but PRONTO stops at max_iter on this mission (an optimiser
-    # matter); the outputs and the checks below do not depend on convergence
     assert main(["-q", "plan", str(MISSION), "-o", str(folder)]) == 0  # CONVERGED
     return folder
 

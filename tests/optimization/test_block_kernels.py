@@ -213,6 +213,27 @@ def test_chunked_points_give_the_one_chunk_results(
         assert_close(many, one, 1e-14)
 
 
+def test_jacobians_elsewhere_keep_the_linearisation_s_sweeps(
+    compiled: dict[str, BlockKernels], rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The regulator's Jacobians at other points neither evict nor change the Hessians' data."""
+    kernels, weights = compiled["cart"], MODELS["cart"][1]
+    x, u, p, w = _points(kernels, weights, rng)
+    costate = rng.standard_normal((N_POINTS, kernels.n_x))
+    arguments = (x, u, p, w, DT / 2, 2)
+    kernels.first_order(*arguments)
+    expected = kernels.hessian(*arguments, costate, 1.0)
+    kernels.first_order(*arguments)
+    kernels.first_order(x + 0.1, u, p, w, DT / 2, 2, remember=False)
+    sweeps: list[int] = []
+    forward = BlockKernels._forward
+    monkeypatch.setattr(
+        BlockKernels, "_forward", lambda self, *a: sweeps.append(1) or forward(self, *a)
+    )
+    assert_close(kernels.hessian(*arguments, costate, 1.0), expected, 0.0)
+    assert sweeps == []  # the Hessians reused the linearisation's forward sweep
+
+
 def test_closed_loop_equals_a_loop_of_substeps(
     compiled: dict[str, BlockKernels], rng: np.random.Generator
 ) -> None:

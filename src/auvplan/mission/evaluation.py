@@ -79,7 +79,7 @@ def evaluate_plan(
     states = np.stack(layout.unstack_states(flat_states))
     inputs = np.stack(layout.unstack_inputs(flat_inputs))
     held = np.vstack([flat_inputs, flat_inputs[-1:]])
-    power_map = functions.power.map(time.size)
+    power_map = functions.power.map(time.size, "serial")
     power = np.asarray(power_map(flat_states.T, held.T)).reshape(layout.n_vehicles, time.size)
     energy = np.asarray(np.trapezoid(power, time, axis=1), dtype=np.float64)
     planned = np.stack([positions(model, states[i]) for i, model in enumerate(models)])

@@ -16,7 +16,7 @@ from typing import Any, Literal, TypeAlias, TypeVar
 import casadi as ca
 import numpy as np
 
-from auvplan._typing import FloatArray
+from auvplan._typing import FloatArray, IntArray
 from auvplan.errors import InputError
 
 __all__ = [
@@ -93,6 +93,17 @@ def hessian_blocks(expression: Symbol, x: Symbol, u: Symbol) -> list[Symbol]:
         row_major(hessian[:n_x, n_x:]),
         row_major(hessian[n_x:, n_x:]),
     ]
+
+
+def nonzeros(matrix: Symbol) -> Symbol:
+    """The structural nonzeros of a sparse matrix as a column (CasADi's column-major order)."""
+    return matrix[matrix.sparsity().find()] if matrix.nnz() else type(matrix)(0, 1)
+
+
+def entries(matrix: Symbol) -> tuple[IntArray, IntArray]:
+    """Row and column of each of :func:`nonzeros`' entries."""
+    rows, columns = matrix.sparsity().get_triplet()
+    return np.asarray(rows, dtype=np.int64), np.asarray(columns, dtype=np.int64)
 
 
 def hessian_shapes(n_x: int, n_u: int) -> list[tuple[int, ...]]:
@@ -193,9 +204,9 @@ def check_rollout(
 class StageEvaluator:
     """Evaluates single-stage Functions ``g(x, u, p[, w])`` over ``N`` stages in one call.
 
-    ``(n_x, n_u, n_p)`` are the sizes of ``(x, u, p)``. The mapped Functions (``g.map(N)``,
-    with ``n_threads`` threads when ``parallelization == "thread"``) are built on first use
-    and kept per ``(name, N)``.
+    ``(n_x, n_u, n_p)`` are the sizes of ``(x, u, p)``. The mapped Functions
+    (``g.map(N, "serial")``, or with ``n_threads`` threads when ``parallelization ==
+    "thread"``) are built on first use and kept per ``(name, N)``.
     """
 
     n_x: int
@@ -206,14 +217,14 @@ class StageEvaluator:
     maps: dict[tuple[str, int], ca.Function] = field(default_factory=dict, repr=False)
 
     def mapped(self, function: ca.Function, n_stages: int) -> ca.Function:
-        """``function.map(n_stages)`` (built once per name and horizon)."""
+        """``function.map(n_stages, "serial")`` (built once per name and horizon)."""
         key = (function.name(), n_stages)
         mapped = self.maps.get(key)
         if mapped is None:
             if self.parallelization == "thread" and self.n_threads > 1:
                 mapped = function.map(n_stages, "thread", self.n_threads)
-            else:
-                mapped = function.map(n_stages)
+            else:  # "serial" explicitly: map(n) alone takes seconds to build for n ~ 1e3
+                mapped = function.map(n_stages, "serial")
             self.maps[key] = mapped
         return mapped
 

@@ -159,9 +159,20 @@ class BlockKernels:
     a Newton step asks for the Hessians at the trajectory it just linearised."""
 
     def _sweeps(
-        self, x: FloatArray, u: FloatArray, p: FloatArray, w: FloatArray, h: float, n_substeps: int
+        self,
+        x: FloatArray,
+        u: FloatArray,
+        p: FloatArray,
+        w: FloatArray,
+        h: float,
+        n_substeps: int,
+        remember: bool = True,
     ) -> list[_Forward]:
-        """The forward sweeps of every chunk (reused when the arguments repeat)."""
+        """The forward sweeps of every chunk (reused when the arguments repeat).
+
+        ``remember=False`` leaves the remembered sweeps alone (e.g. Jacobians at other points
+        between a linearisation and its Hessians).
+        """
         digest = hashlib.blake2b(np.array([h, n_substeps, CHUNK], dtype=np.float64).tobytes())
         for array in (x, u, p, w):
             digest.update(np.ascontiguousarray(array).tobytes())
@@ -172,8 +183,9 @@ class BlockKernels:
                 self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps)
                 for rows in _chunks(x.shape[0])
             ]
-            self._last.clear()
-            self._last[key] = sweeps
+            if remember:
+                self._last.clear()
+                self._last[key] = sweeps
         return sweeps
 
     def step(
@@ -233,13 +245,23 @@ class BlockKernels:
         return _Forward(*nodes, dy, cost, cost_grad)
 
     def first_order(
-        self, x: FloatArray, u: FloatArray, p: FloatArray, w: FloatArray, h: float, n_substeps: int
+        self,
+        x: FloatArray,
+        u: FloatArray,
+        p: FloatArray,
+        w: FloatArray,
+        h: float,
+        n_substeps: int,
+        remember: bool = True,
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """``∂F/∂(x, u) (B, n_x, n_z)``, ``L (B,)`` and ``∇_{(x,u)} L (B, n_z)``."""
+        """``∂F/∂(x, u) (B, n_x, n_z)``, ``L (B,)`` and ``∇_{(x,u)} L (B, n_z)``.
+
+        ``remember``: keep the forward sweeps for :meth:`hessian` at the same arguments.
+        """
         n_z = self.n_x + self.n_u
         step_jac = np.empty((x.shape[0], self.n_x, n_z))
         cost, cost_grad = np.empty(x.shape[0]), np.empty((x.shape[0], n_z))
-        sweeps = self._sweeps(x, u, p, w, h, n_substeps)
+        sweeps = self._sweeps(x, u, p, w, h, n_substeps, remember)
         for rows, forward in zip(_chunks(x.shape[0]), sweeps, strict=True):
             step_jac[rows], cost[rows], cost_grad[rows] = (
                 forward.step_jac, forward.cost, forward.cost_grad,

@@ -14,9 +14,8 @@ from auvplan.optimization._casadi import (
     StageEvaluator,
     Symbol,
     dense_function,
-    hessian_blocks,
-    hessian_shapes,
-    row_major,
+    entries,
+    nonzeros,
     signature_sizes,
     symbols,
     with_symbol_fallback,
@@ -41,7 +40,13 @@ class ConstraintModel:
     n_c: int
     function: ca.Function
     _jacobians: ca.Function = field(repr=False)
+    """``(c, nonzeros of ∂c/∂(x, u))`` at one stage."""
     _hessian: ca.Function = field(repr=False)
+    """Nonzeros of ``∇²_{(x, u)} (wᵀc)`` at one stage."""
+    jacobian_entries: tuple[IntArray, IntArray] = field(repr=False)
+    """Row and column in ``∂c/∂(x, u)`` of each Jacobian nonzero (CasADi's order)."""
+    hessian_entries: tuple[IntArray, IntArray] = field(repr=False)
+    """Row and column in ``∇²_{(x, u)}`` of each Hessian nonzero."""
     row_start: IntArray = field(repr=False)
     """Row ``j`` of ``∂c/∂(x, u)`` has its structural nonzeros in
     ``columns[row_start[j]:row_start[j + 1]]`` (compressed rows)."""
@@ -59,15 +64,20 @@ class ConstraintModel:
     def jacobians(
         self, states: FloatArray, inputs: FloatArray, parameters: FloatArray
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """Values ``(N, n_c)`` and Jacobians ``c_x (N, n_c, n_x)``, ``c_u (N, n_c, n_u)``."""
-        c, c_x, c_u = self._stages(
-            self._jacobians,
-            states,
-            inputs,
-            parameters,
-            [(self.n_c,), (self.n_c, self.n_x), (self.n_c, self.n_u)],
+        """Values ``(N, n_c)`` and Jacobians ``c_x (N, n_c, n_x)``, ``c_u (N, n_c, n_u)``.
+
+        Only the structural nonzeros are evaluated (a separation touches four states).
+        """
+        rows, columns = self.jacobian_entries
+        c, nonzeros = self._stages(
+            self._jacobians, states, inputs, parameters, [(self.n_c,), (rows.size,)]
         )
-        return c, c_x, c_u
+        full = _scattered(nonzeros, rows, columns, (self.n_c, self.n_x + self.n_u))
+        return (
+            c,
+            np.ascontiguousarray(full[:, :, : self.n_x]),
+            np.ascontiguousarray(full[:, :, self.n_x :]),
+        )
 
     def weighted_hessians(
         self,
@@ -76,16 +86,22 @@ class ConstraintModel:
         parameters: FloatArray,
         weights: FloatArray,
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """Blocks of ``Σ_j w_{k,j} ∇²c_j(x_k, u_k, p_k)``; ``weights`` has shape ``(N, n_c)``."""
-        h_xx, h_xu, h_uu = self._stages(
-            self._hessian,
-            states,
-            inputs,
-            parameters,
-            hessian_shapes(self.n_x, self.n_u),
+        """Blocks of ``Σ_j w_{k,j} ∇²c_j(x_k, u_k, p_k)``; ``weights`` has shape ``(N, n_c)``.
+
+        Only the structural nonzeros are evaluated (those of the positions in a separation).
+        """
+        rows, columns = self.hessian_entries
+        (nonzeros,) = self._stages(
+            self._hessian, states, inputs, parameters, [(rows.size,)],
             ("weights", weights, self.n_c),
+        )  # fmt: skip
+        n_x, n_z = self.n_x, self.n_x + self.n_u
+        full = _scattered(nonzeros, rows, columns, (n_z, n_z))
+        return (
+            np.ascontiguousarray(full[:, :n_x, :n_x]),
+            np.ascontiguousarray(full[:, :n_x, n_x:]),
+            np.ascontiguousarray(full[:, n_x:, n_x:]),
         )
-        return h_xx, h_xu, h_uu
 
     def add_outer_products(
         self,
@@ -100,6 +116,15 @@ class ConstraintModel:
         states of a fleet), so the cost does not grow with ``n_x²``.
         """
         _add_outer_products(weights, c_x, c_u, self.row_start, self.columns, *blocks)
+
+
+def _scattered(
+    nonzeros: FloatArray, rows: IntArray, columns: IntArray, shape: tuple[int, int]
+) -> FloatArray:
+    """``(N, *shape)`` zeros with ``nonzeros (N, nnz)`` placed at ``(rows, columns)``."""
+    full = np.zeros((nonzeros.shape[0], *shape))
+    full[:, rows, columns] = nonzeros
+    return full
 
 
 @numba.njit(cache=True)
@@ -168,27 +193,21 @@ def discretize_constraints(
         n_c = int(c.numel())
         weights = kind.sym("w", n_c)
         args = [x, u, p]
-        row_start, columns = ca.jacobian(c, ca.vertcat(x, u)).sparsity().get_crs()
+        jacobian = ca.jacobian(c, ca.vertcat(x, u))
+        hessian, _ = ca.hessian(ca.dot(weights, c), ca.vertcat(x, u))
+        row_start, columns = jacobian.sparsity().get_crs()
         return ConstraintModel(
             n_x,
             n_u,
             n_p,
             n_c,
             dense_function("constraints", args, [c], _ARGS, ["c"]),
+            dense_function("constraint_jac", args, [c, nonzeros(jacobian)], _ARGS, ["c", "c_xu"]),
             dense_function(
-                "constraint_jac",
-                args,
-                [c, row_major(ca.jacobian(c, x)), row_major(ca.jacobian(c, u))],
-                _ARGS,
-                ["c", "c_x", "c_u"],
+                "constraint_hess", [*args, weights], [nonzeros(hessian)], [*_ARGS, "w"], ["h"]
             ),
-            dense_function(
-                "constraint_hess",
-                [*args, weights],
-                hessian_blocks(ca.dot(weights, c), x, u),
-                [*_ARGS, "w"],
-                ["h_xx", "h_xu", "h_uu"],
-            ),
+            entries(jacobian),
+            entries(hessian),
             np.asarray(row_start, dtype=np.int64),
             np.asarray(columns, dtype=np.int64),
         )

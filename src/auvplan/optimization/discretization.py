@@ -18,7 +18,7 @@ the discrete stage cost is the RK4 quadrature of ``l`` along the same stages:
 (one substep; :mod:`auvplan.optimization.integration` composes several). All derivatives
 (``F_x``, ``F_u``, the costate-weighted Hessians ``Σ_i λ_i ∇²F^i`` and the cost derivatives)
 are exact: CasADi differentiates the RK4 expression graph itself. Batched evaluation over a
-horizon of ``N`` stages uses ``casadi.Function.map(N)`` (one call into CasADi's virtual
+horizon of ``N`` stages uses ``casadi.Function.map(N, "serial")`` (one call into CasADi's virtual
 machine, no Python loop per stage); the mapped functions are built once per ``N`` and kept.
 Every method takes and returns time-major arrays (layout: :mod:`auvplan.optimization._casadi`).
 """

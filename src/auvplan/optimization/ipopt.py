@@ -138,13 +138,15 @@ def solve_ipopt(
     states = ca.MX.sym("X", n_x, n_steps + 1)
     inputs = ca.MX.sym("U", n_u, n_steps)
     current, following = states[:, :n_steps], states[:, 1:]
-    defects = model.step_function.map(n_steps)(current, inputs, params) - following
-    running = ca.sum2(model.cost_function.map(n_steps)(current, inputs, params))
+    defects = model.step_function.map(n_steps, "serial")(current, inputs, params) - following
+    running = ca.sum2(model.cost_function.map(n_steps, "serial")(current, inputs, params))
     terminal = problem.terminal_cost(states[:, n_steps])
     barrier_term: ca.MX = ca.MX(0)
     inequalities: list[ca.MX] = []
     for constraint in problem.constraints:
-        slacks = [constraint.function.map(n_steps)(current, inputs, params) / constraint.scale]
+        slacks = [
+            constraint.function.map(n_steps, "serial")(current, inputs, params) / constraint.scale
+        ]
         final = np.flatnonzero(constraint.at_final_node).tolist()
         if final:  # the components free of u also hold at x_N (last input and parameters)
             at_end = constraint.function(

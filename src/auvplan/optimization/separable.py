@@ -235,9 +235,16 @@ class BlockDiscreteModel:
         return next_states, cost
 
     def first_order(
-        self, states: FloatArray, inputs: FloatArray, parameters: FloatArray
+        self,
+        states: FloatArray,
+        inputs: FloatArray,
+        parameters: FloatArray,
+        remember: bool = True,
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
-        """``(F_x, F_u, L, L_x, L_u)``; ``F_x``, ``F_u`` block-diagonal."""
+        """``(F_x, F_u, L, L_x, L_u)``; ``F_x``, ``F_u`` block-diagonal.
+
+        ``remember``: keep the kernels' forward sweeps for the Hessians at these points.
+        """
         states, inputs, parameters = self._checked(states, inputs, parameters)
         n_stages = states.shape[0]
         f_x = np.zeros((n_stages, self.n_x, self.n_x))
@@ -246,7 +253,7 @@ class BlockDiscreteModel:
         l_x, l_u = np.zeros((n_stages, self.n_x)), np.zeros((n_stages, self.n_u))
         for group in self.groups:
             points = self._points(group, states, inputs, parameters)
-            jac, total, grad = group.kernels.first_order(*points, self.h, self.n_substeps)
+            jac, total, grad = group.kernels.first_order(*points, self.h, self.n_substeps, remember)
             n_bx = group.kernels.n_x
             for i, block in enumerate(group.blocks):
                 rows = slice(i * n_stages, (i + 1) * n_stages)
@@ -260,8 +267,8 @@ class BlockDiscreteModel:
     def jacobians(
         self, states: FloatArray, inputs: FloatArray, parameters: FloatArray
     ) -> tuple[FloatArray, FloatArray]:
-        """``F_x (N, n_x, n_x)`` and ``F_u (N, n_x, n_u)``."""
-        f_x, f_u, _, _, _ = self.first_order(states, inputs, parameters)
+        """``F_x (N, n_x, n_x)`` and ``F_u (N, n_x, n_u)`` (the remembered sweeps are kept)."""
+        f_x, f_u, _, _, _ = self.first_order(states, inputs, parameters, remember=False)
         return f_x, f_u
 
     def _weighted_hessians(

@@ -355,7 +355,7 @@ def vessel_dynamics(states: FloatArray, inputs: FloatArray, model: VehicleModel)
     (3, 8)
     """
     n_t, _ = _as_grid(states, inputs, model)
-    mapped = model.dynamics.map(n_t)
+    mapped = model.dynamics.map(n_t, "serial")
     result = mapped(np.asarray(states, dtype=np.float64).T, np.asarray(inputs, dtype=np.float64).T)
     return np.asarray(result, dtype=np.float64).T.reshape(n_t, model.n_x)
 
@@ -385,7 +385,7 @@ def electrical_power(states: FloatArray, inputs: FloatArray, model: VehicleModel
     [40.0, 40.0]
     """
     n_t, _ = _as_grid(states, inputs, model)
-    mapped = model.power.map(n_t)
+    mapped = model.power.map(n_t, "serial")
     result = mapped(np.asarray(states, dtype=np.float64).T, np.asarray(inputs, dtype=np.float64).T)
     return np.asarray(result, dtype=np.float64).reshape(n_t)
 

@@ -61,7 +61,7 @@ def fastest_mode(model: VehicleModel) -> float:
     x = ca.SX.sym("x", model.n_x)
     c = ca.SX.sym("c", model.n_u)
     jacobian = ca.Function("f_x", [x, c], [ca.jacobian(model.dynamics(x, c), x)])
-    batched = jacobian.map(points.shape[0])
+    batched = jacobian.map(points.shape[0], "serial")
     matrices = np.asarray(batched(states.T, np.zeros((model.n_u, points.shape[0]))))
     stacked = matrices.T.reshape(points.shape[0], model.n_x, model.n_x).transpose(0, 2, 1)
     return float(np.max(np.abs(np.linalg.eigvals(stacked))))
