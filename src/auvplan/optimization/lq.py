@@ -113,8 +113,36 @@ def directional_derivative(linearization: Linearization, z: FloatArray, v: Float
     return float(np.sum(lin.a * z[:-1]) + np.sum(lin.b * v) + lin.m_x @ z[-1])
 
 
+def block_ranges(groups: tuple[IntArray, ...], n_x: int, n_u: int) -> tuple[IntArray, IntArray]:
+    """``(start, stop)`` rows of each group's states and inputs, shape ``(n_blocks, 2)`` each.
+
+    ``groups`` are index sets of ``z = (x, u)`` (:func:`convexify`); without groups, or when
+    a group's states or inputs are not one contiguous range, the whole ``x`` and ``u`` form
+    one block.
+    """
+    whole = np.array([[0, n_x]], dtype=np.int64), np.array([[0, n_u]], dtype=np.int64)
+    x_blocks: list[tuple[int, int]] = []
+    u_blocks: list[tuple[int, int]] = []
+    for group in groups:
+        states, inputs = group[group < n_x], group[group >= n_x] - n_x
+        for indices, ranges in ((states, x_blocks), (inputs, u_blocks)):
+            if indices.size == 0:
+                ranges.append((0, 0))
+                continue
+            start, stop = int(indices.min()), int(indices.max()) + 1
+            if stop - start != indices.size:  # not one contiguous range
+                return whole
+            ranges.append((start, stop))
+    if not groups:
+        return whole
+    return np.array(x_blocks, dtype=np.int64), np.array(u_blocks, dtype=np.int64)
+
+
 def _try_direction(
-    linearization: Linearization, weights: StageWeights, direction: DirectionType
+    linearization: Linearization,
+    weights: StageWeights,
+    direction: DirectionType,
+    blocks: tuple[IntArray, IntArray],
 ) -> LqDirection | None:
     lin = linearization
     feedback, feedforward, failed = _kernels.lq_backward(
@@ -127,6 +155,7 @@ def _try_direction(
         lin.b,
         np.ascontiguousarray(weights.P_N),
         np.ascontiguousarray(lin.m_x),
+        *blocks,
     )
     if failed >= 0:
         logger.debug("%s LQ model not positive definite at stage %d", direction.value, failed)
@@ -171,7 +200,8 @@ def solve_lq_direction(
     eigenvalue_floor : float
         Eigenvalue clip of the convexified model.
     groups : tuple of ndarray
-        Independent subsystems' indices of ``(x, u)`` (see :func:`convexify`).
+        Independent subsystems' indices of ``(x, u)`` (see :func:`convexify`); ``A_k`` and
+        ``B_k`` are block-diagonal in them (:func:`block_ranges`), which the Riccati sweep uses.
 
     Returns
     -------
@@ -183,17 +213,21 @@ def solve_lq_direction(
     SolverError
         If no level produced a descent direction.
     """
-    direction = _try_direction(linearization, weights, DirectionType.NEWTON)
+    blocks = block_ranges(groups, linearization.A.shape[1], linearization.B.shape[2])
+    direction = _try_direction(linearization, weights, DirectionType.NEWTON, blocks)
     if direction is not None:
         return direction
     base = quasi_weights() if quasi_weights is not None else weights
     direction = _try_direction(
-        linearization, convexify(base, eigenvalue_floor, groups), DirectionType.CONVEXIFIED
+        linearization,
+        convexify(base, eigenvalue_floor, groups),
+        DirectionType.CONVEXIFIED,
+        blocks,
     )
     if direction is not None:
         return direction
     if steepest_weights is not None:
-        direction = _try_direction(linearization, steepest_weights, DirectionType.STEEPEST)
+        direction = _try_direction(linearization, steepest_weights, DirectionType.STEEPEST, blocks)
         if direction is not None:
             return direction
     raise SolverError("no descent direction: Newton, convexified and steepest models all failed")

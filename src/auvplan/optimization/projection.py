@@ -11,12 +11,14 @@ from typing import Literal
 import numpy as np
 import scipy.linalg
 
-from auvplan._typing import FloatArray
+from auvplan._typing import FloatArray, IntArray
 from auvplan.errors import SolverError
 from auvplan.optimization import _kernels
+from auvplan.optimization.lq import block_ranges
 from auvplan.optimization.model import ProntoModel
 from auvplan.optimization.options import ProntoOptions, TerminalRegulator, named_choice
 from auvplan.optimization.problem import Trajectory
+from auvplan.optimization.separable import coordinate_groups
 
 __all__ = ["design_regulator", "project", "project_guess", "regulator_gains"]
 
@@ -28,8 +30,14 @@ def design_regulator(
     R_r: FloatArray,
     *,
     terminal: TerminalRegulator | Literal["dare", "weight"] = TerminalRegulator.DARE,
+    blocks: tuple[IntArray, IntArray] | None = None,
 ) -> FloatArray:
     """Time-varying discrete LQR along a trajectory (the projection regulator, §6.1).
+
+    With ``blocks`` (state and input ``(start, stop)`` ranges of independent subsystems,
+    :func:`~auvplan.optimization.lq.block_ranges`) and weights without entries between them,
+    the Riccati matrices stay block-diagonal: each subsystem's regulator is designed on its
+    own, the same gains at a fraction of the cost (zero between subsystems).
 
     Parameters
     ----------
@@ -62,14 +70,49 @@ def design_regulator(
                 p_final = 0.5 * (candidate + candidate.T)
         except (np.linalg.LinAlgError, ValueError):
             p_final = Q_r
-    gains, ok = _kernels.regulator_riccati(
-        np.ascontiguousarray(A), np.ascontiguousarray(B), Q_r, R_r, np.ascontiguousarray(p_final)
-    )
+    parts = _independent(blocks, Q_r, R_r, A.shape[1], B.shape[2])
+    gains = np.zeros((A.shape[0], B.shape[2], A.shape[1]))
+    ok = True
+    for states, inputs in parts:
+        block, block_ok = _kernels.regulator_riccati(
+            np.ascontiguousarray(A[:, states, states]),
+            np.ascontiguousarray(B[:, states, inputs]),
+            np.ascontiguousarray(Q_r[states, states]),
+            np.ascontiguousarray(R_r[inputs, inputs]),
+            np.ascontiguousarray(p_final[states, states]),
+        )
+        gains[:, inputs, states] = block
+        ok = ok and block_ok
     if not ok or not np.all(np.isfinite(gains)):
         raise SolverError(
             "the projection-regulator Riccati recursion broke down (non-finite A, B?)"
         )
     return gains
+
+
+def _independent(
+    blocks: tuple[IntArray, IntArray] | None,
+    Q_r: FloatArray,
+    R_r: FloatArray,
+    n_x: int,
+    n_u: int,
+) -> list[tuple[slice, slice]]:
+    """State and input slices of the subsystems the regulator may be designed on separately.
+
+    One (everything) unless ``blocks`` has several and ``Q_r``, ``R_r`` vanish between them.
+    """
+    whole = [(slice(0, n_x), slice(0, n_u))]
+    if blocks is None or len(blocks[0]) < 2:
+        return whole
+    parts = [
+        (slice(int(x0), int(x1)), slice(int(u0), int(u1)))
+        for (x0, x1), (u0, u1) in zip(blocks[0], blocks[1], strict=True)
+    ]
+    coupled_q, coupled_r = Q_r != 0.0, R_r != 0.0
+    for states, inputs in parts:
+        coupled_q[states, states] = False
+        coupled_r[inputs, inputs] = False
+    return whole if coupled_q.any() or coupled_r.any() else parts
 
 
 def regulator_gains(
@@ -98,7 +141,14 @@ def regulator_gains(
                 design, trajectory.inputs[stages], problem.parameters[stages]
             )
     return design_regulator(
-        A, B, problem.state_weight, problem.input_weight, terminal=options.terminal_regulator
+        A,
+        B,
+        problem.state_weight,
+        problem.input_weight,
+        terminal=options.terminal_regulator,
+        blocks=block_ranges(
+            coordinate_groups(problem.blocks, problem.n_states), problem.n_states, problem.n_inputs
+        ),
     )
 
 

@@ -1,0 +1,67 @@
+"""Riccati sweeps that use the block-diagonal ``A_k``, ``B_k`` of a fleet give the dense results."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from auvplan.optimization import _kernels, design_regulator
+from auvplan.optimization.lq import block_ranges
+
+SIZES = ((3, 1), (5, 2), (4, 2))  # (states, inputs) of three subsystems
+N_X, N_U, N = sum(s for s, _ in SIZES), sum(m for _, m in SIZES), 40
+
+
+def _groups() -> tuple[np.ndarray, ...]:
+    groups, x0, u0 = [], 0, 0
+    for n_s, n_i in SIZES:
+        groups.append(np.r_[x0 : x0 + n_s, N_X + u0 : N_X + u0 + n_i])
+        x0, u0 = x0 + n_s, u0 + n_i
+    return tuple(groups)
+
+
+def _block_diagonal_dynamics(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    a, b = np.zeros((N, N_X, N_X)), np.zeros((N, N_X, N_U))
+    x0 = u0 = 0
+    for n_s, n_i in SIZES:
+        a[:, x0 : x0 + n_s, x0 : x0 + n_s] = np.eye(n_s) + 0.1 * rng.normal(size=(N, n_s, n_s))
+        b[:, x0 : x0 + n_s, u0 : u0 + n_i] = 0.3 * rng.normal(size=(N, n_s, n_i))
+        x0, u0 = x0 + n_s, u0 + n_i
+    return a, b
+
+
+def test_block_ranges_of_contiguous_and_scattered_groups() -> None:
+    x_blocks, u_blocks = block_ranges(_groups(), N_X, N_U)
+    assert x_blocks.tolist() == [[0, 3], [3, 8], [8, 12]]
+    assert u_blocks.tolist() == [[0, 1], [1, 3], [3, 5]]
+    scattered = (np.r_[0, 2, N_X], np.r_[1, 3:N_X, N_X + 1 : N_X + N_U])
+    assert [r.tolist() for r in block_ranges(scattered, N_X, N_U)] == [[[0, N_X]], [[0, N_U]]]
+    assert [r.tolist() for r in block_ranges((), N_X, N_U)] == [[[0, N_X]], [[0, N_U]]]
+
+
+def test_lq_sweep_with_blocks_equals_the_dense_sweep(rng: np.random.Generator) -> None:
+    a, b = _block_diagonal_dynamics(rng)
+    z = rng.normal(size=(N, N_X + N_U, N_X + N_U))
+    w = z @ np.swapaxes(z, 1, 2) + np.eye(N_X + N_U)  # coupled (dense) PD stage weights
+    q, s, r = w[:, :N_X, :N_X].copy(), w[:, :N_X, N_X:].copy(), w[:, N_X:, N_X:].copy()
+    l_x, l_u = rng.normal(size=(N, N_X)), rng.normal(size=(N, N_U))
+    p_final, m_x = np.eye(N_X) + 0.1 * np.ones((N_X, N_X)), rng.normal(size=N_X)
+    args = (a, b, q, s, r, l_x, l_u, p_final, m_x)
+    dense = _kernels.lq_backward(*args, np.array([[0, N_X]]), np.array([[0, N_U]]))
+    blocked = _kernels.lq_backward(*args, *block_ranges(_groups(), N_X, N_U))
+    assert dense[2] == blocked[2] == -1
+    np.testing.assert_allclose(blocked[0], dense[0], rtol=1e-11, atol=1e-12)
+    np.testing.assert_allclose(blocked[1], dense[1], rtol=1e-11, atol=1e-12)
+
+
+@pytest.mark.parametrize("coupled", [False, True])
+def test_regulator_per_subsystem_equals_the_whole(rng: np.random.Generator, coupled: bool) -> None:
+    a, b = _block_diagonal_dynamics(rng)
+    q_r, r_r = np.diag(rng.uniform(0.5, 2.0, N_X)), np.diag(rng.uniform(0.5, 2.0, N_U))
+    if coupled:  # a weight between subsystems: designed as one system
+        q_r[0, 5] = q_r[5, 0] = 0.2
+    whole = design_regulator(a, b, q_r, r_r)
+    parts = design_regulator(a, b, q_r, r_r, blocks=block_ranges(_groups(), N_X, N_U))
+    np.testing.assert_allclose(parts, whole, rtol=1e-10, atol=1e-12)
+    if not coupled:
+        assert np.all(parts[:, 0, 3:] == 0.0)  # subsystem 0's input ignores the others
