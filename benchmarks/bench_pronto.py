@@ -47,7 +47,9 @@ def run(case: str, solver: str, cache: Path, max_iter: int | None = None) -> dic
     env = {**os.environ, "AUVPLAN_CACHE_DIR": str(cache)}
     done = subprocess.run(command, capture_output=True, text=True, env=env, check=False)
     if done.returncode != 0:
-        return {"case": case, "solver": solver, "error": done.stderr.strip().splitlines()[-1]}
+        lines = done.stderr.strip().splitlines()
+        reason = lines[-1] if lines else f"exit status {done.returncode}"  # e.g. killed
+        return {"case": case, "solver": solver, "error": reason}
     record: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])
     return record
 
