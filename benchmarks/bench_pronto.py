@@ -11,7 +11,8 @@ two-MEDUSA crossing (600 s, ``dt_s`` 0.5, propeller order 3) optimised energy-on
 is a separate process (its own peak memory). ``cold``: an empty kernel cache, so the time
 includes compiling the vehicle's kernels; ``warm``: the cache filled by the cold run.
 PRONTO times include building the model; IPOPT times the solve from PRONTO's projected
-initial trajectory with the path constraints hard (MUMPS, exact Hessian).
+initial trajectory with the path constraints hard (MUMPS, exact Hessian), on an MX NLP and,
+for the crossing only, an SX NLP (which needs ~15 GB); ratios are against the faster of them.
 
 Tables: (1) auvplan vs CasADi VM vs IPOPT: wall time, iterations, final cost, peak memory;
 (2) the issue-12 targets (fleets of 4 and 8 for an hour, ``auvplan demo`` end to end);
@@ -96,11 +97,13 @@ def comparison(cases: tuple[str, ...]) -> str:
                 "auvplan, cold cache": run(case, "kernels", cold_cache),
                 "auvplan, warm cache": run(case, "kernels", cold_cache),
                 "PRONTO on the CasADi VM": run(case, "casadi", cold_cache),
-                "CasADi + IPOPT": run(case, "ipopt", cold_cache),
                 "CasADi + IPOPT (MX NLP)": run(case, "ipopt-mx", cold_cache),
             }
-        ipopt = records["CasADi + IPOPT"]
-        reference = ipopt.get("wall_s")
+            if case == "demo":  # the SX NLP needs ~15 GB already here: crossing only
+                records["CasADi + IPOPT (SX NLP)"] = run(case, "ipopt", cold_cache)
+        solved = [r for label, r in records.items() if "IPOPT" in label and "error" not in r]
+        ipopt = min(solved, key=lambda r: r["wall_s"], default=records["CasADi + IPOPT (MX NLP)"])
+        reference = ipopt.get("wall_s")  # the faster IPOPT set-up
         for label, record in records.items():
             lines.append(_row(record, label, reference))
         warm = records["auvplan, warm cache"]
