@@ -232,7 +232,8 @@ def _times_block_diagonal(
     """``matrix @ diagonal`` for a block-diagonal ``diagonal``.
 
     Block ``b`` is ``diagonal[rows[b, 0]:rows[b, 1], columns[b, 0]:columns[b, 1]]``; entries
-    outside the blocks are taken as zero.
+    outside the blocks are taken as zero. ``diagonalᵀ @ matrix`` is the transpose of
+    ``matrixᵀ @ diagonal``.
     """
     out = np.zeros((matrix.shape[0], diagonal.shape[1]))
     for b in range(rows.shape[0]):
@@ -242,22 +243,6 @@ def _times_block_diagonal(
                 if d != 0.0:
                     for i in range(matrix.shape[0]):
                         out[i, j] += matrix[i, k] * d
-    return out
-
-
-@numba.njit(cache=True)
-def _block_diagonal_t_times(
-    diagonal: FloatArray, matrix: FloatArray, rows: IntArray, columns: IntArray
-) -> FloatArray:
-    """``diagonalᵀ @ matrix`` for a block-diagonal ``diagonal`` (blocks as above)."""
-    out = np.zeros((diagonal.shape[1], matrix.shape[1]))
-    for b in range(rows.shape[0]):
-        for i in range(columns[b, 0], columns[b, 1]):
-            for k in range(rows[b, 0], rows[b, 1]):
-                d = diagonal[k, i]
-                if d != 0.0:
-                    for j in range(matrix.shape[1]):
-                        out[i, j] += d * matrix[k, j]
     return out
 
 
@@ -295,7 +280,7 @@ def lq_backward(
         b = b_mat[k]
         pa = _times_block_diagonal(p, a, x_blocks, x_blocks)
         pb = _times_block_diagonal(p, b, x_blocks, u_blocks)
-        m = r_mat[k] + _block_diagonal_t_times(b, pb, x_blocks, u_blocks)
+        m = r_mat[k] + _times_block_diagonal(pb.T.copy(), b, x_blocks, u_blocks).T
         lower, is_pd = _cholesky(0.5 * (m + m.T))
         if not is_pd:
             return feedback, feedforward, k
@@ -308,7 +293,8 @@ def lq_backward(
         gain = sol[:, :n_x].copy()
         feedback[k] = gain
         feedforward[k] = -sol[:, n_x]
-        p_new = q_mat[k] + _block_diagonal_t_times(a, pa, x_blocks, x_blocks) - g_mat.T @ gain
+        a_pa = _times_block_diagonal(pa.T.copy(), a, x_blocks, x_blocks).T  # Aᵀ P A
+        p_new = q_mat[k] + a_pa - g_mat.T @ gain
         r = l_x[k] + a.T @ r - gain.T @ g_vec
         p = 0.5 * (p_new + p_new.T)
     return feedback, feedforward, -1
