@@ -10,6 +10,9 @@ import numpy as np
 import pytest
 
 matplotlib.use("Agg")
+# the CLI's second process (auvplan.api.companion) is tested on its own: the many in-process
+# `auvplan plan` runs of the suite use one process each, as `--jobs 1`
+os.environ.setdefault("AUVPLAN_JOBS", "1")
 
 SHARED_DATA = Path(
     os.environ.get("AUVPLAN_SHARED_DATA", Path(__file__).parents[1] / ".." / "shared" / "data")

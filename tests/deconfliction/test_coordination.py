@@ -184,6 +184,23 @@ def test_single_vehicle_is_its_nominal_schedule() -> None:
         assert result.delays[0] == pytest.approx(0.0)
 
 
+@pytest.mark.parametrize(
+    ("method", "status"),
+    [("auto", "OPTIMAL"), ("astar", "OPTIMAL"), ("prioritized", "FEASIBLE")],
+)
+def test_single_vehicle_needs_no_search(method: str, status: str) -> None:
+    path = np.array([[0.0, 0.0], [30.0, 10.0], [60.0, 0.0]])
+    problem = CoordinationProblem((path,), 2.0, np.array([0.7]), 0.5)
+    result = deconflict(problem, method=method)
+    assert result.n_expanded == 0
+    assert result.status.name == status
+    assert str(result.method) == ("prioritized" if method == "prioritized" else "astar")
+    # one grid step per time step: at the nominal speed, arriving on the first step after it
+    assert np.all(np.diff(result.progress[0]) <= 0.7 * 0.5 + 1e-9)
+    nominal = float(problem.nominal_arrival_times[0])
+    assert nominal <= result.arrival_times[0] < nominal + problem.time_step
+
+
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(seed=st.integers(0, 2**32 - 1), method=st.sampled_from(["astar", "prioritized"]))
 def test_random_path_sets_are_safe_or_infeasible(seed: int, method: str) -> None:

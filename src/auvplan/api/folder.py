@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from auvplan._figures import DEFAULT_DPI
 from auvplan.export import DEFAULT_TOLERANCE_M, write_exports
@@ -24,6 +25,9 @@ from auvplan.mission.outputs import write_mission_files
 from auvplan.mission.pipeline import MissionResult
 from auvplan.viz.html import render_report
 from auvplan.viz.report import RenderedFigure, render_mission_figures
+
+if TYPE_CHECKING:
+    from auvplan.api.companion import Companion
 
 #: The report's file name in every output folder.
 REPORT_FILE = "report.html"
@@ -39,6 +43,7 @@ def write_output_folder(
     dpi: int = DEFAULT_DPI,
     exports: Sequence[str] = (),
     tolerance: float = DEFAULT_TOLERANCE_M,
+    companion: Companion | None = None,
 ) -> list[Path]:
     """Write the output folder of ``result`` into ``target`` (module notes).
 
@@ -61,6 +66,8 @@ def write_output_folder(
         ignored without an optimised plan.
     tolerance : float
         Waypoint tolerance of the exports [m].
+    companion : Companion, optional
+        Draws half the figures in a second process (:mod:`auvplan.api.companion`).
 
     Returns
     -------
@@ -69,7 +76,8 @@ def write_output_folder(
     """
     rendered: dict[str, RenderedFigure] = {}
     if figures:  # rendered before anything is written: a bad format or dpi writes nothing
-        rendered = render_mission_figures(result, figure_format=figure_format, dpi=dpi)
+        draw = render_mission_figures if companion is None else companion.render_figures
+        rendered = draw(result, figure_format=figure_format, dpi=dpi)
     with staged_output_dir(target) as staging:
         written = write_mission_files(result, staging, warnings=warnings)
         if exports and result.plan is not None:

@@ -35,7 +35,7 @@ from auvplan.io.trajectories_file import read_trajectories_netcdf
 from auvplan.mission.config import MissionConfig, load_mission, parse_mission
 from auvplan.mission.outputs import plan_dataset
 from auvplan.mission.pipeline import MissionResult, Stage, run_mission
-from auvplan.mission.progress import no_progress
+from auvplan.mission.progress import ProgressReporter, no_progress
 from auvplan.mission.summary import mission_summary
 from auvplan.terrain import BathymetryGrid
 
@@ -44,6 +44,7 @@ if TYPE_CHECKING:
     import xarray as xr
     from matplotlib.figure import Figure
 
+    from auvplan.api.companion import Companion
     from auvplan.api.progress import ConsoleProgress
 
 #: What :func:`plan` accepts as a mission: a TOML file, a validated mission, or its document.
@@ -211,6 +212,7 @@ class MissionPlan:
         dpi: int = DEFAULT_DPI,
         exports: Sequence[str] = (),
         tolerance_m: float = DEFAULT_TOLERANCE_M,
+        companion: Companion | None = None,
     ) -> list[Path]:
         """Write the output folder of ``auvplan plan`` into ``directory``; returns the files.
 
@@ -219,7 +221,8 @@ class MissionPlan:
         exports (``moos``, ``qgc``, ``imc``, ``gpx``, ``kml``, ``geojson``) into
         ``directory/export`` and ``report.html``; all-or-nothing
         (:func:`auvplan.api.folder.write_output_folder`). A plan loaded from a folder is
-        copied as it is (the options apply to a plan made in this session).
+        copied as it is (the options apply to a plan made in this session). A ``companion``
+        (:mod:`auvplan.api.companion`) draws half the figures.
         """
         target = Path(directory)
         if self._result is None:
@@ -235,6 +238,7 @@ class MissionPlan:
             self._result, target, warnings=self.warnings, figures=figures,
             figure_format=figure_format, dpi=dpi,
             exports=parse_formats(",".join(exports)) if exports else (), tolerance=tolerance_m,
+            companion=companion,
         )  # fmt: skip
 
     def _repr_html_(self) -> str:
@@ -256,6 +260,7 @@ def plan(
     compare_energy_only: bool = False,
     compare_no_current: bool = False,
     progress: bool = True,
+    companion: Companion | None = None,
 ) -> MissionPlan:
     """Plan a mission: maps and A* paths, deconfliction, PRONTO (SPEC §1-§5).
 
@@ -274,6 +279,9 @@ def plan(
         and report the saving (``summary["current_comparison"]``).
     progress : bool
         Show progress (:class:`auvplan.api.progress.ConsoleProgress`).
+    companion : Companion, optional
+        A second process (:mod:`auvplan.api.companion`) that compiles the optimiser's kernels
+        of a first run while this one searches the paths.
 
     Returns
     -------
@@ -293,13 +301,17 @@ def plan(
         choices = ", ".join(repr(s.value) for s in Stage)
         raise InputError(f"stage must be one of {choices}, got {stage!r}") from None
     with _logged_warnings() as warnings, _reporter(config, progress) as reporter:
+        stages: ProgressReporter = no_progress if reporter is None else reporter
+        if companion is not None and last_stage is Stage.FULL:
+            companion.warm_up(config)
+            stages = companion.waiting(stages)
         result = run_mission(
             config,
             stage=last_stage,
             compare_energy_only=compare_energy_only,
             compare_no_current=compare_no_current,
             callback=None if reporter is None else reporter.iteration,
-            progress=no_progress if reporter is None else reporter,
+            progress=stages,
         )
     return MissionPlan.from_result(result, warnings=warnings)
 

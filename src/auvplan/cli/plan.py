@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+from contextlib import nullcontext
 from pathlib import Path
 from typing import Any
 
@@ -48,6 +50,14 @@ def _add_common(parser: argparse.ArgumentParser, *, default_output: Path | None)
     )
     parser.add_argument("--stage", choices=STAGES, default="full", help="stop after this stage")
     parser.add_argument(
+        "--jobs",
+        type=int,
+        default=_default_jobs(),
+        help="processes: 2 (the default on 2+ cores) compiles the optimiser's kernels on a "
+        "first run and draws half the figures in a second process; 1 uses this one only "
+        "(default also from $AUVPLAN_JOBS)",
+    )
+    parser.add_argument(
         "--compare-energy-only",
         action="store_true",
         help="also optimise without the terrain term (the energy-only reference)",
@@ -62,6 +72,15 @@ def _add_common(parser: argparse.ArgumentParser, *, default_output: Path | None)
         "--no-figures", action="store_true", help="write no figures (report.html has tables only)"
     )
     add_figure_options(parser)
+
+
+def _default_jobs() -> int:
+    """``$AUVPLAN_JOBS`` when set (checked by :func:`_run`), else 2 with 2+ cores, else 1."""
+    given = os.environ.get("AUVPLAN_JOBS")
+    if given:
+        return int(given) if given.isdigit() else -1
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    return 2 if (cores or 1) >= 2 else 1
 
 
 def run_plan(args: argparse.Namespace) -> int:
@@ -98,24 +117,33 @@ def _export_formats(config: Any, args: argparse.Namespace) -> tuple[str, ...]:
 
 def _run(config: Any, args: argparse.Namespace) -> int:
     from auvplan.api import plan
+    from auvplan.api.companion import Companion
+    from auvplan.errors import InputError
     from auvplan.export import DEFAULT_TOLERANCE_M
 
     formats = _export_formats(config, args)
-    mission_plan = plan(
-        config,
-        stage=args.stage,
-        compare_energy_only=args.compare_energy_only,
-        compare_no_current=args.compare_no_current,
-        progress=not args.quiet,
-    )
-    written = mission_plan.save(
-        args.output,
-        figures=not args.no_figures,
-        figure_format=args.figure_format,
-        dpi=args.dpi,
-        exports=formats,
-        tolerance_m=getattr(args, "tolerance_m", DEFAULT_TOLERANCE_M),  # demo: no --export
-    )
+    if args.jobs not in (1, 2):
+        raise InputError(f"--jobs (or $AUVPLAN_JOBS) must be 1 or 2, got {args.jobs}")
+    with Companion() if args.jobs == 2 else nullcontext() as companion:
+        if companion is not None and not args.no_figures:
+            companion.start()  # its imports overlap the planning
+        mission_plan = plan(
+            config,
+            stage=args.stage,
+            compare_energy_only=args.compare_energy_only,
+            compare_no_current=args.compare_no_current,
+            progress=not args.quiet,
+            companion=companion,
+        )
+        written = mission_plan.save(
+            args.output,
+            figures=not args.no_figures,
+            figure_format=args.figure_format,
+            dpi=args.dpi,
+            exports=formats,
+            tolerance_m=getattr(args, "tolerance_m", DEFAULT_TOLERANCE_M),  # demo: no --export
+            companion=companion,
+        )
     result = mission_plan.result
     if not args.quiet:
         _print_report(result, written)

@@ -182,6 +182,8 @@ def deconflict(
     if method is DeconflictionMethod.PRIORITIZED and weight is not None:
         raise InputError(f"weight applies to method='astar' only, got {weight}")
     check_endpoints(problem)
+    if n == 1:  # no pair to keep apart: the nominal time law is optimal
+        return _result(problem, _nominal_schedule(problem, method), "")
     search = _search_problem(problem, coarsening)
     fallback = ""
     if method is DeconflictionMethod.AUTO and n > AUTO_ASTAR_MAX_VEHICLES:
@@ -345,6 +347,16 @@ def _astar_error(error: _AstarGaveUp, problem: CoordinationProblem, coarsening: 
 def _schedule_from_arrival(arrival: IntArray, horizon: int) -> IntArray:
     """Grid index at each time step ``0 … horizon`` from per-index arrival steps."""
     return np.searchsorted(arrival, np.arange(horizon + 1), side="right").astype(np.int64) - 1
+
+
+def _nominal_schedule(problem: CoordinationProblem, method: DeconflictionMethod) -> _Schedule:
+    """The one vehicle of ``problem`` at its cruise speed: a grid index per time step."""
+    grid = np.arange(int(problem.n_steps[0]) + 1, dtype=np.int64)[None, :]
+    if method is DeconflictionMethod.PRIORITIZED:
+        solved, status = DeconflictionMethod.PRIORITIZED, CoordinationStatus.FEASIBLE
+    else:
+        solved, status = DeconflictionMethod.ASTAR, CoordinationStatus.OPTIMAL
+    return _Schedule(grid, problem, 1, solved, status, "nominal time law", None, 0)
 
 
 def _solve_prioritized(problem: CoordinationProblem, coarsening: int) -> _Schedule:

@@ -3,15 +3,17 @@
 from __future__ import annotations
 
 import io
+from collections.abc import Callable, Collection
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Final
+from typing import Any, Final
 
 import numpy as np
 from matplotlib.figure import Figure
 
 from auvplan._figures import DEFAULT_DPI, FIGURE_FORMATS
 from auvplan.errors import InputError
+from auvplan.mission.evaluation import OptimizedPlan
 from auvplan.mission.pipeline import MissionResult
 from auvplan.planning import CircleObstacle, PolygonObstacle
 from auvplan.vehicle import positions
@@ -81,55 +83,64 @@ def render_figure(
 
 
 def mission_figures(result: MissionResult) -> dict[str, Figure]:
-    """The figures of a run, by file stem.
+    """The figures of a run, by file stem (:func:`figure_builders`)."""
+    return {stem: build() for stem, build in figure_builders(result).items()}
+
+
+def figure_builders(result: MissionResult) -> dict[str, Callable[[], Figure]]:
+    """What draws each figure of a run, by file stem, in the order of the report.
 
     ``maps`` (paper Fig. 5), ``paths`` (Fig. 6 over the bathymetry), ``paths_cost`` (over the
     cost map), and by stage ``coordination``, ``time_series`` (speeds, propellers, power),
     ``separation`` and, with the comparison, ``paths_energy_only``.
     """
     preplan = result.preplan
-    config = result.config
     circles = np.array(
         [(o.north, o.east, o.radius) for o in preplan.obstacles if isinstance(o, CircleObstacle)]
     ).reshape(-1, 3)
     polygons = [o.vertices for o in preplan.obstacles if isinstance(o, PolygonObstacle)]
     planned = [route.points for route in preplan.routes]
     stage2 = result.deconfliction
-    optimized = None if result.plan is None else _tracks(result, result.plan.states)
-    radius = config.fleet.safety_radius
-    figures: dict[str, Figure] = {"maps": plot_terrain_maps(preplan.maps)}
-    figures["paths"] = add_current_arrows(plot_mission_paths(
-        preplan.bathymetry, preplan.names, planned, optimized, safety_radius=radius,
-        circles=circles, polygons=polygons,
-    ), preplan.bathymetry, preplan.current)  # fmt: skip
-    cost_on_grid = _cost_on_bathymetry_grid(result)
-    figures["paths_cost"] = plot_mission_paths(
-        preplan.bathymetry, preplan.names, planned, optimized, safety_radius=radius,
-        circles=circles, polygons=polygons, background=cost_on_grid,
-        background_label="shifted cost ω + w·M_C", cmap="magma",
-        title="Pre-planned paths over the cost map",
-    )  # fmt: skip
-    if result.energy_only is not None:
-        figures["paths_energy_only"] = plot_mission_paths(
+    plan = result.plan
+    radius = result.config.fleet.safety_radius
+
+    def paths(tracks: OptimizedPlan | None, **options: Any) -> Figure:
+        return plot_mission_paths(
             preplan.bathymetry, preplan.names, planned,
-            _tracks(result, result.energy_only.states), safety_radius=radius,
-            circles=circles, polygons=polygons,
-            title="Energy-only optimum (terrain weight 0) against the pre-planned paths",
+            None if tracks is None else _tracks(result, tracks.states), safety_radius=radius,
+            circles=circles, polygons=polygons, **options,
         )  # fmt: skip
+
+    builders: dict[str, Callable[[], Figure]] = {
+        "maps": lambda: plot_terrain_maps(preplan.maps),
+        "paths": lambda: add_current_arrows(paths(plan), preplan.bathymetry, preplan.current),
+        "paths_cost": lambda: paths(
+            plan,
+            background=_cost_on_bathymetry_grid(result),
+            background_label="shifted cost ω + w·M_C",
+            cmap="magma",
+            title="Pre-planned paths over the cost map",
+        ),
+    }
+    energy_only = result.energy_only
+    if energy_only is not None:
+        builders["paths_energy_only"] = lambda: paths(
+            energy_only,
+            title="Energy-only optimum (terrain weight 0) against the pre-planned paths",
+        )
     if stage2 is not None and len(preplan.names) >= 2:
-        figures["coordination"] = plot_coordination_space(
+        builders["coordination"] = lambda: plot_coordination_space(
             stage2.problem, stage2.coordination, pair=(0, 1)
         )
-    if result.plan is not None and stage2 is not None:
-        figures["time_series"] = plot_time_series(
-            stage2.time, preplan.names, result.plan.states, result.plan.power,
-            models=stage2.layout.models,
-        )  # fmt: skip
-        if result.plan.fine_distances:
-            figures["separation"] = plot_separation(
-                result.plan.fine_time, result.plan.fine_distances, 2 * radius
+    if plan is not None and stage2 is not None:
+        builders["time_series"] = lambda: plot_time_series(
+            stage2.time, preplan.names, plan.states, plan.power, models=stage2.layout.models
+        )
+        if plan.fine_distances:
+            builders["separation"] = lambda: plot_separation(
+                plan.fine_time, plan.fine_distances, 2 * radius
             )
-    return figures
+    return builders
 
 
 def _tracks(result: MissionResult, states: np.ndarray) -> list[np.ndarray]:
@@ -151,12 +162,23 @@ def _cost_on_bathymetry_grid(result: MissionResult) -> np.ndarray:
 
 
 def render_mission_figures(
-    result: MissionResult, *, figure_format: str = "png", dpi: int = DEFAULT_DPI
+    result: MissionResult,
+    *,
+    figure_format: str = "png",
+    dpi: int = DEFAULT_DPI,
+    stems: Collection[str] | None = None,
 ) -> dict[str, RenderedFigure]:
-    """:func:`mission_figures` rendered by :func:`render_figure`, by file stem."""
+    """The figures of :func:`figure_builders` (those of ``stems``, default all), rendered.
+
+    Raises
+    ------
+    InputError
+        As :func:`render_figure`.
+    """
     return {
-        stem: render_figure(figure, figure_format=figure_format, dpi=dpi)
-        for stem, figure in mission_figures(result).items()
+        stem: render_figure(build(), figure_format=figure_format, dpi=dpi)
+        for stem, build in figure_builders(result).items()
+        if stems is None or stem in stems
     }
 
 

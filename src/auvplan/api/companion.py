@@ -1,0 +1,226 @@
+"""A second process beside a mission run: first-run kernel compilation, and half the figures.
+
+Planning a mission runs on one core; on the two-core laptops our users plan on, the other
+core idles. A :class:`Companion` is a worker process on it (spawned, not forked: it shares
+nothing with the mission's process but the disk caches) that
+
+* on the first run with a mission's vehicle types and solver settings
+  (:meth:`Companion.warm_up`), runs :func:`auvplan.mission.warmup.warm_up`: it compiles the
+  optimiser's kernels (about 30 s) while the mission's process compiles and runs its path
+  searches; stage 3 waits for it (:meth:`Companion.waiting`) and then reads the kernels from
+  numba's disk cache;
+* renders about half the figures of the output folder (:meth:`Companion.render_figures`)
+  while the mission's process renders the rest.
+
+A first run is recognised by a marker file in the kernel cache (:func:`warm_marker`), named
+by a hash of the small warm-up missions and of the installed sources, written once a
+warm-up succeeded. A warm-up that fails (e.g. an unusual vehicle file) is logged and
+ignored: the mission compiles its kernels itself, as without a companion. The ``auvplan``
+command line uses a companion; a script may too, from its ``if __name__ == "__main__":``
+block (spawning re-imports the main module)::
+
+    with Companion() as companion:
+        mission_plan = auvplan.plan(config, companion=companion)
+        mission_plan.save("out", companion=companion)
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib
+import io
+import logging
+import multiprocessing
+import time
+import warnings
+from collections.abc import Callable, Collection, Iterator
+from contextlib import AbstractContextManager, contextmanager
+from multiprocessing.pool import AsyncResult, Pool
+from pathlib import Path
+from types import TracebackType
+from typing import TYPE_CHECKING, Any, Final, Self
+
+import numba
+
+import auvplan
+from auvplan.mission.config import MissionConfig
+from auvplan.mission.progress import ProgressReporter
+from auvplan.optimization._kernel_cache import cache_root
+
+if TYPE_CHECKING:
+    from auvplan.mission.pipeline import MissionResult
+    from auvplan.viz.report import RenderedFigure
+
+logger = logging.getLogger(__name__)
+
+#: The stage that needs the warm-up's kernels (a name of the pipeline's progress).
+NEEDS_KERNELS = "optimize"
+#: The figures that the worker draws: about half of the drawing time of a run (the maps,
+#: coordination and separation figures take about as long as these).
+WORKER_FIGURES: Final = frozenset({"paths", "paths_cost", "paths_energy_only", "time_series"})
+
+
+def warm_marker(config: MissionConfig) -> Path:
+    """The marker of a finished warm-up for ``config`` (module notes).
+
+    The name hashes the small missions of :func:`~auvplan.mission.warmup.warm_up_missions`,
+    the numba version and the size and time of every source file of the installed package,
+    so that a new version or an edited checkout warms up again.
+    """
+    from auvplan.mission.warmup import warm_up_missions
+
+    digest = hashlib.sha256(numba.__version__.encode())
+    for small in warm_up_missions(config):
+        digest.update(small.model_dump_json(exclude={"mission"}).encode())  # not the clock
+    package = Path(auvplan.__file__).parent
+    for source in sorted(package.rglob("*.py")):
+        stat = source.stat()
+        digest.update(f"{source.relative_to(package)} {stat.st_size} {stat.st_mtime_ns}".encode())
+    return cache_root() / "warm" / digest.hexdigest()[:24]
+
+
+class Companion(AbstractContextManager["Companion"]):
+    """The worker process (module notes); started on first use, stopped on exit."""
+
+    def __init__(self) -> None:
+        self._pool: Pool | None = None
+        self._warm_up: tuple[AsyncResult[None], Path, float] | None = None
+
+    def start(self) -> None:
+        """Spawn the worker now, so that its imports overlap the mission's own work."""
+        if self._pool is None:
+            context = multiprocessing.get_context("spawn")
+            self._pool = context.Pool(1, initializer=_prepare)
+
+    def warm_up(self, config: MissionConfig) -> bool:
+        """Start the warm-up of ``config`` unless it already ran here; True if it started."""
+        marker = warm_marker(config)
+        if marker.exists():
+            return False
+        self.start()
+        assert self._pool is not None
+        logger.info(
+            "first run with these vehicles and solver settings: compiling the optimiser's "
+            "kernels in a second process (once)"
+        )
+        task = self._pool.apply_async(_warm_up, (config,))
+        self._warm_up = (task, marker, time.perf_counter())
+        return True
+
+    def wait_for_warm_up(self) -> None:
+        """Wait for a running warm-up to finish (:meth:`_finish_warm_up`)."""
+        if self._warm_up is not None:
+            if not self._warm_up[0].ready():
+                logger.info("waiting for the optimiser's kernels (compiling in a second process)")
+            self._finish_warm_up()
+
+    def _finish_warm_up(self) -> None:
+        """Mark a finished warm-up done, or log why it failed (the mission then compiles)."""
+        assert self._warm_up is not None
+        task, marker, started = self._warm_up
+        self._warm_up = None
+        try:
+            task.get()
+        except Exception as error:  # noqa: BLE001 (the mission compiles what it needs itself)
+            logger.info("kernel warm-up failed (%s); the optimiser compiles its kernels", error)
+            return
+        marker.parent.mkdir(parents=True, exist_ok=True)
+        marker.touch()
+        logger.info("optimiser's kernels compiled in %.0f s", time.perf_counter() - started)
+
+    def waiting(self, progress: ProgressReporter) -> ProgressReporter:
+        """``progress`` that waits for the warm-up when stage :data:`NEEDS_KERNELS` begins."""
+
+        @contextmanager
+        def reporter(name: str, *, total: int | None = None) -> Iterator[Callable[[str], None]]:
+            if name == NEEDS_KERNELS:
+                self.wait_for_warm_up()
+            with progress(name, total=total) as advance:
+                yield advance
+
+        return reporter
+
+    def render_figures(
+        self, result: MissionResult, *, figure_format: str, dpi: int
+    ) -> dict[str, RenderedFigure]:
+        """The figures of ``result`` (:func:`~auvplan.viz.report.render_mission_figures`).
+
+        The worker renders those of :data:`WORKER_FIGURES` while this process renders the
+        rest; the run is pickled over (a few MB).
+        """
+        from auvplan.viz.report import figure_builders, render_mission_figures
+
+        stems = list(figure_builders(result))
+        theirs = [stem for stem in stems if stem in WORKER_FIGURES]
+        self.start()
+        assert self._pool is not None
+        task = self._pool.apply_async(_render, (result, figure_format, dpi, theirs))
+        ours = render_mission_figures(
+            result, figure_format=figure_format, dpi=dpi, stems=set(stems) - set(theirs)
+        )
+        try:
+            rendered = {**ours, **task.get()}
+        except Exception as error:  # noqa: BLE001 (e.g. a result that does not pickle)
+            logger.info("figures of the second process failed (%s); drawing them here", error)
+            rendered = {**ours, **render_mission_figures(
+                result, figure_format=figure_format, dpi=dpi, stems=theirs
+            )}  # fmt: skip
+        return {stem: rendered[stem] for stem in stems}
+
+    def close(self) -> None:
+        """Stop the worker.
+
+        A warm-up still compiling is abandoned (numba writes its cache files whole or not
+        at all); a finished one is marked done.
+        """
+        if self._warm_up is not None and self._warm_up[0].ready():
+            self._finish_warm_up()
+        if self._pool is not None:
+            self._pool.terminate()
+            self._pool.join()
+            self._pool = None
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    def __enter__(self) -> Self:
+        return self
+
+
+def _prepare() -> None:
+    """The worker's start: import what it will run while the mission's process plans.
+
+    Its logs and warnings are dropped: the mission's process reports.
+    """
+    logging.getLogger("auvplan").addHandler(logging.NullHandler())
+    logging.getLogger("auvplan").propagate = False
+    warnings.simplefilter("ignore")
+    for module in ("auvplan.mission.warmup", "auvplan.viz.report"):  # pipeline; matplotlib
+        importlib.import_module(module)
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(1, 1))  # the first drawing loads the fonts
+    figure.subplots().set_title("warm-up")
+    figure.savefig(io.BytesIO(), format="png")
+
+
+def _warm_up(config: MissionConfig) -> None:
+    from auvplan.mission.warmup import warm_up
+
+    warm_up(config)
+
+
+def _render(
+    result: MissionResult, figure_format: str, dpi: int, stems: Collection[str]
+) -> dict[str, Any]:
+    from auvplan.viz.report import render_mission_figures
+
+    return render_mission_figures(result, figure_format=figure_format, dpi=dpi, stems=stems)
+
+
+__all__ = ["Companion", "warm_marker"]
