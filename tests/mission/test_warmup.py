@@ -24,7 +24,7 @@ MIXED = {
          "goal": {"north": 300.0, "east": 500.0}},
     ],
     "current": {"north": 0.1, "east": 0.0},
-    "solver": {"dt_s": 1.0},
+    "solver": {"dt_s": 1.0, "compile": True},
 }  # fmt: skip
 
 
@@ -34,10 +34,10 @@ def test_one_small_mission_per_vehicle_type_with_the_mission_settings() -> None:
     assert [m.vehicles[0].type for m in small] == ["medusa", "remus100"]
     for mission in small:
         assert len(mission.vehicles) == 1
-        assert mission.solver.model_copy(update={"max_iter": config.solver.max_iter}) == (
-            config.solver
-        )
+        restored = {"max_iter": config.solver.max_iter, "compile": True}
+        assert mission.solver.model_copy(update=restored) == config.solver
         assert mission.solver.max_iter == ITERATIONS
+        assert not mission.solver.compile
         assert mission.maps == config.maps
         assert mission.weights == config.weights
         assert mission.current is not None

@@ -124,9 +124,12 @@ class Companion(AbstractContextManager["Companion"]):
         except Exception as error:  # noqa: BLE001 (the mission compiles what it needs itself)
             logger.info("kernel warm-up failed (%s); the optimiser compiles its kernels", error)
             return
-        marker.parent.mkdir(parents=True, exist_ok=True)
-        marker.touch()
         logger.info("optimiser's kernels compiled in %.0f s", time.perf_counter() - started)
+        try:
+            marker.parent.mkdir(parents=True, exist_ok=True)
+            marker.touch()
+        except OSError as error:  # a read-only cache: the next run warms up again
+            logger.info("cannot mark the warm-up done (%s)", error)
 
     def waiting(self, progress: ProgressReporter) -> ProgressReporter:
         """``progress`` that waits for the warm-up when stage :data:`NEEDS_KERNELS` begins."""

@@ -47,7 +47,9 @@ def warm_up_missions(config: MissionConfig) -> list[MissionConfig]:
 
     One mission per distinct vehicle type of ``config``: its vehicle heads north over
     :data:`TRACK_LENGTH` on the synthetic bank; the solver, maps, weights and deconfliction
-    settings are ``config``'s, with :data:`ITERATIONS` PRONTO iterations.
+    settings are ``config``'s, with :data:`ITERATIONS` PRONTO iterations and without the C
+    compilation of ``solver.compile`` (its code holds the mission's constants: no other
+    mission can use it).
     """
     speeds = {vehicle.type: vehicle.start.speed for vehicle in config.vehicles}
     return [
@@ -66,7 +68,9 @@ def warm_up_missions(config: MissionConfig) -> list[MissionConfig]:
                 ],
                 "weights": config.weights,
                 "deconfliction": config.deconfliction,
-                "solver": config.solver.model_copy(update={"max_iter": ITERATIONS}),
+                "solver": config.solver.model_copy(
+                    update={"max_iter": ITERATIONS, "compile": False}
+                ),
                 "current": None if config.current is None else CURRENT,
             }
         )
