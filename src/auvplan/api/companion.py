@@ -26,6 +26,7 @@ block (spawning re-imports the main module)::
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import importlib
 import io
@@ -33,18 +34,19 @@ import logging
 import multiprocessing
 import time
 import warnings
-from collections.abc import Callable, Collection, Iterator
+from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager, contextmanager
 from multiprocessing.pool import AsyncResult, Pool
 from pathlib import Path
 from types import TracebackType
-from typing import TYPE_CHECKING, Any, Final, Self
+from typing import TYPE_CHECKING, Final
 
 import numba
 
 import auvplan
 from auvplan.mission.config import MissionConfig
 from auvplan.mission.progress import ProgressReporter
+from auvplan.mission.warmup import warm_up, warm_up_missions
 from auvplan.optimization._kernel_cache import cache_root
 
 if TYPE_CHECKING:
@@ -67,8 +69,6 @@ def warm_marker(config: MissionConfig) -> Path:
     the numba version and the size and time of every source file of the installed package,
     so that a new version or an edited checkout warms up again.
     """
-    from auvplan.mission.warmup import warm_up_missions
-
     digest = hashlib.sha256(numba.__version__.encode())
     for small in warm_up_missions(config):
         digest.update(small.model_dump_json(exclude={"mission"}).encode())  # not the clock
@@ -103,7 +103,7 @@ class Companion(AbstractContextManager["Companion"]):
             "first run with these vehicles and solver settings: compiling the optimiser's "
             "kernels in a second process (once)"
         )
-        task = self._pool.apply_async(_warm_up, (config,))
+        task = self._pool.apply_async(warm_up, (config,))
         self._warm_up = (task, marker, time.perf_counter())
         return True
 
@@ -157,17 +157,14 @@ class Companion(AbstractContextManager["Companion"]):
         theirs = [stem for stem in stems if stem in WORKER_FIGURES]
         self.start()
         assert self._pool is not None
-        task = self._pool.apply_async(_render, (result, figure_format, dpi, theirs))
-        ours = render_mission_figures(
-            result, figure_format=figure_format, dpi=dpi, stems=set(stems) - set(theirs)
-        )
+        draw = functools.partial(render_mission_figures, figure_format=figure_format, dpi=dpi)
+        task = self._pool.apply_async(draw, (result,), {"stems": theirs})
+        ours = draw(result, stems=set(stems) - set(theirs))
         try:
             rendered = {**ours, **task.get()}
         except Exception as error:  # noqa: BLE001 (e.g. a result that does not pickle)
             logger.info("figures of the second process failed (%s); drawing them here", error)
-            rendered = {**ours, **render_mission_figures(
-                result, figure_format=figure_format, dpi=dpi, stems=theirs
-            )}  # fmt: skip
+            rendered = {**ours, **draw(result, stems=theirs)}
         return {stem: rendered[stem] for stem in stems}
 
     def close(self) -> None:
@@ -191,9 +188,6 @@ class Companion(AbstractContextManager["Companion"]):
     ) -> None:
         self.close()
 
-    def __enter__(self) -> Self:
-        return self
-
 
 def _prepare() -> None:
     """The worker's start: import what it will run while the mission's process plans.
@@ -210,20 +204,6 @@ def _prepare() -> None:
     figure = Figure(figsize=(1, 1))  # the first drawing loads the fonts
     figure.subplots().set_title("warm-up")
     figure.savefig(io.BytesIO(), format="png")
-
-
-def _warm_up(config: MissionConfig) -> None:
-    from auvplan.mission.warmup import warm_up
-
-    warm_up(config)
-
-
-def _render(
-    result: MissionResult, figure_format: str, dpi: int, stems: Collection[str]
-) -> dict[str, Any]:
-    from auvplan.viz.report import render_mission_figures
-
-    return render_mission_figures(result, figure_format=figure_format, dpi=dpi, stems=stems)
 
 
 __all__ = ["Companion", "warm_marker"]
