@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from auvplan._typing import FloatArray
+from auvplan.navigation._prediction_kernel import covariance_recursion
 from auvplan.navigation.depth import depth_gradient_at
 from auvplan.terrain import BathymetryGrid
 
@@ -71,18 +72,36 @@ def posterior_crb(
     array([[ 20.,   0.],
            [  0., 100.]])
     """
+    fisher = sounding_information(grid, positions, offsets, variances)
+    packed = covariance_recursion(
+        fisher[:, [0, 0, 1], [0, 1, 1]],
+        np.zeros(positions.shape[0] - 1),
+        np.asarray(process_sigma, dtype=np.float64) ** 2,
+        float(initial_sigma) ** 2,
+    )
+    return unpack_covariance(packed)
+
+
+def sounding_information(
+    grid: BathymetryGrid, positions: FloatArray, offsets: FloatArray, variances: FloatArray
+) -> FloatArray:
+    r"""Fisher information :math:`\sum_j \nabla h_j \nabla h_j^\top / r_j` [1/m²] of each ping.
+
+    ``positions`` ``(n, 2)``, ``offsets`` ``(n, n_beams, 2)`` and ``variances``
+    ``(n, n_beams)`` as :func:`posterior_crb`; beams without a sounding add nothing.
+    Returns ``(n, 2, 2)``.
+    """
     footprints = positions[:, None, :] + offsets
     gradient = depth_gradient_at(grid, footprints[..., 0], footprints[..., 1])
     usable = np.all(np.isfinite(gradient), axis=-1) & np.isfinite(variances)
     weights = np.where(usable, 1.0 / np.where(usable, variances, 1.0), 0.0)
     gradient = np.where(usable[..., None], gradient, 0.0)
-    # per-update Fisher information of the soundings: sum_j g g^T / r, shape (K + 1, 2, 2)
-    fisher = np.einsum("kj,kja,kjb->kab", weights, gradient, gradient)
-    bound = np.empty_like(fisher)
-    information = np.eye(2) / initial_sigma**2 + fisher[0]
-    bound[0] = np.linalg.inv(information)
-    for k in range(1, positions.shape[0]):
-        predicted = bound[k - 1] + process_sigma[k - 1] ** 2 * np.eye(2)
-        information = np.linalg.inv(predicted) + fisher[k]
-        bound[k] = np.linalg.inv(information)
-    return np.asarray(bound, dtype=np.float64)
+    return np.asarray(np.einsum("kj,kja,kjb->kab", weights, gradient, gradient), np.float64)
+
+
+def unpack_covariance(packed: FloatArray) -> FloatArray:
+    """``(n, 3)`` entries ``p00, p01, p11`` as symmetric ``(n, 2, 2)`` matrices."""
+    out = np.empty((packed.shape[0], 2, 2))
+    out[:, 0, 0], out[:, 1, 1] = packed[:, 0], packed[:, 2]
+    out[:, 0, 1] = out[:, 1, 0] = packed[:, 1]
+    return out

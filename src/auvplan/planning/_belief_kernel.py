@@ -1,0 +1,225 @@
+r"""Numba kernel of the belief-space search: labels (cost, covariance) on a padded 8-grid.
+
+A label is a path prefix ending at a cell, with its graph cost ``g``, the predicted position
+covariance ``P`` at its end (``p00, p01, p11`` [m²], the recursion of
+:mod:`auvplan.navigation._prediction_kernel` applied move by move), the distance travelled
+[m] and the peak radial error after the settling distance. Its bin is
+``min(⌊σ / Δσ⌋, n_bins − 1)`` with :math:`\sigma = \sqrt{\operatorname{tr} P}`.
+
+Labels are popped from a binary heap in order of ``key``: ``g + h`` (cost mode, A* with the
+consistent heuristic ``h`` of :mod:`auvplan.planning._kernel`), or the peak error (bottleneck
+mode, ties broken by ``g``). Either key is non-decreasing along a path and equal heuristics
+at one cell make the pop order at a cell the order of ``g`` (or of the peak), so a label
+popped at a cell is dominated — and skipped — when a label of a lower or equal bin was popped
+there before (``closed[cell]`` keeps the lowest closed bin). A label is thus expanded only if
+it is better in error than every cheaper label at its cell: at most ``n_bins`` per cell.
+After the settling distance a move whose predicted σ exceeds ``max_error`` is not made.
+
+A move ``u → v`` of length ℓ [m] with the move factor ``f`` (e.g. the time ratio in a
+current) costs ``ℓ f (c_u + c_v) / 2 + λ ℓ (σ_u² + σ_v²) / 2`` and takes
+``n = ℓ · updates_per_metre`` TAN updates: drift growth ``σ_b ℓ``, white variance
+``n q`` and information ``n (F_u + F_v) / 2``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from auvplan._typing import FloatArray, IntArray
+from auvplan.navigation._prediction_kernel import propagate
+from auvplan.planning._kernel import _moves
+
+#: Columns of the label table: cost, p00, p01, p11, distance, peak.
+_G, _P00, _P01, _P11, _DIST, _PEAK = 0, 1, 2, 3, 4, 5
+#: Exit codes of :func:`belief_search`.
+FOUND, UNREACHABLE, TOO_MANY_LABELS = 0, 1, 2
+
+
+@njit(cache=True)
+def _grow_rows(table: FloatArray, size: int) -> FloatArray:  # pragma: no cover - compiled
+    bigger = np.empty((2 * table.shape[0], table.shape[1]), table.dtype)
+    bigger[:size] = table[:size]
+    return bigger
+
+
+@njit(cache=True)
+def _grow(values: IntArray, size: int) -> IntArray:  # pragma: no cover - compiled
+    bigger = np.empty(2 * values.shape[0], values.dtype)
+    bigger[:size] = values[:size]
+    return bigger
+
+
+@njit(cache=True)
+def _grow_keys(values: FloatArray, size: int) -> FloatArray:  # pragma: no cover - compiled
+    bigger = np.empty(2 * values.shape[0])
+    bigger[:size] = values[:size]
+    return bigger
+
+
+@njit(cache=True)
+def _push(
+    keys: FloatArray, items: IntArray, size: int, key: float, item: int
+) -> None:  # pragma: no cover - compiled
+    """Sift ``(key, item)`` up from position ``size`` (the caller has room for it)."""
+    i = size
+    while i > 0:
+        parent = (i - 1) >> 1
+        if keys[parent] <= key:
+            break
+        keys[i] = keys[parent]
+        items[i] = items[parent]
+        i = parent
+    keys[i] = key
+    items[i] = item
+
+
+@njit(cache=True)
+def _pop(keys: FloatArray, items: IntArray, size: int) -> int:  # pragma: no cover - compiled
+    """Remove the smallest entry of a heap of ``size`` and return its item."""
+    top = items[0]
+    last_key = keys[size - 1]
+    last_item = items[size - 1]
+    n = size - 1
+    i = 0
+    while True:
+        child = 2 * i + 1
+        if child >= n:
+            break
+        if child + 1 < n and keys[child + 1] < keys[child]:
+            child += 1
+        if keys[child] >= last_key:
+            break
+        keys[i] = keys[child]
+        items[i] = items[child]
+        i = child
+    if n > 0:
+        keys[i] = last_key
+        items[i] = last_item
+    return int(top)
+
+
+@njit(cache=True)
+def belief_search(
+    cost: FloatArray,
+    width: int,
+    start: int,
+    goal: int,
+    spacing_north: float,
+    spacing_east: float,
+    factor: FloatArray,
+    factor_stride: int,
+    heuristic: FloatArray,
+    fisher: FloatArray,
+    updates_per_metre: float,
+    drift_rate: float,
+    process_variance: float,
+    initial_variance: float,
+    max_error: float,
+    settle_distance: float,
+    error_weight: float,
+    bin_width: float,
+    n_bins: int,
+    bottleneck: bool,
+    max_labels: int,
+) -> tuple[int, IntArray, FloatArray, float, float, int]:  # pragma: no cover - compiled
+    """Search from ``start`` to ``goal`` (flat padded cells; module notes).
+
+    ``cost``, ``heuristic`` ``(n_padded,)``; ``fisher`` ``(n_padded, 3)`` per update;
+    ``factor`` ``(8, ·)`` with ``factor_stride``. Returns the exit code, the path's cells and
+    its σ at each cell, its cost and peak error after settling, and the labels created.
+    """
+    offsets, _, _, length = _moves(width, spacing_north, spacing_east)
+    closed = np.full(cost.shape[0], n_bins, np.int32)
+    capacity = 1024
+    table = np.empty((capacity, 6))
+    cells = np.empty(capacity, np.int64)
+    parents = np.empty(capacity, np.int64)
+    keys = np.empty(capacity)
+    items = np.empty(capacity, np.int64)
+    heap = 0
+    f0 = fisher[start]
+    j00 = 1.0 / initial_variance + f0[0]
+    j01 = f0[1]
+    j11 = 1.0 / initial_variance + f0[2]
+    det = j00 * j11 - j01 * j01
+    table[0, _G], table[0, _DIST], table[0, _PEAK] = 0.0, 0.0, 0.0
+    table[0, _P00], table[0, _P01], table[0, _P11] = j11 / det, -j01 / det, j00 / det
+    cells[0], parents[0] = start, -1
+    n_labels = 1
+    _push(keys, items, heap, 0.0 if bottleneck else heuristic[start], 0)
+    heap += 1
+    found = -1
+    while heap > 0:
+        label = _pop(keys, items, heap)
+        heap -= 1
+        u = cells[label]
+        row = table[label]
+        sigma_u = math.sqrt(row[_P00] + row[_P11])
+        bin_u = min(int(sigma_u / bin_width), n_bins - 1)
+        if bin_u >= closed[u]:
+            continue
+        closed[u] = bin_u
+        if u == goal:
+            found = label
+            break
+        for k in range(8):
+            v = u + offsets[k]
+            c_v = cost[v]
+            move = factor[k, v * factor_stride]
+            if not (math.isfinite(c_v) and math.isfinite(move)):
+                continue
+            ell = length[k]
+            n_updates = ell * updates_per_metre
+            f_v = fisher[v]
+            f_u = fisher[u]
+            p00, p01, p11 = propagate(
+                row[_P00], row[_P01], row[_P11], drift_rate * ell, n_updates * process_variance,
+                0.5 * n_updates * (f_u[0] + f_v[0]), 0.5 * n_updates * (f_u[1] + f_v[1]),
+                0.5 * n_updates * (f_u[2] + f_v[2]),
+            )  # fmt: skip
+            sigma_v = math.sqrt(p00 + p11)
+            bin_v = min(int(sigma_v / bin_width), n_bins - 1)
+            if bin_v >= closed[v]:
+                continue
+            distance = row[_DIST] + ell
+            peak = row[_PEAK]
+            if distance > settle_distance:
+                if sigma_v > max_error:
+                    continue
+                peak = max(peak, sigma_v)
+            g = row[_G] + ell * move * 0.5 * (cost[u] + c_v)
+            g += error_weight * ell * 0.5 * (sigma_u * sigma_u + sigma_v * sigma_v)
+            if n_labels == max_labels:
+                return TOO_MANY_LABELS, np.empty(0, np.int64), np.empty(0), 0.0, 0.0, n_labels
+            if n_labels == table.shape[0]:
+                table = _grow_rows(table, n_labels)
+                cells = _grow(cells, n_labels)
+                parents = _grow(parents, n_labels)
+            if heap == keys.shape[0]:
+                keys = _grow_keys(keys, heap)
+                items = _grow(items, heap)
+            table[n_labels, _G], table[n_labels, _DIST], table[n_labels, _PEAK] = g, distance, peak
+            table[n_labels, _P00], table[n_labels, _P01], table[n_labels, _P11] = p00, p01, p11
+            cells[n_labels], parents[n_labels] = v, label
+            key = peak * 1e9 + g if bottleneck else g + heuristic[v]
+            _push(keys, items, heap, key, n_labels)
+            heap += 1
+            n_labels += 1
+    if found < 0:
+        return UNREACHABLE, np.empty(0, np.int64), np.empty(0), 0.0, 0.0, n_labels
+    n_path = 0
+    label = found
+    while label >= 0:
+        n_path += 1
+        label = parents[label]
+    path = np.empty(n_path, np.int64)
+    sigma = np.empty(n_path)
+    label = found
+    for i in range(n_path - 1, -1, -1):
+        path[i] = cells[label]
+        sigma[i] = math.sqrt(table[label, _P00] + table[label, _P11])
+        label = parents[label]
+    return FOUND, path, sigma, table[found, _G], table[found, _PEAK], n_labels
