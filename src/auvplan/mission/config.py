@@ -30,6 +30,7 @@ from auvplan.mission.tables import (
     FleetConfig,
     GoalPose,
     MapsConfig,
+    NavigationConfig,
     ObstacleConfig,
     PlannerConfig,
     Position,
@@ -58,6 +59,7 @@ class MissionConfig(TableModel):
     comms: tuple[CommConfig, ...] = Field((), alias="comm", max_length=1000)
     weights: WeightsConfig = Field(default_factory=WeightsConfig)
     planner: PlannerConfig = Field(default_factory=PlannerConfig)
+    navigation: NavigationConfig = Field(default_factory=NavigationConfig)
     deconfliction: DeconflictionConfig = Field(default_factory=DeconflictionConfig)
     solver: SolverConfig = Field(default_factory=SolverConfig)
     mission: ExecutionConfig = Field(default_factory=ExecutionConfig)
@@ -266,6 +268,7 @@ __all__ = [
     "GoalPose",
     "MapsConfig",
     "MissionConfig",
+    "NavigationConfig",
     "ObstacleConfig",
     "PlannerConfig",
     "Position",

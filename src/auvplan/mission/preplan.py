@@ -24,6 +24,7 @@ from auvplan.mission.config import (
 )
 from auvplan.mission.current import cell_currents, current_move_factor, load_current
 from auvplan.mission.models import vehicle_model
+from auvplan.mission.navigation import NavigationChoice, VehicleNavigation, vehicle_navigation
 from auvplan.mission.progress import ProgressReporter, no_progress
 from auvplan.ocean import CurrentField
 from auvplan.planning import (
@@ -38,6 +39,8 @@ from auvplan.planning import (
     skirt_discs,
     smooth_path,
 )
+from auvplan.planning.belief import BeliefModel
+from auvplan.planning.route import BudgetInfeasible
 from auvplan.terrain import BathymetryGrid, MapParameters, TerrainMaps, compute_terrain_maps
 from auvplan.terrain.synthetic import synthetic_bank
 from auvplan.vehicle import optimal_cruise_speed, turning_radius
@@ -61,7 +64,8 @@ class PreplanStage:
     ``starts`` and ``goals`` have shape ``(n_vehicles, 3)``: north, east [m], psi [rad];
     ``start_speeds`` [m/s]. ``paths`` are the smoothed routes (``(n_i, 2)`` north/east [m]);
     ``obstacle_names`` label ``obstacles``; ``current`` is the ocean current (None: still
-    water).
+    water); ``navigation`` says how each route was chosen for navigation (None: the paper's
+    or the crossed edge model).
     """
 
     bathymetry: BathymetryGrid
@@ -75,6 +79,7 @@ class PreplanStage:
     routes: tuple[Route, ...]
     paths: tuple[FloatArray, ...]
     current: CurrentField | None = None
+    navigation: tuple[NavigationChoice, ...] | None = None
 
 
 def load_terrain(terrain: TerrainConfig) -> BathymetryGrid:
@@ -267,8 +272,9 @@ def plan_routes(
     start_courses: FloatArray | None = None,
     current: CurrentField | None = None,
     water_speeds: FloatArray | None = None,
+    navigation: tuple[VehicleNavigation, ...] | None = None,
     progress: ProgressReporter = no_progress,
-) -> tuple[tuple[Route, ...], tuple[FloatArray, ...]]:
+) -> tuple[tuple[Route, ...], tuple[FloatArray, ...], tuple[NavigationChoice, ...] | None]:
     """One A* route per vehicle on the shifted cost map, and its smoothed curve.
 
     The curve stays within half a cell of the route, or within the corner cut
@@ -287,7 +293,11 @@ def plan_routes(
     is_blocked = blocked_lookup(geometry, blocked)
     courses = starts[:, 2] if start_courses is None else start_courses
     velocity = None if current is None else cell_currents(geometry, current)
-    routes, paths = [], []
+    cost = maps.shifted_cost
+    if navigation is not None:  # length is the energy proxy
+        cost = np.where(np.isfinite(cost), 1.0, np.nan)
+    edge_model = EdgeModel.CROSSED if navigation is not None else EdgeModel(planner.edge_model)
+    routes, paths, choices = [], [], []
     with progress("A*", total=len(names)) as advance:
         for index, name in enumerate(names):
             factor = (
@@ -301,25 +311,43 @@ def plan_routes(
                 index: int = index,
                 name: str = name,
                 factor: FloatArray | None = factor,
-            ) -> Route:
-                return plan_route(
-                    maps.shifted_cost,
-                    geometry,
-                    (float(starts[index, 0]), float(starts[index, 1])),
-                    (float(goals[index, 0]), float(goals[index, 1])),
-                    obstacles=obstacles + extra,
-                    clearance=clearance,
-                    edge_model=EdgeModel(planner.edge_model),
-                    move_factor=factor,
-                    name=name,
-                )
+            ) -> tuple[Route, NavigationChoice | None]:
+                def one(belief: BeliefModel | None, bottleneck: bool = False) -> Route:
+                    return plan_route(
+                        cost,
+                        geometry,
+                        (float(starts[index, 0]), float(starts[index, 1])),
+                        (float(goals[index, 0]), float(goals[index, 1])),
+                        obstacles=obstacles + extra,
+                        clearance=clearance,
+                        edge_model=edge_model,
+                        move_factor=factor,
+                        name=name,
+                        belief=belief,
+                        bottleneck=bottleneck,
+                    )
+
+                if navigation is None:
+                    return one(None), None
+                return navigation[index].route(one)
 
             keep_out = goal_keep_outs(starts, goals, index, clearance, cell)
             try:
-                route = search(keep_out)
+                route, choice = search(keep_out)
+            except BudgetInfeasible:
+                raise
             except InfeasibleError:  # the keep-outs close every way: timing must do it
-                route, keep_out = search(()), ()
+                (route, choice), keep_out = search(()), ()
             routes.append(route)
+            choices.append(choice)
+            if choice is not None:
+                logger.info(
+                    "navigation %s: %s route, predicted error RMS %.1f m, peak %.1f m "
+                    "(shortest route: %.1f m, %.1f m), energy %+.1f %%",
+                    name, "budget" if choice.budget_m is not None else "energy-only",
+                    choice.rms_m, choice.peak_m, choice.energy_only_rms_m,
+                    choice.energy_only_peak_m, 100.0 * choice.energy_increase,
+                )  # fmt: skip
             # near the route, never through a no-go cell nor within 2 r_c of a kept-out goal
             radius = 0.0 if turning_radii is None else float(turning_radii[index])
             path = smooth_path(
@@ -334,7 +362,8 @@ def plan_routes(
                 route.n_expanded,
             )  # fmt: skip
             advance(name)
-    return tuple(routes), tuple(paths)
+    navigated = tuple(c for c in choices if c is not None)
+    return tuple(routes), tuple(paths), navigated if navigation is not None else None
 
 
 def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progress) -> PreplanStage:
@@ -368,12 +397,20 @@ def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progre
     models = [vehicle_model(v.type, config.solver.harmonics) for v in config.vehicles]
     start_speeds = np.array([v.start.speed for v in config.vehicles])
     cruise = config.fleet.cruise_speed
-    routes, paths = plan_routes(
+    navigation = None
+    if config.planner.edge_model == "navigation":
+        navigation = vehicle_navigation(
+            maps, config.navigation, names, models, np.hypot(*(goals[:, :2] - starts[:, :2]).T),
+            horizon=config.fleet.horizon, cruise_speed=cruise, vehicle_depth=config.mission.depth,
+            weight=config.weights.navigation,
+        )  # fmt: skip
+    routes, paths, choices = plan_routes(
         maps, names, starts, goals, obstacles,
         clearance=config.fleet.safety_radius, planner=config.planner,
         turning_radii=np.array([turning_radius(model) for model in models]),
         start_courses=courses_over_ground(starts, start_speeds, current),
         current=current,
+        navigation=navigation,
         water_speeds=None if current is None else np.array(
             [cruise if cruise is not None else optimal_cruise_speed(model).speed
              for model in models]
@@ -392,4 +429,5 @@ def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progre
         routes=routes,
         paths=paths,
         current=current,
+        navigation=choices,
     )

@@ -170,6 +170,8 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> d
                 "smoothed_length_m": path_length(preplan.paths[i]),
             },
         }
+        if preplan.navigation is not None:
+            vehicle["preplan"]["navigation"] = preplan.navigation[i].document()
         summary["vehicles"].append(vehicle)
     stage2 = result.deconfliction
     if stage2 is not None:

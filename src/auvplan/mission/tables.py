@@ -10,12 +10,15 @@ import math
 import types
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Annotated, Any, Final, Literal, Union, get_args, get_origin
+from typing import TYPE_CHECKING, Annotated, Any, Final, Literal, Union, get_args, get_origin
 
 from pydantic import BaseModel, ConfigDict, Field, Strict, field_validator, model_validator
 
 from auvplan.errors import InputError
 from auvplan.optimization import ProntoOptions
+
+if TYPE_CHECKING:  # the navigation package (numba kernels) loads only when a run needs it
+    from auvplan.navigation import NavigationSettings
 
 #: Strict scalar types: TOML's own types, no strings parsed as numbers, no NaN/inf.
 Number = Annotated[float, Strict()]
@@ -281,14 +284,112 @@ class WeightsConfig(TableModel):
         0.0, ge=0.0, le=1e4, description="reward for information in the optimiser (x terrain)",
         json_schema_extra=_unit("W"),
     )  # fmt: skip
+    navigation: Number = Field(
+        0.0, ge=0.0, le=1e6,
+        description="price of predicted TAN error in the navigation pre-planner: J per m² of "
+        "radial error variance per second flown", json_schema_extra=_unit("W/m²"),
+    )  # fmt: skip
 
 
 class PlannerConfig(TableModel):
     """The A* pre-planner."""
 
-    edge_model: Literal["paper", "crossed"] = Field(
-        "paper", description="paper: cost of the cell entered; crossed: length x terrain crossed"
+    edge_model: Literal["navigation", "paper", "crossed"] = Field(
+        "navigation",
+        description="navigation: cheapest path whose predicted TAN error meets [navigation]; "
+        "paper: cost of the cell entered; crossed: length x terrain crossed",
     )
+
+
+class NavigationConfig(TableModel):
+    """The vehicles' terrain-aided navigation, one model for the planner and ``evaluate``.
+
+    Defaults: MB-System's terrain-relative navigation (drift 1 % of distance, map variance
+    1 m², an update every 3 s) and a DVL of ±0.5 cm/s (:mod:`auvplan.navigation`). The
+    planner keeps each vehicle's predicted 1-σ radial error at or below ``max_error_m`` after
+    the first ``settle_s`` seconds; without ``max_error_m`` it buys the largest predicted
+    error reduction that costs at most ``max_energy_increase`` more energy and cuts the
+    predicted RMS error by at least ``min_error_reduction`` (else it flies the energy-only
+    path).
+    """
+
+    sensor: Literal["altimeter", "multibeam"] = Field(
+        "altimeter", description="depth sensor (multibeam: 11 beams over 90°)"
+    )
+    update_period: Number = Field(
+        3.0, alias="update_period_s", ge=0.1, le=600.0, description="time between TAN updates",
+        json_schema_extra=_unit("s"),
+    )  # fmt: skip
+    drift: Number = Field(
+        1.0, alias="drift_percent", gt=0.0, le=20.0,
+        description="dead-reckoning drift, CEP in % of the distance travelled",
+        json_schema_extra=_unit("%"),
+    )  # fmt: skip
+    velocity_noise: Number = Field(
+        0.005, alias="dvl_noise_m_s", ge=0.0, le=1.0, description="white DVL velocity noise",
+        json_schema_extra=_unit("m/s"),
+    )  # fmt: skip
+    initial_sigma: Number = Field(
+        7.0, alias="initial_sigma_m", gt=0.0, le=1000.0,
+        description="initial position error, standard deviation per axis",
+        json_schema_extra=_unit("m"),
+    )  # fmt: skip
+    map_variance: Number = Field(
+        1.0, alias="map_variance_m2", gt=0.0, le=1e4, description="variance of the map's depths",
+        json_schema_extra=_unit("m²"),
+    )  # fmt: skip
+    max_error: Number | None = Field(
+        None, alias="max_error_m", gt=0.0, le=1e5,
+        description="budget on the predicted 1-σ radial error after settle_s (absent: "
+        "automatic)", json_schema_extra=_unit("m"),
+    )  # fmt: skip
+    settle: Number = Field(
+        600.0, alias="settle_s", ge=0.0, le=1e6,
+        description="time from the start before the budget applies",
+        json_schema_extra=_unit("s"),
+    )  # fmt: skip
+    max_energy_increase: Number = Field(
+        0.05,
+        ge=0.0,
+        le=10.0,
+        description="automatic budget: most extra energy (fraction of the energy-only path's)",
+    )
+    min_error_reduction: Number = Field(
+        0.2,
+        ge=0.0,
+        lt=1.0,
+        description="automatic budget: least cut of the predicted RMS error worth paying for",
+    )
+
+    def settings(
+        self, *, vehicle_depth: float = 0.0, particles: int = 5000, convergence_updates: int = 200
+    ) -> NavigationSettings:
+        """The :class:`~auvplan.navigation.NavigationSettings` of this table.
+
+        ``vehicle_depth`` [m] is the plan's depth (the altimeter's range is the seabed depth
+        below it); ``particles`` and ``convergence_updates`` are the evaluator's own
+        (``evaluate`` options). Raises :class:`~auvplan.errors.InputError` for an invalid value.
+        """
+        from auvplan.navigation import (
+            DeadReckoningModel,
+            NavigationSettings,
+            ParticleFilterOptions,
+            SensorModel,
+        )
+
+        sensor = SensorModel.named(self.sensor)
+        return NavigationSettings(
+            sensor=SensorModel(
+                sensor.n_beams, sensor.swath_angle, sensor.range_error_fraction,
+                self.map_variance, vehicle_depth,
+            ),
+            motion=DeadReckoningModel(
+                drift_fraction=self.drift / 100.0, velocity_noise=self.velocity_noise
+            ),
+            filter=ParticleFilterOptions(n_particles=particles, initial_sigma=self.initial_sigma),
+            update_period=self.update_period,
+            convergence_updates=convergence_updates,
+        )  # fmt: skip
 
 
 class DeconflictionConfig(TableModel):

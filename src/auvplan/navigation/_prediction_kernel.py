@@ -1,19 +1,30 @@
 r"""The compiled step of the predicted TAN error: drift growth, process noise, soundings.
 
-One step from covariance :math:`P` (symmetric 2 × 2, stored as ``p00, p01, p11`` [m²]):
+One step of length :math:`\ell` [m] from the covariance :math:`P` (symmetric 2 × 2, stored as
+``p00, p01, p11`` [m²]) and the variance :math:`V` [m²] that dead reckoning has added since
+the last fixes:
 
 .. math::
 
-    P^- = \left(\sqrt{P} + g I\right)^2 + w I, \qquad
-    P^+ = \left((P^-)^{-1} + F\right)^{-1},
+    \Delta = \max\left(\sigma_b^2 \left((d + \ell)^2 - d^2\right),\; w\right), \quad
+    d = \sqrt{V} / \sigma_b, \qquad
+    P^- = P + \Delta I, \quad V^- = V + \Delta,
 
-with :math:`g` [m] the growth of the standard deviation by dead-reckoning drift over the step
-(a scale or heading bias: the error of a straight leg of length :math:`D` grows as
-:math:`\sigma_b D`, linearly), :math:`w` [m²] the white process variance added over the step
-and :math:`F` [1/m²] the Fisher information of the soundings taken in it. With :math:`g = 0`
-this is the posterior Cramér-Rao recursion of :mod:`~auvplan.navigation.pcrb`. The square
-root of a 2 × 2 SPD matrix is closed-form: :math:`\sqrt P = (P + sI)/t` with
-:math:`s = \sqrt{\det P}` and :math:`t = \sqrt{\operatorname{tr} P + 2s}`.
+.. math::
+
+    P^+ = \left((P^-)^{-1} + F\right)^{-1}, \qquad
+    V^+ = V^- \, \operatorname{tr} P^+ / \operatorname{tr} P^-.
+
+Dead reckoning with a scale and heading bias :math:`\sigma_b` (per metre) makes the error
+of a straight leg grow as :math:`\sigma_b D` — quadratically in variance, from the last
+fix on: :math:`d` is the distance flown since it, and a fix shrinks it with the error.
+Over a flat seabed (:math:`F = 0`) the variance is exactly
+:math:`\sigma_0^2 + \sigma_b^2 D^2` per axis, the dead-reckoning error. ``w`` [m²] is the
+white variance the filter itself adds over the step (its process noise): it sets the growth
+where dead reckoning grows slower (just after a fix), and so the accuracy a filter keeps
+over informative seabed. :math:`F` [1/m²] is the Fisher information of the soundings of the
+step. With :math:`\sigma_b = 0` this is the posterior Cramér-Rao recursion of
+:mod:`~auvplan.navigation.pcrb`.
 """
 
 from __future__ import annotations
@@ -31,40 +42,48 @@ def propagate(
     p00: float,
     p01: float,
     p11: float,
-    growth: float,
+    grown: float,
+    drift_variance: float,
+    length: float,
     white: float,
     f00: float,
     f01: float,
     f11: float,
-) -> tuple[float, float, float]:  # pragma: no cover - compiled
-    """One step of the recursion (module notes); returns ``p00, p01, p11`` after it."""
-    if growth > 0.0:
-        s = math.sqrt(max(p00 * p11 - p01 * p01, 0.0))
-        t = math.sqrt(p00 + p11 + 2.0 * s)
-        p00 += 2.0 * growth * (p00 + s) / t + growth * growth
-        p01 += 2.0 * growth * p01 / t
-        p11 += 2.0 * growth * (p11 + s) / t + growth * growth
-    p00 += white
-    p11 += white
+) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
+    r"""One step of the recursion (module notes).
+
+    ``drift_variance`` is :math:`\sigma_b^2` [1], ``grown`` is :math:`V` [m²], ``length``
+    is :math:`\ell` [m]; returns ``p00, p01, p11`` and :math:`V` after the step.
+    """
+    increment = white
+    if drift_variance > 0.0:
+        since = math.sqrt(grown / drift_variance)
+        increment = max(drift_variance * length * (2.0 * since + length), white)
+    p00 += increment
+    p11 += increment
+    grown += increment
+    before = p00 + p11
     det = p00 * p11 - p01 * p01
     j00 = p11 / det + f00
     j01 = -p01 / det + f01
     j11 = p00 / det + f11
     det_j = j00 * j11 - j01 * j01
-    return j11 / det_j, 0.0 - j01 / det_j, j00 / det_j
+    q00, q01, q11 = j11 / det_j, 0.0 - j01 / det_j, j00 / det_j
+    return q00, q01, q11, grown * (q00 + q11) / before
 
 
 @njit(cache=True)
 def covariance_recursion(
     fisher: FloatArray,
-    growth: FloatArray,
+    steps: FloatArray,
     white: FloatArray,
     initial_variance: float,
+    drift_variance: float,
 ) -> FloatArray:  # pragma: no cover - compiled
     r"""Covariances ``(K + 1, 3)`` after updates ``0..K`` (``fisher`` ``(K + 1, 3)``).
 
-    Update 0 adds ``fisher[0]`` to the prior :math:`I / \sigma_0^2`; step ``k`` grows by
-    ``growth[k - 1]``, ``white[k - 1]`` and adds ``fisher[k]``.
+    Update 0 adds ``fisher[0]`` to the prior :math:`I / \sigma_0^2`; step ``k`` flies
+    ``steps[k - 1]`` metres, adds ``white[k - 1]`` and ``fisher[k]``.
     """
     n = fisher.shape[0]
     out = np.empty((n, 3))
@@ -73,9 +92,10 @@ def covariance_recursion(
     j11 = 1.0 / initial_variance + fisher[0, 2]
     det_j = j00 * j11 - j01 * j01
     out[0, 0], out[0, 1], out[0, 2] = j11 / det_j, 0.0 - j01 / det_j, j00 / det_j
+    grown = 0.0
     for k in range(1, n):
-        out[k, 0], out[k, 1], out[k, 2] = propagate(
-            out[k - 1, 0], out[k - 1, 1], out[k - 1, 2], growth[k - 1], white[k - 1],
-            fisher[k, 0], fisher[k, 1], fisher[k, 2],
+        out[k, 0], out[k, 1], out[k, 2], grown = propagate(
+            out[k - 1, 0], out[k - 1, 1], out[k - 1, 2], grown, drift_variance, steps[k - 1],
+            white[k - 1], fisher[k, 0], fisher[k, 1], fisher[k, 2],
         )  # fmt: skip
     return out

@@ -78,6 +78,7 @@ def posterior_crb(
         np.zeros(positions.shape[0] - 1),
         np.asarray(process_sigma, dtype=np.float64) ** 2,
         float(initial_sigma) ** 2,
+        0.0,
     )
     return unpack_covariance(packed)
 

@@ -7,12 +7,14 @@ covariance :math:`P` of the position error (north, east) follows
 
 .. math::
 
-    P^- = \left(\sqrt{P} + \sigma_b d_k I\right)^2 + q_k I, \qquad
+    P^- = P + \max\left(\sigma_b^2 \left((d + \ell_k)^2 - d^2\right), q_k\right) I, \qquad
     P^+ = \left((P^-)^{-1} + \sum_j \frac{\nabla h_j \nabla h_j^\top}{r_j}\right)^{-1},
 
-* :math:`\sigma_b d_k`: the dead-reckoning drift over the step of length :math:`d_k` [m]; the
-  DVL scale and heading biases of :class:`~auvplan.navigation.DeadReckoningModel` make the
-  error of a straight leg grow linearly, :math:`\sigma_b D` per axis (CEP = ``drift`` × D);
+* :math:`\sigma_b`: the DVL scale and heading biases of
+  :class:`~auvplan.navigation.DeadReckoningModel` make the error of a straight leg grow
+  linearly, :math:`\sigma_b D` per axis (CEP = ``drift`` × D); :math:`d` is the distance
+  flown since the last fixes (shrunk with the error by each fix), :math:`\ell_k` the step
+  (details in :mod:`~auvplan.navigation._prediction_kernel`);
 * :math:`q_k`: the filter's own process variance per update
   (:func:`~auvplan.navigation.process_noise_sigma`, MB-System's rule) — the rate at which the
   filter forgets, which bounds its accuracy over informative terrain;
@@ -103,8 +105,9 @@ def predict_error(
 
     Examples
     --------
-    Over a flat seabed the error grows at the drift rate, :math:`\sqrt 2 (\sigma_0 +
-    \sigma_b D)` radially (here without the filter's process noise):
+    Over a flat seabed the error grows at the drift rate, as dead reckoning's,
+    :math:`\sqrt{2 (\sigma_0^2 + \sigma_b^2 D^2)}` radially (here without the filter's
+    process noise):
 
     >>> from auvplan.navigation import DeadReckoningModel, ParticleFilterOptions
     >>> grid = BathymetryGrid(np.full((50, 50), 40.0), GridGeometry(50, 50, 100.0, 100.0))
@@ -116,7 +119,7 @@ def predict_error(
     ...               np.full(5, np.pi / 2))
     >>> prediction = predict_error(grid, track, settings)
     >>> bias = settings.motion.bias_sigma
-    >>> bool(np.isclose(prediction.sigma[-1], np.sqrt(2.0) * (5.0 + bias * 3000.0)))
+    >>> bool(np.isclose(prediction.sigma[-1], np.sqrt(2.0 * (25.0 + (bias * 3000.0) ** 2))))
     True
     """
     samples = track.sampled(settings.update_period)
@@ -126,9 +129,10 @@ def predict_error(
     steps = np.diff(positions, axis=0)
     packed = covariance_recursion(
         fisher[:, [0, 0, 1], [0, 1, 1]],
-        settings.motion.bias_sigma * np.hypot(steps[:, 0], steps[:, 1]),
+        np.hypot(steps[:, 0], steps[:, 1]),
         process_noise_sigma(settings.motion, steps) ** 2,
         settings.filter.initial_sigma**2,
+        settings.motion.bias_sigma**2,
     )
     return ErrorPrediction(samples.time, positions, unpack_covariance(packed))
 

@@ -1,8 +1,9 @@
 r"""Numba kernel of the belief-space search: labels (cost, covariance) on a padded 8-grid.
 
 A label is a path prefix ending at a cell, with its graph cost ``g``, the predicted position
-covariance ``P`` at its end (``p00, p01, p11`` [m²], the recursion of
-:mod:`auvplan.navigation._prediction_kernel` applied move by move), the distance travelled
+covariance ``P`` at its end (``p00, p01, p11`` [m²] and the variance ``V`` dead reckoning has
+added since the fixes: the recursion of :mod:`auvplan.navigation._prediction_kernel` applied
+move by move), the distance travelled
 [m] and the peak radial error after the settling distance. Its bin is
 ``min(⌊σ / Δσ⌋, n_bins − 1)`` with :math:`\sigma = \sqrt{\operatorname{tr} P}`.
 
@@ -17,8 +18,8 @@ After the settling distance a move whose predicted σ exceeds ``max_error`` is n
 
 A move ``u → v`` of length ℓ [m] with the move factor ``f`` (e.g. the time ratio in a
 current) costs ``ℓ f (c_u + c_v) / 2 + λ ℓ (σ_u² + σ_v²) / 2`` and takes
-``n = ℓ · updates_per_metre`` TAN updates: drift growth ``σ_b ℓ``, white variance
-``n q`` and information ``n (F_u + F_v) / 2``.
+``n = ℓ · updates_per_metre`` TAN updates: drift over ℓ, white variance ``n q`` and
+information ``n (F_u + F_v) / 2``.
 """
 
 from __future__ import annotations
@@ -30,12 +31,41 @@ from numba import njit
 
 from auvplan._typing import FloatArray, IntArray
 from auvplan.navigation._prediction_kernel import propagate
-from auvplan.planning._kernel import _moves
 
-#: Columns of the label table: cost, p00, p01, p11, distance, peak.
-_G, _P00, _P01, _P11, _DIST, _PEAK = 0, 1, 2, 3, 4, 5
+#: Columns of the label table: cost, p00, p01, p11, variance grown since the fixes, distance,
+#: peak.
+_G, _P00, _P01, _P11, _GROWN, _DIST, _PEAK = 0, 1, 2, 3, 4, 5, 6
 #: Exit codes of :func:`belief_search`.
 FOUND, UNREACHABLE, TOO_MANY_LABELS = 0, 1, 2
+
+
+@njit(cache=True)
+def moves(
+    width: int, spacing_north: float, spacing_east: float, n_moves: int
+) -> tuple[IntArray, IntArray, FloatArray]:  # pragma: no cover - compiled
+    """Flat offsets, the offsets of the cells each move crosses, and lengths [m].
+
+    The 8 king moves in the order of :data:`~auvplan.planning.problem.MOVES` (crossing only
+    the cell entered), then, with ``n_moves = 16``, the 8 knight moves, each crossing the two
+    cells beside its segment's midpoint (both must be passable).
+    """
+    d_row = np.array([-1, -1, -1, 0, 0, 1, 1, 1, -2, -2, -1, -1, 1, 1, 2, 2], np.int64)
+    d_col = np.array([-1, 0, 1, -1, 1, -1, 0, 1, -1, 1, -2, 2, -2, 2, -1, 1], np.int64)
+    offsets = d_row[:n_moves] * width + d_col[:n_moves]
+    crossed = np.empty((n_moves, 2), np.int64)
+    length = np.empty(n_moves)
+    for k in range(n_moves):
+        length[k] = math.hypot(d_row[k] * spacing_north, d_col[k] * spacing_east)
+        if k < 8:
+            crossed[k, 0] = crossed[k, 1] = offsets[k]
+        else:  # the cells at half the long step, beside the segment
+            half_row = d_row[k] // 2 if abs(d_row[k]) == 2 else 0
+            half_col = d_col[k] // 2 if abs(d_col[k]) == 2 else 0
+            crossed[k, 0] = half_row * width + half_col
+            crossed[k, 1] = (half_row + (d_row[k] if half_row == 0 else 0)) * width + (
+                half_col + (d_col[k] if half_col == 0 else 0)
+            )
+    return offsets, crossed, length
 
 
 @njit(cache=True)
@@ -111,10 +141,11 @@ def belief_search(
     spacing_east: float,
     factor: FloatArray,
     factor_stride: int,
+    n_moves: int,
     heuristic: FloatArray,
     fisher: FloatArray,
     updates_per_metre: float,
-    drift_rate: float,
+    drift_variance: float,
     process_variance: float,
     initial_variance: float,
     max_error: float,
@@ -125,16 +156,18 @@ def belief_search(
     bottleneck: bool,
     max_labels: int,
 ) -> tuple[int, IntArray, FloatArray, float, float, int]:  # pragma: no cover - compiled
-    """Search from ``start`` to ``goal`` (flat padded cells; module notes).
+    """Search from ``start`` to ``goal`` (flat cells of a grid padded by 2; module notes).
 
     ``cost``, ``heuristic`` ``(n_padded,)``; ``fisher`` ``(n_padded, 3)`` per update;
-    ``factor`` ``(8, ·)`` with ``factor_stride``. Returns the exit code, the path's cells and
-    its σ at each cell, its cost and peak error after settling, and the labels created.
+    ``factor`` ``(8, ·)`` with ``factor_stride`` for the king moves (knight moves only
+    without factors: ``n_moves`` 8 or 16, :func:`moves`). Returns the exit code, the path's
+    cells and its σ at each cell, its cost and peak error after settling, and the labels
+    created.
     """
-    offsets, _, _, length = _moves(width, spacing_north, spacing_east)
+    offsets, crossed, length = moves(width, spacing_north, spacing_east, n_moves)
     closed = np.full(cost.shape[0], n_bins, np.int32)
     capacity = 1024
-    table = np.empty((capacity, 6))
+    table = np.empty((capacity, 7))
     cells = np.empty(capacity, np.int64)
     parents = np.empty(capacity, np.int64)
     keys = np.empty(capacity)
@@ -145,7 +178,7 @@ def belief_search(
     j01 = f0[1]
     j11 = 1.0 / initial_variance + f0[2]
     det = j00 * j11 - j01 * j01
-    table[0, _G], table[0, _DIST], table[0, _PEAK] = 0.0, 0.0, 0.0
+    table[0, _G], table[0, _GROWN], table[0, _DIST], table[0, _PEAK] = 0.0, 0.0, 0.0, 0.0
     table[0, _P00], table[0, _P01], table[0, _P11] = j11 / det, -j01 / det, j00 / det
     cells[0], parents[0] = start, -1
     n_labels = 1
@@ -165,18 +198,23 @@ def belief_search(
         if u == goal:
             found = label
             break
-        for k in range(8):
+        for k in range(n_moves):
             v = u + offsets[k]
             c_v = cost[v]
-            move = factor[k, v * factor_stride]
+            move = factor[k, v * factor_stride] if k < 8 else 1.0
             if not (math.isfinite(c_v) and math.isfinite(move)):
+                continue
+            if not (
+                math.isfinite(cost[u + crossed[k, 0]]) and math.isfinite(cost[u + crossed[k, 1]])
+            ):
                 continue
             ell = length[k]
             n_updates = ell * updates_per_metre
             f_v = fisher[v]
             f_u = fisher[u]
-            p00, p01, p11 = propagate(
-                row[_P00], row[_P01], row[_P11], drift_rate * ell, n_updates * process_variance,
+            p00, p01, p11, grown = propagate(
+                row[_P00], row[_P01], row[_P11], row[_GROWN], drift_variance, ell,
+                n_updates * process_variance,
                 0.5 * n_updates * (f_u[0] + f_v[0]), 0.5 * n_updates * (f_u[1] + f_v[1]),
                 0.5 * n_updates * (f_u[2] + f_v[2]),
             )  # fmt: skip
@@ -203,6 +241,7 @@ def belief_search(
                 items = _grow(items, heap)
             table[n_labels, _G], table[n_labels, _DIST], table[n_labels, _PEAK] = g, distance, peak
             table[n_labels, _P00], table[n_labels, _P01], table[n_labels, _P11] = p00, p01, p11
+            table[n_labels, _GROWN] = grown
             cells[n_labels], parents[n_labels] = v, label
             key = peak * 1e9 + g if bottleneck else g + heuristic[v]
             _push(keys, items, heap, key, n_labels)

@@ -7,6 +7,7 @@ both as cells of the cost grid and as world points.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -15,6 +16,7 @@ import numpy as np
 from auvplan._typing import BoolArray, FloatArray, IntArray
 from auvplan.errors import InfeasibleError, InputError
 from auvplan.planning.astar import plan_astar
+from auvplan.planning.belief import BeliefModel, search_belief
 from auvplan.planning.obstacles import (
     CircleObstacle,
     PolygonObstacle,
@@ -48,6 +50,10 @@ class Route:
         Vehicle name.
     edge_model : EdgeModel
         Edge model used.
+    predicted_error : ndarray of shape (n_cells,), optional
+        Predicted 1-σ radial TAN error [m] at each cell (belief-space routes).
+    peak_error : float, optional
+        Its largest value after the settling distance [m].
     """
 
     cells: IntArray
@@ -58,6 +64,8 @@ class Route:
     n_expanded: int
     name: str
     edge_model: EdgeModel
+    predicted_error: FloatArray | None = None
+    peak_error: float | None = None
 
     @property
     def success(self) -> bool:
@@ -154,6 +162,8 @@ def plan_route(
     edge_model: EdgeModel = EdgeModel.PAPER,
     move_factor: FloatArray | None = None,
     name: str = "vehicle",
+    belief: BeliefModel | None = None,
+    bottleneck: bool = False,
 ) -> Route:
     r"""Optimal 8-connected route of one vehicle from ``start`` to ``goal`` on a cost map.
 
@@ -176,6 +186,12 @@ def plan_route(
         e.g. :func:`auvplan.mission.current.current_move_factor`.
     name : str
         Vehicle name used in error messages and stored in the result.
+    belief : BeliefModel, optional
+        Search the belief space instead (:func:`~auvplan.planning.belief.search_belief`, on
+        the crossed edge model with ``cost`` as the per-metre energy proxy): the cheapest route
+        whose predicted TAN error meets the model's budget.
+    bottleneck : bool
+        With ``belief``: the route of the smallest peak predicted error instead.
 
     Returns
     -------
@@ -188,6 +204,8 @@ def plan_route(
     InfeasibleError
         Start/goal on land or no-data, inside an obstacle or within ``clearance`` of one, or
         goal unreachable. Every message is one line that names the vehicle.
+    BudgetInfeasible
+        With ``belief``: the goal is reachable, but not within its navigation budget.
 
     Examples
     --------
@@ -217,7 +235,14 @@ def plan_route(
         )
     except InputError as error:
         raise InputError(f"{name}: {error}") from error
-    result = plan_astar(problem, edge_model=edge_model)
+    sigma, peak = None, None
+    if belief is None:
+        result = plan_astar(problem, edge_model=edge_model)
+    else:
+        found = search_belief(problem, belief, bottleneck=bottleneck)
+        result, sigma, peak = found.path, found.sigma, found.peak
+        if not result.success and math.isfinite(belief.max_error) and not bottleneck:
+            raise BudgetInfeasible(f"{name}: {result.message}")
     if not result.success:
         raise InfeasibleError(
             f"{name}: goal ({goal[0]:g}, {goal[1]:g}) m is unreachable from start "
@@ -238,8 +263,14 @@ def plan_route(
         f"{name}: {result.message}",
         result.n_expanded,
         name,
-        edge_model,
+        EdgeModel.CROSSED if belief is not None else edge_model,
+        sigma,
+        peak,
     )
+
+
+class BudgetInfeasible(InfeasibleError):
+    """The goal is reachable, but no route keeps the predicted TAN error within the budget."""
 
 
 def _check_shape(cost: FloatArray, geometry: GridGeometry) -> FloatArray:

@@ -1,0 +1,271 @@
+r"""Navigation-aware pre-planning of a mission: what navigation a route buys, and its price.
+
+Each vehicle's route comes from the belief-space search (:mod:`auvplan.planning.belief`) on
+the mission's ``[navigation]`` model (:class:`~auvplan.mission.tables.NavigationConfig`, the
+same model ``auvplan evaluate`` flies). Its edges cost length (times the current's time
+ratio): the energy-only route is the shortest. The predicted error is the information
+recursion of :mod:`auvplan.navigation.prediction` at the vehicle's nominal speed ``U``
+(``U T`` metres between TAN updates; the budget applies after ``settle_s · U`` metres).
+
+* **Budget** (``max_error_m`` given): the cheapest route whose predicted 1-σ radial error
+  stays within it; if none, :class:`~auvplan.errors.InfeasibleError` names where the
+  cheapest route breaks the budget and the smallest budget any route meets.
+* **Automatic** (no ``max_error_m``): budgets are tried on a geometric ladder from the
+  energy-only route's peak error down to the smallest feasible one; the route with the lowest
+  predicted RMS error whose energy exceeds the energy-only route's by at most
+  ``max_energy_increase`` is taken, if it cuts the predicted RMS error by at least
+  ``min_error_reduction`` — otherwise the energy-only route. Energy of a route of length
+  ``L``: ``P(L / T) T`` with a fixed horizon ``T`` (faster on a longer route), ``e(U) L``
+  at a cruise speed (``P`` the vehicle's steady power, ``e`` its energy per metre).
+
+``weights.navigation`` [W/m²] adds ``λ σ² / U`` joules per metre to every edge (a soft
+price on the predicted error variance, integrated over time).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, Final
+
+import numpy as np
+
+from auvplan._typing import FloatArray
+from auvplan.errors import InfeasibleError
+from auvplan.navigation import process_noise_sigma
+from auvplan.navigation.prediction import fisher_map
+from auvplan.planning import Route
+from auvplan.planning.belief import BeliefModel
+from auvplan.planning.route import BudgetInfeasible
+from auvplan.terrain import TerrainMaps
+from auvplan.vehicle import VehicleModel
+from auvplan.vehicle.trim import energy_per_metre, top_speed, trim_surge
+
+logger = logging.getLogger(__name__)
+
+#: Budgets tried by the automatic mode between the energy-only peak and the smallest feasible.
+LADDER_STEPS: Final = 6
+
+#: One search: a belief model (None: plain A*) and whether to minimise the peak error.
+RouteSearch = Callable[[BeliefModel, bool], Route]
+
+
+@dataclass(frozen=True)
+class NavigationChoice:
+    """How a vehicle's route was chosen, and what it predicts (errors in metres).
+
+    ``mode``: ``"budget"`` or ``"automatic"``; ``budget_m``: the budget the route meets
+    (None: the energy-only route); ``peak_m`` / ``rms_m``: predicted peak error after settling
+    and RMS error along the route; ``energy_only_*``: the same for the shortest route;
+    ``energy_increase``: predicted extra energy of the route (fraction); ``searches``: the
+    searches run.
+    """
+
+    mode: str
+    budget_m: float | None
+    peak_m: float
+    rms_m: float
+    energy_only_peak_m: float
+    energy_only_rms_m: float
+    energy_increase: float
+    searches: int
+
+    def document(self) -> dict[str, Any]:
+        """The ``summary.json`` entry."""
+        return {
+            "mode": self.mode,
+            "budget_m": self.budget_m,
+            "route_predicted_peak_m": self.peak_m,
+            "route_predicted_rms_m": self.rms_m,
+            "energy_only_route_predicted_peak_m": self.energy_only_peak_m,
+            "energy_only_route_predicted_rms_m": self.energy_only_rms_m,
+            "route_energy_increase": self.energy_increase,
+            "searches": self.searches,
+        }
+
+
+@dataclass(frozen=True)
+class VehicleNavigation:
+    """One vehicle's belief model (no budget) and route energy, to choose its route."""
+
+    name: str
+    model: BeliefModel
+    energy: Callable[[float], float]
+    max_error: float | None
+    max_energy_increase: float
+    min_error_reduction: float
+
+    def route(self, search: RouteSearch) -> tuple[Route, NavigationChoice]:
+        """The vehicle's route by its budget or automatically (module notes)."""
+        cheapest = search(self.model, False)
+        base_energy = self.energy(route_length(cheapest))
+        base_peak, base_rms = _peak(cheapest), route_rms(cheapest)
+        searches = 1
+
+        def choice(route: Route, mode: str, budget: float | None) -> NavigationChoice:
+            increase = self.energy(route_length(route)) / base_energy - 1.0
+            return NavigationChoice(
+                mode, budget, _peak(route), route_rms(route), base_peak, base_rms, increase,
+                searches,
+            )  # fmt: skip
+
+        if self.max_error is not None:
+            if base_peak <= self.max_error:
+                return cheapest, choice(cheapest, "budget", self.max_error)
+            try:
+                route = search(self.with_budget(self.max_error), False)
+            except BudgetInfeasible:
+                raise InfeasibleError(self._budget_message(cheapest, search)) from None
+            searches += 1
+            return route, choice(route, "budget", self.max_error)
+        floor = _peak(search(self.model, True))
+        searches += 1
+        best, best_budget = cheapest, None
+        if floor < base_peak * (1.0 - self.min_error_reduction):
+            for budget in np.geomspace(base_peak, floor, LADDER_STEPS + 1)[1:]:
+                try:
+                    route = search(self.with_budget(float(budget) + self.model.bin_width), False)
+                except BudgetInfeasible:
+                    continue
+                finally:
+                    searches += 1
+                energy = self.energy(route_length(route))
+                fits = energy <= (1.0 + self.max_energy_increase) * base_energy
+                if fits and route_rms(route) < route_rms(best):
+                    best, best_budget = route, float(budget) + self.model.bin_width
+        if route_rms(best) > (1.0 - self.min_error_reduction) * base_rms:
+            best, best_budget = cheapest, None
+        return best, choice(best, "automatic", best_budget)
+
+    def with_budget(self, budget: float) -> BeliefModel:
+        """The model with a budget [m]."""
+        return BeliefModel(
+            self.model.fisher, self.model.updates_per_metre, self.model.drift_rate,
+            self.model.process_variance, self.model.initial_sigma, budget,
+            self.model.settle_distance, self.model.error_weight, self.model.bin_width,
+            self.model.max_labels,
+        )  # fmt: skip
+
+    def _budget_message(self, cheapest: Route, search: RouteSearch) -> str:
+        """One line: where the cheapest route breaks the budget, and the smallest budget."""
+        assert cheapest.predicted_error is not None
+        assert self.max_error is not None
+        steps = np.hypot(*np.diff(cheapest.points, axis=0).T)
+        distance = np.concatenate([[0.0], np.cumsum(steps)])
+        late = distance > self.model.settle_distance
+        late &= cheapest.predicted_error > self.max_error
+        where = int(np.argmax(late))
+        floor = _peak(search(self.model, True))
+        north, east = cheapest.points[where]
+        return (
+            f"vehicle {self.name}: no route keeps the predicted navigation error within "
+            f"navigation.max_error_m = {self.max_error:g} m; the shortest route exceeds it "
+            f"{distance[where]:.0f} m from the start (north {north:.0f} m, east {east:.0f} m), "
+            f"and the smallest budget any route meets is {math.ceil(floor * 10) / 10:g} m "
+            "(raise max_error_m or settle_s)"
+        )
+
+
+def route_length(route: Route) -> float:
+    """Length [m] of a route's polyline."""
+    return float(np.sum(np.hypot(*np.diff(route.points, axis=0).T)))
+
+
+def route_rms(route: Route) -> float:
+    """RMS of a route's predicted error [m], weighted by the length flown at each cell."""
+    assert route.predicted_error is not None
+    steps = np.hypot(*np.diff(route.points, axis=0).T)
+    weights = np.concatenate([[0.0], steps]) + np.concatenate([steps, [0.0]])
+    if not np.any(weights > 0.0):
+        return float(route.predicted_error[0])
+    return float(np.sqrt(np.average(route.predicted_error**2, weights=weights)))
+
+
+def _peak(route: Route) -> float:
+    assert route.peak_error is not None
+    return route.peak_error
+
+
+def vehicle_navigation(
+    maps: TerrainMaps,
+    navigation: Any,
+    names: tuple[str, ...],
+    models: tuple[VehicleModel, ...] | list[VehicleModel],
+    straight: FloatArray,
+    *,
+    horizon: float | None,
+    cruise_speed: float | None,
+    vehicle_depth: float,
+    weight: float,
+) -> tuple[VehicleNavigation, ...]:
+    """The :class:`VehicleNavigation` of each vehicle.
+
+    Parameters
+    ----------
+    maps : TerrainMaps
+        The mission's maps (the cost grid is the search grid).
+    navigation : NavigationConfig
+        The mission's ``[navigation]`` table.
+    names, models : sequence
+        The vehicles and their models.
+    straight : ndarray of shape (n_vehicles,)
+        Straight start-goal distances [m].
+    horizon, cruise_speed : float or None
+        ``fleet.horizon_s`` [s] or ``fleet.cruise_speed`` [m/s] (neither: each vehicle's
+        energy-optimal cruise speed).
+    vehicle_depth : float
+        Depth of the plan [m] (the altimeter's range is the seabed below it).
+    weight : float
+        ``weights.navigation`` [W/m²].
+    """
+    settings = navigation.settings(vehicle_depth=vehicle_depth)
+    fisher = fisher_map(maps.bathymetry, maps.cost_geometry, settings.sensor)
+    vehicles = []
+    for name, model, distance in zip(names, models, straight, strict=True):
+        fastest = top_speed(model)
+        if horizon is not None:
+            speed = min(max(float(distance) / horizon, 0.05), fastest)
+            energy = _horizon_energy(model, horizon, fastest)
+        else:
+            from auvplan.vehicle import optimal_cruise_speed
+
+            speed = cruise_speed if cruise_speed is not None else optimal_cruise_speed(model).speed
+            per_metre = energy_per_metre(model, speed)
+            energy = _cruise_energy(per_metre)
+        step = speed * settings.update_period
+        process = float(process_noise_sigma(settings.motion, np.array([[step, 0.0]]))[0] ** 2)
+        model_nav = BeliefModel(
+            fisher,
+            updates_per_metre=1.0 / step,
+            drift_rate=settings.motion.bias_sigma,
+            process_variance=process,
+            initial_sigma=settings.filter.initial_sigma,
+            settle_distance=navigation.settle * speed,
+            error_weight=weight / (speed * energy_per_metre(model, speed)),
+        )
+        vehicles.append(
+            VehicleNavigation(
+                name, model_nav, energy, navigation.max_error, navigation.max_energy_increase,
+                navigation.min_error_reduction,
+            )
+        )  # fmt: skip
+    return tuple(vehicles)
+
+
+def _horizon_energy(
+    model: VehicleModel, horizon: float, fastest: float
+) -> Callable[[float], float]:
+    """Energy [J] of a route of length ``L`` [m] flown in ``horizon`` [s]: ``P(L/T) T``."""
+
+    def energy(length: float) -> float:
+        speed = length / horizon
+        return trim_surge(model, speed).power * horizon if speed <= fastest else math.inf
+
+    return energy
+
+
+def _cruise_energy(per_metre: float) -> Callable[[float], float]:
+    """Energy [J] of a route of length ``L`` [m] at a cruise speed: ``e L``."""
+    return lambda length: per_metre * length
