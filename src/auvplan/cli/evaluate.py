@@ -44,33 +44,43 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
 
 
 def add_navigation_options(parser: argparse.ArgumentParser) -> None:
-    """The navigation system's options, shared by ``evaluate`` and ``sweep --evaluate``."""
+    """The navigation system's options, shared by ``evaluate`` and ``sweep --evaluate``.
+
+    The navigation model's flags default to the plan's ``[navigation]`` table (its defaults
+    when the mission has none) and override it when given.
+    """
     parser.add_argument(
         "--runs", type=int, default=100, help="Monte-Carlo runs per vehicle and plan (default 100)"
     )
     parser.add_argument(
         "--sensor",
         choices=("altimeter", "multibeam"),
-        default="altimeter",
-        help="depth sensor (default altimeter; multibeam: 11 beams over 90 degrees)",
+        default=None,
+        help="depth sensor (default: the mission's navigation.sensor, altimeter; multibeam: "
+        "11 beams over 90 degrees)",
     )
     parser.add_argument(
         "--particles", type=int, default=5000, help="particles per filter (default 5000)"
     )
     parser.add_argument(
-        "--update-period", type=float, default=3.0, help="seconds between updates (default 3)"
+        "--update-period",
+        type=float,
+        default=None,
+        help="seconds between updates (default: the mission's navigation.update_period_s, 3)",
     )
     parser.add_argument(
         "--initial-sigma",
         type=float,
-        default=7.0,
-        help="initial position error, standard deviation per axis [m] (default 7)",
+        default=None,
+        help="initial position error, standard deviation per axis [m] (default: the "
+        "mission's navigation.initial_sigma_m, 7)",
     )
     parser.add_argument(
         "--drift",
         type=float,
-        default=1.0,
-        help="dead-reckoning drift, CEP in %% of distance travelled (default 1)",
+        default=None,
+        help="dead-reckoning drift, CEP in %% of distance travelled (default: the mission's "
+        "navigation.drift_percent, 1)",
     )
     parser.add_argument(
         "--convergence-updates",
@@ -82,9 +92,12 @@ def add_navigation_options(parser: argparse.ArgumentParser) -> None:
 
 
 def navigation_options(
-    args: argparse.Namespace, *, seed: int, threads: int | None = None
+    args: argparse.Namespace, *, seed: int, threads: int | None = None, folder: Path | None = None
 ) -> NavigationOptions:
     """The :class:`~auvplan.sweep.NavigationOptions` of :func:`add_navigation_options`'s args.
+
+    The model is ``folder``'s ``[navigation]`` table (defaults without a folder) with the
+    flags given on top (:func:`auvplan.mission.folder.folder_navigation`).
 
     Raises
     ------
@@ -92,21 +105,22 @@ def navigation_options(
         If ``--runs`` is below 1 or a model value is out of its range.
     """
     from auvplan.errors import InputError
-    from auvplan.navigation import (
-        DeadReckoningModel,
-        NavigationSettings,
-        ParticleFilterOptions,
-        SensorModel,
-    )
+    from auvplan.mission.folder import folder_navigation
     from auvplan.sweep.navigation import NavigationOptions
 
     if args.runs < 1:
         raise InputError(f"--runs must be >= 1, got {args.runs}")
-    settings = NavigationSettings(
-        sensor=SensorModel.named(args.sensor),
-        motion=DeadReckoningModel(drift_fraction=args.drift / 100.0),
-        filter=ParticleFilterOptions(n_particles=args.particles, initial_sigma=args.initial_sigma),
-        update_period=args.update_period,
+    flags = {
+        "sensor": args.sensor,
+        "update_period_s": args.update_period,
+        "initial_sigma_m": args.initial_sigma,
+        "drift_percent": args.drift,
+    }
+    overrides = {key: value for key, value in flags.items() if value is not None}
+    table, depth = folder_navigation(folder, overrides)
+    settings = table.settings(
+        vehicle_depth=depth,
+        particles=args.particles,
         convergence_updates=args.convergence_updates,
     )
     return NavigationOptions(settings, n_runs=args.runs, seed=seed, threads=threads)
@@ -119,8 +133,8 @@ def run(args: argparse.Namespace) -> int:
     from auvplan.io.results import write_json
     from auvplan.sweep.navigation import evaluate_folder
 
-    options = navigation_options(args, seed=args.seed)
     folder = read_plan_folder(args.output)
+    options = navigation_options(args, seed=args.seed, folder=args.output)
     n_tracks = sum(len(vehicles) for vehicles in folder.plans.values())
     with _progress(n_tracks * args.runs, args.runs, quiet=args.quiet) as progress:
         navigation = evaluate_folder(folder, options, progress=progress)

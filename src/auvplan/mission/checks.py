@@ -3,9 +3,12 @@
 The optimiser imposes its constraints at the solver nodes; here they are checked on the plan
 flown with its tracking regulator on a grid ``CHECK_REFINEMENT`` times finer
 (:mod:`auvplan.mission.evaluation`): separation ``>= 2 r_c`` between vehicles, clearance
-``>= r_c`` from every obstacle's edge, communication ranges, and arrival within
-``ARRIVAL_TOLERANCE`` of the goal. Each violation names the vehicles or obstacle, the worst
-value and when, and a change to the mission that would help.
+``>= r_c`` from every obstacle's edge, communication ranges, arrival within
+``ARRIVAL_TOLERANCE`` of the goal and, with an explicit ``navigation.max_error_m``, the
+predicted TAN error along the flown track within the budget after ``settle_s`` (with
+``NAVIGATION_TOLERANCE`` for the pre-planner's quantisation of the error and the tracking).
+Each violation names the vehicles or obstacle, the worst value and when, and a change to the
+mission that would help.
 """
 
 from __future__ import annotations
@@ -18,12 +21,17 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.mission.config import MissionConfig
+from auvplan.mission.navigation import budget_of
+from auvplan.navigation.prediction import ErrorPrediction
 from auvplan.optimization import ProntoResult
 
 #: Slack [m] allowed on distance limits for round-off between the plan and its replay.
 DISTANCE_TOLERANCE: Final = 1e-3
 #: Largest distance [m] from the goal at the horizon that still counts as arrived.
 ARRIVAL_TOLERANCE: Final = 2.0
+#: Relative slack on the navigation budget: the pre-planner's error bins (0.5 m) and the
+#: optimiser's freedom to cut the route's corners.
+NAVIGATION_TOLERANCE: Final = 0.1
 
 
 class PlanStatus(enum.Enum):
@@ -50,7 +58,7 @@ class Violation:
 
     def describe(self) -> str:
         """One line for the user."""
-        relation = ">" if self.kind == "communication" else "<"
+        relation = ">" if self.kind in ("communication", "navigation error") else "<"
         return (
             f"{self.kind}: {self.who} at {self.value:.2f} m {relation} {self.limit:g} m "
             f"(t = {self.time:.0f} s); {self.advice}"
@@ -86,11 +94,13 @@ def judge_plan(
     fine_time: FloatArray,
     fine_distances: dict[str, FloatArray],
     arrival_error: FloatArray,
+    predicted: tuple[ErrorPrediction, ...] = (),
 ) -> PlanVerdict:
     """Check a plan's constraints on the fine replay and give its verdict.
 
     ``fine_distances`` are labelled ``"a / b"`` (vehicles or a vehicle and an obstacle label);
-    ``arrival_error`` ``(n_vehicles,)`` [m].
+    ``arrival_error`` ``(n_vehicles,)`` [m]; ``predicted`` the predicted TAN error of each
+    vehicle along its replayed track.
     """
     radius = config.fleet.safety_radius
     obstacles = set(config.obstacle_names)
@@ -125,6 +135,15 @@ def judge_plan(
                     advice,
                 )
             )
+    budget = budget_of(config)
+    for name, prediction in zip(names, predicted if budget is not None else (), strict=False):
+        assert budget is not None
+        late = prediction.time - prediction.time[0] >= config.navigation.settle
+        if np.any(late):
+            value, when = _worst(prediction.sigma[late], prediction.time[late], largest=True)
+            if value > budget * (1.0 + NAVIGATION_TOLERANCE):
+                advice = "raise navigation.max_error_m or settle_s, or weights.terrain"
+                violations.append(Violation("navigation error", name, value, budget, when, advice))
     if not result.success:
         status = PlanStatus.NOT_CONVERGED
         message = (

@@ -17,12 +17,14 @@ from auvplan._typing import FloatArray
 from auvplan.mission.checks import PlanVerdict, judge_plan
 from auvplan.mission.config import MissionConfig
 from auvplan.mission.fleet import FleetProblemFunctions
+from auvplan.mission.navigation import predict_tracks
 from auvplan.mission.preplan import PreplanStage
 from auvplan.mission.verify import replay_closed_loop
+from auvplan.navigation.prediction import ErrorPrediction
 from auvplan.optimization import ProntoResult
 from auvplan.planning import distance_to_obstacle
 from auvplan.terrain import TerrainMaps
-from auvplan.vehicle import positions
+from auvplan.vehicle import headings, positions
 
 #: Refinement of the solver grid for the certified-separation resimulation.
 CHECK_REFINEMENT: Final = 10
@@ -41,8 +43,9 @@ class OptimizedPlan:
     tracking regulator on a grid ``CHECK_REFINEMENT`` times finer than the solver's, whose
     time series are ``fine_distances`` (labels ``"a / b"``) on ``fine_time``;
     ``tracking_error`` ``(n_vehicles,)`` is that replay's largest distance [m] from the plan at
-    the solver nodes. ``verdict`` says whether every constraint holds between samples
-    (:func:`auvplan.mission.checks.judge_plan`).
+    the solver nodes. ``predicted_navigation`` is the predicted TAN error along each replayed
+    track (:func:`auvplan.mission.navigation.predict_tracks`). ``verdict`` says whether every
+    constraint holds between samples (:func:`auvplan.mission.checks.judge_plan`).
     """
 
     result: ProntoResult
@@ -57,6 +60,7 @@ class OptimizedPlan:
     fine_time: FloatArray
     fine_distances: dict[str, FloatArray]
     tracking_error: FloatArray
+    predicted_navigation: tuple[ErrorPrediction, ...]
     verdict: PlanVerdict
 
 
@@ -102,6 +106,11 @@ def evaluate_plan(
     fine_time = dt / CHECK_REFINEMENT * np.arange(fine.shape[1], dtype=np.float64)
     tracking_error = np.max(np.linalg.norm(fine[:, ::CHECK_REFINEMENT] - planned, axis=-1), axis=1)
     fine_distances, separations = pairwise_distances(preplan, fine)
+    predicted = predict_tracks(
+        config.navigation, preplan.bathymetry, fine_time, fine,
+        np.stack([headings(model, flown[i]) for i, model in enumerate(models)]),
+        vehicle_depth=config.mission.depth,
+    )  # fmt: skip
     return OptimizedPlan(
         result=result,
         terrain_weight=terrain_weight,
@@ -115,7 +124,10 @@ def evaluate_plan(
         fine_time=fine_time,
         fine_distances=fine_distances,
         tracking_error=tracking_error,
-        verdict=judge_plan(config, preplan.names, result, fine_time, fine_distances, arrival),
+        predicted_navigation=predicted,
+        verdict=judge_plan(
+            config, preplan.names, result, fine_time, fine_distances, arrival, predicted
+        ),
     )
 
 

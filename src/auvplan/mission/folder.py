@@ -16,12 +16,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from pydantic import ValidationError
 
 from auvplan.errors import DataFormatError, InputError
 from auvplan.export.plan import CircleZone, ExportPlan, PolygonZone, VehicleTrack
 from auvplan.io.results import read_trajectories_csv
-from auvplan.io.text import read_json
+from auvplan.io.text import read_json, read_toml
 from auvplan.io.trajectories_file import read_trajectories_netcdf
+from auvplan.mission.tables import NavigationConfig
 
 logger = logging.getLogger(__name__)
 
@@ -136,3 +138,36 @@ def _zone(obstacle: dict[str, Any]) -> CircleZone | PolygonZone:
 
 
 __all__ = ["load_export_plan"]
+
+
+def folder_navigation(
+    folder: Path | None, overrides: dict[str, Any]
+) -> tuple[NavigationConfig, float]:
+    """The ``[navigation]`` table the folder's plan was made with, and the plan's depth [m].
+
+    Read from the folder's ``mission.toml`` (defaults without a folder or when it has no
+    ``mission.toml``), with ``overrides`` (TOML keys of the table, e.g.
+    ``{"drift_percent": 0.5}``) on top, so that ``auvplan evaluate`` flies the navigation the
+    planner predicted.
+
+    Raises
+    ------
+    InputError
+        If a value (of the file or an override) is out of its range; the message names it.
+    DataFormatError
+        If ``mission.toml`` is not valid TOML.
+    """
+    path = None if folder is None else folder / "mission.toml"
+    document = read_toml(path, what="mission file") if path and path.is_file() else {}
+    table = document.get("navigation", {})
+    execution = document.get("mission", {})
+    depth = execution.get("depth_m", 0.0) if isinstance(execution, dict) else 0.0
+    try:
+        config = NavigationConfig.model_validate(
+            {**(table if isinstance(table, dict) else {}), **overrides}
+        )
+    except ValidationError as error:
+        first = error.errors(include_url=False)[0]
+        key = ".".join(str(part) for part in first["loc"])
+        raise InputError(f"navigation.{key}: {first['msg']}, got {first.get('input')!r}") from None
+    return config, float(depth) if isinstance(depth, int | float) else 0.0

@@ -24,6 +24,7 @@ price on the predicted error variance, integrated over time).
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 from collections.abc import Callable
@@ -34,12 +35,12 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InfeasibleError
-from auvplan.navigation import process_noise_sigma
-from auvplan.navigation.prediction import fisher_map
+from auvplan.navigation import Track, process_noise_sigma
+from auvplan.navigation.prediction import ErrorPrediction, fisher_map, predict_error
 from auvplan.planning import Route
 from auvplan.planning.belief import BeliefModel
 from auvplan.planning.route import BudgetInfeasible
-from auvplan.terrain import TerrainMaps
+from auvplan.terrain import BathymetryGrid, TerrainMaps
 from auvplan.vehicle import VehicleModel
 from auvplan.vehicle.trim import energy_per_metre, top_speed, trim_surge
 
@@ -269,3 +270,35 @@ def _horizon_energy(
 def _cruise_energy(per_metre: float) -> Callable[[float], float]:
     """Energy [J] of a route of length ``L`` [m] at a cruise speed: ``e L``."""
     return lambda length: per_metre * length
+
+
+def predict_tracks(
+    navigation: Any,
+    bathymetry: BathymetryGrid,
+    time: FloatArray,
+    tracks: FloatArray,
+    headings: FloatArray,
+    *,
+    vehicle_depth: float,
+) -> tuple[ErrorPrediction, ...]:
+    """The predicted TAN error along each vehicle's flown track (the evaluator's model).
+
+    ``navigation`` is the mission's ``[navigation]`` table; ``time`` ``(n_t,)`` [s],
+    ``tracks`` ``(n_vehicles, n_t, 2)`` north/east [m], ``headings`` ``(n_vehicles, n_t)``
+    [rad]; ``vehicle_depth`` [m] the plan's depth.
+    """
+    settings = navigation.settings(vehicle_depth=vehicle_depth)
+    if time[-1] - time[0] < settings.update_period:  # shorter than one update: the prior
+        settings = dataclasses.replace(settings, update_period=float(time[-1] - time[0]))
+    return tuple(
+        predict_error(bathymetry, Track(time, track, heading), settings)
+        for track, heading in zip(tracks, headings, strict=True)
+    )
+
+
+def budget_of(config: Any) -> float | None:
+    """The mission's explicit navigation budget [m], if its routes are navigation-aware."""
+    if config.planner.edge_model != "navigation":
+        return None
+    budget: float | None = config.navigation.max_error
+    return budget

@@ -20,6 +20,7 @@ from auvplan.mission.evaluation import CHECK_REFINEMENT, OptimizedPlan
 from auvplan.mission.pipeline import MissionResult
 from auvplan.mission.preplan import PreplanStage
 from auvplan.mission.still_water import CurrentComparison
+from auvplan.navigation.prediction import ErrorPrediction
 from auvplan.planning import CircleObstacle, path_length
 from auvplan.terrain import LocalProjection
 
@@ -34,7 +35,16 @@ def _record(record: Any) -> Any:
     return record
 
 
-def _plan_summary(plan: OptimizedPlan, names: tuple[str, ...]) -> dict[str, Any]:
+def _predicted(prediction: ErrorPrediction, settle_s: float) -> dict[str, float]:
+    """A vehicle's predicted TAN error along its flown track [m] (the evaluator's model)."""
+    return {
+        "rms_m": prediction.rms,
+        "peak_after_settle_m": prediction.peak_after(settle_s),
+        "final_m": float(prediction.sigma[-1]),
+    }
+
+
+def _plan_summary(plan: OptimizedPlan, names: tuple[str, ...], settle_s: float) -> dict[str, Any]:
     result = plan.result
     return {
         "terrain_weight": plan.terrain_weight,
@@ -53,6 +63,7 @@ def _plan_summary(plan: OptimizedPlan, names: tuple[str, ...]) -> dict[str, Any]
                 "arrival_error_m": float(plan.arrival_error[i]),
                 "tracking_error_m": float(plan.tracking_error[i]),
                 "min_separation_m": plan.separations[name],
+                "predicted_navigation_error": _predicted(plan.predicted_navigation[i], settle_s),
             }
             for i, name in enumerate(names)
         },
@@ -120,6 +131,7 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> d
     """
     config = result.config
     preplan = result.preplan
+    settle_s = config.navigation.settle
     maps = preplan.maps
     grid = preplan.bathymetry.geometry
     summary: dict[str, Any] = {
@@ -201,17 +213,19 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> d
     if result.failure is not None:
         summary["optimization"] = {"plan_status": "FAILED", "verdict": result.failure}
     if result.plan is not None:
-        summary["optimization"] = _plan_summary(result.plan, preplan.names)
+        summary["optimization"] = _plan_summary(result.plan, preplan.names, settle_s)
     if result.energy_only is not None:
-        summary["energy_only"] = _plan_summary(result.energy_only, preplan.names)
+        summary["energy_only"] = _plan_summary(result.energy_only, preplan.names, settle_s)
     if result.current_comparison is not None:
         summary["current_comparison"] = _comparison_summary(
-            result.current_comparison, preplan.names
+            result.current_comparison, preplan.names, settle_s
         )
     return summary
 
 
-def _comparison_summary(comparison: CurrentComparison, names: tuple[str, ...]) -> dict[str, Any]:
+def _comparison_summary(
+    comparison: CurrentComparison, names: tuple[str, ...], settle_s: float
+) -> dict[str, Any]:
     """``--compare-no-current``: both plans flown in the current (:mod:`.still_water`)."""
     using, still = comparison.using_current, comparison.still_water
     total_using, total_still = float(np.sum(using.energy)), float(np.sum(still.energy))
@@ -222,7 +236,7 @@ def _comparison_summary(comparison: CurrentComparison, names: tuple[str, ...]) -
         "total_energy_still_water_plan_J": total_still,
         "saving_J": comparison.saving,
         "saving_percent": 100.0 * comparison.saving / total_still if total_still > 0 else 0.0,
-        "still_water_plan": _plan_summary(comparison.still_water_plan, names),
+        "still_water_plan": _plan_summary(comparison.still_water_plan, names, settle_s),
         "vehicles": {
             name: {
                 "energy_using_current_J": float(using.energy[i]),

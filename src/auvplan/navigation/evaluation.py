@@ -28,6 +28,7 @@ from auvplan.navigation.montecarlo import (
     Track,
     run_monte_carlo,
 )
+from auvplan.navigation.prediction import ErrorPrediction, predict_error
 from auvplan.terrain import BathymetryGrid
 
 #: Progress callback: ``(plan label, vehicle name, runs finished)``.
@@ -44,10 +45,15 @@ class VehiclePlan:
 
 @dataclass(frozen=True)
 class PlanNavigation:
-    """Monte-Carlo navigation of every vehicle of one plan, and the plan's energy."""
+    """Monte-Carlo navigation of every vehicle of one plan, and the plan's energy.
+
+    ``predictions``: the error the planner's model predicts along each track
+    (:func:`~auvplan.navigation.prediction.predict_error`).
+    """
 
     results: dict[str, MonteCarloResult]
     energy: dict[str, float]
+    predictions: dict[str, ErrorPrediction] = dataclasses.field(default_factory=dict)
 
 
 def evaluate_plans(
@@ -106,7 +112,9 @@ def evaluate_plans(
                 progress=report,
             )
         evaluations[label] = PlanNavigation(
-            results, {name: vehicle.energy for name, vehicle in vehicles.items()}
+            results,
+            {name: vehicle.energy for name, vehicle in vehicles.items()},
+            {name: predict_error(grid, v.track, settings) for name, v in vehicles.items()},
         )
     return evaluations
 
@@ -122,7 +130,9 @@ def navigation_summary(
     """The ``navigation.json`` document.
 
     Per plan: ``energy_J``, ``rmse_m`` (mean over vehicles and runs of the run RMSE) and its
-    spread ``rmse_std_m``, ``dead_reckoning_rmse_m``, ``pcrb_rms_m``, ``convergence_time_s``
+    spread ``rmse_std_m``, ``error_p95_m`` (95th percentile of the error over every run and
+    update), ``predicted_rmse_m`` (the planner's predicted error, RMS along each track,
+    mean over vehicles), ``dead_reckoning_rmse_m``, ``pcrb_rms_m``, ``convergence_time_s``
     (median over the runs that converged), ``converged_fraction``, ``divergence_rate``, and the
     same per vehicle under ``vehicles`` (with percentiles, the final error, mean NEES and ESS).
     With both plans, ``comparison`` holds the RMSE reduction and energy increase of the
@@ -141,12 +151,14 @@ def navigation_summary(
             "terrain_weight": record.get("terrain_weight"),
             "plan_status": record.get("plan_status"),
             **_statistics(list(evaluation.results.values())),
+            **_predicted(list(evaluation.predictions.values())),
             "energy_J": float(sum(evaluation.energy.values())),
             "vehicles": {
                 name: {
                     "energy_J": evaluation.energy[name],
                     "distance_m": result.distance,
                     **_statistics([result]),
+                    **_predicted([evaluation.predictions[name]] if evaluation.predictions else []),
                     **_vehicle_details(result),
                 }
                 for name, result in evaluation.results.items()
@@ -158,9 +170,19 @@ def navigation_summary(
         document["comparison"] = {
             "rmse_reduction": 1.0 - aware["rmse_m"] / energy_only["rmse_m"],
             "energy_increase": aware["energy_J"] / energy_only["energy_J"] - 1.0,
-            "target": "rmse_reduction >= 0.30 at energy_increase <= 0.10 (issue 13)",
+            "target": "rmse_reduction >= 0.30 at energy_increase <= 0.10 (issues 13, 23)",
         }
     return document
+
+
+def _predicted(predictions: list[ErrorPrediction]) -> dict[str, Any]:
+    """The planner's predicted error along the tracks: mean RMS and mean final error [m]."""
+    if not predictions:
+        return {}
+    return {
+        "predicted_rmse_m": float(np.mean([p.rms for p in predictions])),
+        "predicted_final_error_m": float(np.mean([p.sigma[-1] for p in predictions])),
+    }
 
 
 def _statistics(results: list[MonteCarloResult]) -> dict[str, Any]:
@@ -171,6 +193,7 @@ def _statistics(results: list[MonteCarloResult]) -> dict[str, Any]:
     return {
         "rmse_m": float(np.mean(run_rmse)),
         "rmse_std_m": float(np.std(run_rmse)),
+        "error_p95_m": float(np.percentile(np.concatenate([r.error.ravel() for r in results]), 95)),
         "dead_reckoning_rmse_m": float(
             np.mean(np.concatenate([result.dead_reckoning_rmse for result in results]))
         ),
