@@ -159,6 +159,11 @@ def _exit_code(result: Any) -> int:
     if result.failure is not None:
         print(f"auvplan: plan FAILED: {result.failure}", file=sys.stderr)
         return EXIT_NOT_CONVERGED
+    if result.plan is None:  # stopped before stage 3: the routes' navigation budgets
+        for choice in result.preplan.navigation or ():
+            if not choice.budget_met:
+                print(f"auvplan: plan NAVIGATION_BUDGET: {choice.message}", file=sys.stderr)
+                return EXIT_NOT_CONVERGED
     for label, plan in (("plan", result.plan), ("energy-only plan", result.energy_only)):
         if plan is not None and not plan.verdict.success:
             print(

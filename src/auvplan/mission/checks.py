@@ -21,7 +21,7 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.mission.config import MissionConfig
-from auvplan.mission.navigation import budget_of
+from auvplan.mission.navigation import NavigationChoice, budget_of, smallest_budget
 from auvplan.navigation.prediction import ErrorPrediction
 from auvplan.optimization import ProntoResult
 
@@ -95,12 +95,14 @@ def judge_plan(
     fine_distances: dict[str, FloatArray],
     arrival_error: FloatArray,
     predicted: tuple[ErrorPrediction, ...] = (),
+    routes: tuple[NavigationChoice, ...] | None = None,
 ) -> PlanVerdict:
     """Check a plan's constraints on the fine replay and give its verdict.
 
     ``fine_distances`` are labelled ``"a / b"`` (vehicles or a vehicle and an obstacle label);
     ``arrival_error`` ``(n_vehicles,)`` [m]; ``predicted`` the predicted TAN error of each
-    vehicle along its replayed track.
+    vehicle along its replayed track, ``routes`` how each route was chosen (the smallest
+    feasible budget, when the mission's cannot be met).
     """
     radius = config.fleet.safety_radius
     obstacles = set(config.obstacle_names)
@@ -136,14 +138,22 @@ def judge_plan(
                 )
             )
     budget = budget_of(config)
-    for name, prediction in zip(names, predicted if budget is not None else (), strict=False):
+    for i, prediction in enumerate(predicted if budget is not None else ()):
         assert budget is not None
         late = prediction.time - prediction.time[0] >= config.navigation.settle
         if np.any(late):
             value, when = _worst(prediction.sigma[late], prediction.time[late], largest=True)
             if value > budget * (1.0 + NAVIGATION_TOLERANCE):
-                advice = "raise navigation.max_error_m or settle_s, or weights.terrain"
-                violations.append(Violation("navigation error", name, value, budget, when, advice))
+                floor = None if routes is None else routes[i].smallest_budget_m
+                advice = (
+                    "raise navigation.max_error_m or settle_s, or weights.terrain"
+                    if floor is None
+                    else f"no route meets it: the smallest budget any route meets is "
+                    f"{smallest_budget(floor):g} m; raise navigation.max_error_m or settle_s"
+                )
+                violations.append(
+                    Violation("navigation error", names[i], value, budget, when, advice)
+                )
     if not result.success:
         status = PlanStatus.NOT_CONVERGED
         message = (

@@ -126,7 +126,14 @@ def evaluate_plan(
         tracking_error=tracking_error,
         predicted_navigation=predicted,
         verdict=judge_plan(
-            config, preplan.names, result, fine_time, fine_distances, arrival, predicted
+            config,
+            preplan.names,
+            result,
+            fine_time,
+            fine_distances,
+            arrival,
+            predicted,
+            preplan.navigation,
         ),
     )
 

@@ -8,8 +8,9 @@ recursion of :mod:`auvplan.navigation.prediction` at the vehicle's nominal speed
 (``U T`` metres between TAN updates; the budget applies after ``settle_s · U`` metres).
 
 * **Budget** (``max_error_m`` given): the cheapest route whose predicted 1-σ radial error
-  stays within it; if none, :class:`~auvplan.errors.InfeasibleError` names where the
-  cheapest route breaks the budget and the smallest budget any route meets.
+  stays within it. If no route does, the cheapest route within the smallest budget any
+  route meets (its ``smallest_budget_m``), and a warning naming where the shortest route
+  breaks the budget: the plan then fails its check (exit 3) with that smallest budget.
 * **Automatic** (no ``max_error_m``): budgets are tried on a geometric ladder from the
   energy-only route's peak error down to the smallest feasible one; the route with the lowest
   predicted RMS error whose energy exceeds the energy-only route's by at most
@@ -34,7 +35,6 @@ from typing import Any, Final
 import numpy as np
 
 from auvplan._typing import FloatArray
-from auvplan.errors import InfeasibleError
 from auvplan.navigation import Track, process_noise_sigma
 from auvplan.navigation.prediction import ErrorPrediction, fisher_map, predict_error
 from auvplan.planning import Route
@@ -61,7 +61,9 @@ class NavigationChoice:
     (None: the energy-only route); ``peak_m`` / ``rms_m``: predicted peak error after settling
     and RMS error along the route; ``energy_only_*``: the same for the shortest route;
     ``energy_increase``: predicted extra energy of the route (fraction); ``searches``: the
-    searches run.
+    searches run; ``smallest_budget_m``: when no route meets the budget, the smallest one
+    any route meets (the route is then within it), and ``message`` says where the shortest
+    route breaks the budget.
     """
 
     mode: str
@@ -72,6 +74,13 @@ class NavigationChoice:
     energy_only_rms_m: float
     energy_increase: float
     searches: int
+    smallest_budget_m: float | None = None
+    message: str = ""
+
+    @property
+    def budget_met(self) -> bool:
+        """Whether the route meets the mission's budget (always without one)."""
+        return self.smallest_budget_m is None
 
     def document(self) -> dict[str, Any]:
         """The ``summary.json`` entry."""
@@ -84,6 +93,7 @@ class NavigationChoice:
             "energy_only_route_predicted_rms_m": self.energy_only_rms_m,
             "route_energy_increase": self.energy_increase,
             "searches": self.searches,
+            "smallest_feasible_budget_m": self.smallest_budget_m,
         }
 
 
@@ -105,21 +115,29 @@ class VehicleNavigation:
         base_peak, base_rms = _peak(cheapest), route_rms(cheapest)
         searches = 1
 
-        def choice(route: Route, mode: str, budget: float | None) -> NavigationChoice:
+        def choice(
+            route: Route, mode: str, budget: float | None, smallest: float | None = None
+        ) -> NavigationChoice:
             increase = self.energy(route_length(route)) / base_energy - 1.0
+            message = "" if smallest is None else self._budget_message(cheapest, smallest)
             return NavigationChoice(
                 mode, budget, _peak(route), route_rms(route), base_peak, base_rms, increase,
-                searches,
+                searches, smallest, message,
             )  # fmt: skip
 
         if self.max_error is not None:
             if base_peak <= self.max_error:
                 return cheapest, choice(cheapest, "budget", self.max_error)
             try:
+                searches += 1
                 route = search(self.with_budget(self.max_error), False)
             except BudgetInfeasible:
-                raise InfeasibleError(self._budget_message(cheapest, search)) from None
-            searches += 1
+                floor = _peak(search(self.model, True))
+                route = search(self.with_budget(floor + self.model.bin_width), False)
+                searches += 2
+                unmet = choice(route, "budget", self.max_error, floor)
+                logger.info("%s", unmet.message)  # the plan's verdict tells the user
+                return route, unmet
             return route, choice(route, "budget", self.max_error)
         floor = _peak(search(self.model, True))
         searches += 1
@@ -149,7 +167,7 @@ class VehicleNavigation:
             self.model.max_labels,
         )  # fmt: skip
 
-    def _budget_message(self, cheapest: Route, search: RouteSearch) -> str:
+    def _budget_message(self, cheapest: Route, floor: float) -> str:
         """One line: where the cheapest route breaks the budget, and the smallest budget."""
         assert cheapest.predicted_error is not None
         assert self.max_error is not None
@@ -158,15 +176,19 @@ class VehicleNavigation:
         late = distance > self.model.settle_distance
         late &= cheapest.predicted_error > self.max_error
         where = int(np.argmax(late))
-        floor = _peak(search(self.model, True))
         north, east = cheapest.points[where]
         return (
             f"vehicle {self.name}: no route keeps the predicted navigation error within "
             f"navigation.max_error_m = {self.max_error:g} m; the shortest route exceeds it "
             f"{distance[where]:.0f} m from the start (north {north:.0f} m, east {east:.0f} m), "
-            f"and the smallest budget any route meets is {math.ceil(floor * 10) / 10:g} m "
+            f"and the smallest budget any route meets is {smallest_budget(floor):g} m "
             "(raise max_error_m or settle_s)"
         )
+
+
+def smallest_budget(floor: float) -> float:
+    """A route's smallest peak error [m] rounded up to the decimetre, as users are told."""
+    return math.ceil(floor * 10.0) / 10.0
 
 
 def route_length(route: Route) -> float:
