@@ -259,6 +259,7 @@ def plan(
     stage: Stage | str = Stage.FULL,
     compare_energy_only: bool = False,
     compare_no_current: bool = False,
+    compare_paper: bool = False,
     progress: bool = True,
     companion: Companion | None = None,
 ) -> MissionPlan:
@@ -277,6 +278,9 @@ def plan(
     compare_no_current : bool
         With a ``[current]``: also plan as if in still water, fly both plans in the current
         and report the saving (``summary["current_comparison"]``).
+    compare_paper : bool
+        With navigation-aware routes: also plan on the paper's information-map routes
+        (``summary["paper"]``, ``trajectories_paper.csv``).
     progress : bool
         Show progress (:class:`auvplan.api.progress.ConsoleProgress`).
     companion : Companion, optional
@@ -310,6 +314,7 @@ def plan(
             stage=last_stage,
             compare_energy_only=compare_energy_only,
             compare_no_current=compare_no_current,
+            compare_paper=compare_paper,
             callback=None if reporter is None else reporter.iteration,
             progress=stages,
         )

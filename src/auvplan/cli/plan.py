@@ -63,6 +63,13 @@ def _add_common(parser: argparse.ArgumentParser, *, default_output: Path | None)
         help="also optimise without the terrain term (the energy-only reference)",
     )
     parser.add_argument(
+        "--compare-paper",
+        action="store_true",
+        default=default_output is not None,  # the demo shows the paper's plan beside
+        help="with navigation-aware routes (the default planner.edge_model): also plan on the "
+        "paper's information-map routes (trajectories_paper.csv; on by default for demo)",
+    )
+    parser.add_argument(
         "--compare-no-current",
         action="store_true",
         help="with a [current]: also plan as if in still water, fly that plan in the current "
@@ -132,6 +139,7 @@ def _run(config: Any, args: argparse.Namespace) -> int:
             stage=args.stage,
             compare_energy_only=args.compare_energy_only,
             compare_no_current=args.compare_no_current,
+            compare_paper=args.compare_paper,
             progress=not args.quiet,
             companion=companion,
         )
@@ -164,7 +172,9 @@ def _exit_code(result: Any) -> int:
             if not choice.budget_met:
                 print(f"auvplan: plan NAVIGATION_BUDGET: {choice.message}", file=sys.stderr)
                 return EXIT_NOT_CONVERGED
-    for label, plan in (("plan", result.plan), ("energy-only plan", result.energy_only)):
+    paper = None if result.paper is None else result.paper.plan
+    comparisons = (("energy-only plan", result.energy_only), ("paper's plan", paper))
+    for label, plan in (("plan", result.plan), *comparisons):
         if plan is not None and not plan.verdict.success:
             print(
                 f"auvplan: {label} {plan.verdict.status.name}: {plan.verdict.message}",
@@ -194,6 +204,13 @@ def _print_report(result: Any, written: list[Path]) -> None:
                 f"   arrival error {plan.arrival_error[i]:.2f} m   closest {closest:.2f} m",
                 file=out,
             )
+    paper = None if result.paper is None else result.paper.plan
+    if paper is not None:
+        print(
+            f"paper's plan (information-map routes): energy {paper.energy.sum():.1f} J, plan "
+            f"{paper.verdict.status.name}",
+            file=out,
+        )
     comparison = result.current_comparison
     if comparison is not None:
         using, still = comparison.using_current.energy.sum(), comparison.still_water.energy.sum()

@@ -1,4 +1,8 @@
-"""``auvplan scenarios SEED... -o DIR``: write missions of the public seeded scenario family."""
+"""``auvplan scenarios SEED... -o DIR [--kind reliability|transit]``: write seeded missions.
+
+The public seeded scenario family (:func:`auvplan.scenarios.generate`): ``reliability`` (the
+default) or ``transit`` (long transits beside rough features, or over a real grid).
+"""
 
 from __future__ import annotations
 
@@ -35,6 +39,13 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
         help="folder of the real bathymetry grids (default: $AUVPLAN_SHARED_DATA/bathymetry, "
         "else ../shared/data/bathymetry)",
     )
+    parser.add_argument(
+        "--kind",
+        choices=("reliability", "transit"),
+        default="reliability",
+        help="family kind: reliability (varied missions, the default) or transit (1-3 h, "
+        "2-8 km transits of 1-4 MEDUSAs beside rough features, over a flat plain or a real grid)",
+    )
     parser.set_defaults(run=run)
 
 
@@ -47,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
     """Generate every scenario first, then write them; returns the exit code."""
     from auvplan.scenarios import generate
 
-    scenarios = [generate(seed, data_dir=args.data_dir) for seed in args.seeds]
+    scenarios = [generate(seed, data_dir=args.data_dir, kind=args.kind) for seed in args.seeds]
     for scenario in scenarios:
         path = scenario.write(scenario_folder(args.output, scenario.seed))
         if not args.quiet:

@@ -30,9 +30,14 @@ from auvplan.terrain import BathymetryGrid
 TRAJECTORY_FILES: Final = {
     "terrain_aware": "trajectories.csv",
     "energy_only": "trajectories_energy_only.csv",
+    "paper": "trajectories_paper.csv",
 }
 #: Plan label -> the ``summary.json`` record of that plan.
-SUMMARY_RECORDS: Final = {"terrain_aware": "optimization", "energy_only": "energy_only"}
+SUMMARY_RECORDS: Final = {
+    "terrain_aware": "optimization",
+    "energy_only": "energy_only",
+    "paper": "paper",
+}
 _COLUMNS: Final = ("t", "north", "east", "psi", "power")
 
 

@@ -38,7 +38,8 @@ def write_mission_files(
     ``mission.toml`` (the resolved mission: ``auvplan plan`` of it reruns the mission),
     ``maps.nc`` and ``paths.geojson``; after deconfliction ``desired.csv``; after
     optimisation ``trajectories.csv`` and ``trajectories.nc`` (and
-    ``trajectories_energy_only.csv``/``.nc`` when the comparison was run).
+    ``trajectories_energy_only.csv``/``.nc``, ``trajectories_paper.csv``/``.nc`` when those
+    comparisons were run).
     """
     preplan = result.preplan
     names = preplan.names
@@ -74,19 +75,22 @@ def write_mission_files(
         ]
         write_desired_csv(path, names, stage2.time, np.stack(poses))
         written.append(path)
-    for plan, stem in (
-        (result.plan, "trajectories"),
-        (result.energy_only, "trajectories_energy_only"),
+    paper = result.paper
+    for owner, plan, stem in (
+        (result, result.plan, "trajectories"),
+        (result, result.energy_only, "trajectories_energy_only"),
+        (paper, None if paper is None else paper.plan, "trajectories_paper"),
     ):
-        if plan is not None and stage2 is not None:
+        timed = None if owner is None else owner.deconfliction
+        if plan is not None and owner is not None and timed is not None:
             csv_path, netcdf_path = directory / f"{stem}.csv", directory / f"{stem}.nc"
-            models = stage2.layout.models
+            models = timed.layout.models
             write_trajectories_csv(
-                csv_path, names, stage2.time, plan.states, plan.inputs, np.asarray(plan.power),
+                csv_path, names, timed.time, plan.states, plan.inputs, np.asarray(plan.power),
                 state_names=[model.state_names for model in models],
                 input_names=[model.input_names for model in models],
             )  # fmt: skip
-            plan_dataset(result, plan).to_netcdf(netcdf_path)
+            plan_dataset(owner, plan).to_netcdf(netcdf_path)
             written += [csv_path, netcdf_path]
     return written
 

@@ -54,6 +54,8 @@ class MissionResult:
 
     ``failure`` names why stage 3 produced no plan at all (the optimiser failed before its
     first iterate); the earlier stages' results are kept so that they can be written.
+    ``paper`` is the same mission planned on the paper's information-map routes
+    (``planner.edge_model = "paper"``), for comparison with navigation-aware routes.
     """
 
     config: MissionConfig
@@ -65,6 +67,7 @@ class MissionResult:
     timings: dict[str, float] = field(default_factory=dict)
     failure: str | None = None
     current_comparison: CurrentComparison | None = None
+    paper: MissionResult | None = None
 
 
 def run_mission(
@@ -73,6 +76,7 @@ def run_mission(
     stage: Stage = Stage.FULL,
     compare_energy_only: bool = False,
     compare_no_current: bool = False,
+    compare_paper: bool = False,
     callback: Callable[[Any], None] | None = None,
     progress: ProgressReporter = no_progress,
 ) -> MissionResult:
@@ -89,6 +93,9 @@ def run_mission(
     compare_no_current : bool
         With a ``[current]``: also plan as if in still water and fly both plans in the current
         (:mod:`auvplan.mission.still_water`).
+    compare_paper : bool
+        With navigation-aware routes (``planner.edge_model = "navigation"``): also plan the
+        mission on the paper's information-map routes (``MissionResult.paper``).
     callback : callable, optional
         Passed to :func:`auvplan.optimization.solve_pronto` (per-iteration records).
     progress : ProgressReporter
@@ -146,9 +153,16 @@ def run_mission(
             "compare_no_current",
             lambda: _compare_no_current(config, layout, preplan, plan, callback=callback),
         )
+    paper = None
+    if compare_paper and config.planner.edge_model == "navigation":
+        routes = config.planner.model_copy(update={"edge_model": "paper"})
+        paper = timed(
+            "compare_paper",
+            lambda: run_mission(config.model_copy(update={"planner": routes}), callback=callback),
+        )
     return MissionResult(
         config, stage, preplan, deconfliction, plan, energy_only, timings=timings,
-        current_comparison=comparison,
+        current_comparison=comparison, paper=paper,
     )  # fmt: skip
 
 

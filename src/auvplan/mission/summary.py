@@ -216,6 +216,15 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> d
         summary["optimization"] = _plan_summary(result.plan, preplan.names, settle_s)
     if result.energy_only is not None:
         summary["energy_only"] = _plan_summary(result.energy_only, preplan.names, settle_s)
+    if result.paper is not None and result.paper.plan is not None:
+        summary["paper"] = {
+            **_plan_summary(result.paper.plan, preplan.names, settle_s),
+            "edge_model": result.paper.config.planner.edge_model,
+            "smoothed_length_m": {
+                name: path_length(path)
+                for name, path in zip(preplan.names, result.paper.preplan.paths, strict=True)
+            },
+        }
     if result.current_comparison is not None:
         summary["current_comparison"] = _comparison_summary(
             result.current_comparison, preplan.names, settle_s

@@ -23,7 +23,11 @@ from auvplan.viz.style import plain_tick_labels, vehicle_colors
 #: Margin [m] around the tracks in the map panels, and their least width / height.
 MAP_MARGIN_M = 40.0
 MAP_MIN_ASPECT = 0.8
-PLAN_TITLES = {"terrain_aware": "terrain-aware plan", "energy_only": "energy-only plan"}
+PLAN_TITLES = {
+    "terrain_aware": "terrain-aware plan",
+    "energy_only": "energy-only plan",
+    "paper": "paper's plan (information map)",
+}
 
 
 def plot_navigation(

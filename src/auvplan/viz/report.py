@@ -29,6 +29,8 @@ FIGURE_CAPTIONS: Final = {
     "(paper Fig. 6); circles: safety radius at start and goal.",
     "paths_cost": "Pre-planned paths over the shifted cost map that A* searched.",
     "paths_energy_only": "Energy-only optimum (terrain weight 0) against the pre-planned paths.",
+    "paths_paper": "The paper's plan beside: its information-map routes (dashed) and their "
+    "optimum.",
     "coordination": "Coordination space of the first two vehicles: collision region and the "
     "deconflicted schedule.",
     "time_series": "Surge and sway speed, yaw rate, propeller speeds (and control-surface "
@@ -92,7 +94,7 @@ def figure_builders(result: MissionResult) -> dict[str, Callable[[], Figure]]:
 
     ``maps`` (paper Fig. 5), ``paths`` (Fig. 6 over the bathymetry), ``paths_cost`` (over the
     cost map), and by stage ``coordination``, ``time_series`` (speeds, propellers, power),
-    ``separation`` and, with the comparison, ``paths_energy_only``.
+    ``separation`` and, with the comparisons, ``paths_energy_only`` and ``paths_paper``.
     """
     preplan = result.preplan
     circles = np.array(
@@ -128,6 +130,14 @@ def figure_builders(result: MissionResult) -> dict[str, Callable[[], Figure]]:
             energy_only,
             title="Energy-only optimum (terrain weight 0) against the pre-planned paths",
         )
+    paper = result.paper
+    if paper is not None and paper.plan is not None:
+        paper_plan = paper.plan
+        builders["paths_paper"] = lambda: plot_mission_paths(
+            preplan.bathymetry, preplan.names, [route.points for route in paper.preplan.routes],
+            _tracks(paper, paper_plan.states), safety_radius=radius, circles=circles,
+            polygons=polygons, title="The paper's plan: information-map routes and their optimum",
+        )  # fmt: skip
     if stage2 is not None and len(preplan.names) >= 2:
         builders["coordination"] = lambda: plot_coordination_space(
             stage2.problem, stage2.coordination, pair=(0, 1)
