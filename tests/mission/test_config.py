@@ -41,7 +41,7 @@ def test_minimal_mission_defaults_and_units() -> None:
     assert blue.start.psi == pytest.approx(math.pi / 2)  # degrees in the file, radians inside
     assert blue.start.speed == 0.5
     assert blue.goal.north == 380.0
-    assert mission.planner.edge_model == "paper"
+    assert mission.planner.edge_model == "navigation"
     assert mission.solver.dt == 0.5
     # the solver's defaults have one home: ProntoOptions
     assert mission.solver.pronto_options() == ProntoOptions(
