@@ -136,7 +136,8 @@ def test_preplan_writes_paths(
         cells = np.array(vehicle["preplan"]["cells"])
         steps = np.abs(np.diff(cells, axis=0))
         assert steps.max() <= 2  # king and knight moves (navigation-aware routes)
-        assert np.all(steps.sum(axis=1) <= 3) and np.all(steps.sum(axis=1) >= 1)
+        assert np.all(steps.sum(axis=1) <= 3)
+        assert np.all(steps.sum(axis=1) >= 1)
         assert vehicle["preplan"]["graph_cost"] > 0
     for name in ("maps.nc", "maps.png", "paths.png", "paths.geojson"):
         assert (out / name).is_file(), name

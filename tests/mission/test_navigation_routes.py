@@ -68,7 +68,8 @@ def test_automatic_routes_buy_navigation_only_where_it_is_worth_it(tmp_path: Pat
     assert ridge["mode"] == "automatic"
     assert ridge["budget_m"] is not None  # it paid for the ridge
     rms, base = ridge["route_predicted_rms_m"], ridge["energy_only_route_predicted_rms_m"]
-    assert isinstance(rms, float) and isinstance(base, float)
+    assert isinstance(rms, float)
+    assert isinstance(base, float)
     assert rms <= 0.8 * base
     assert 0.0 < float(ridge["route_energy_increase"]) <= 0.08  # type: ignore[arg-type]
     flat = _preplan(_mission(tmp_path / "flat", ridge=False), tmp_path / "flat" / "out")
