@@ -1,8 +1,10 @@
 """Seeded scenario family and independent checks of plans (reliability benchmarking).
 
 :func:`generate` draws a valid mission from a seed (:class:`Scenario`, written with
-:meth:`Scenario.write`); :func:`check` verifies a ``plan`` output folder with its own
-interpolation and its own plain-numpy vehicle model, independently of the solver's report.
+:meth:`Scenario.write`), of the ``"reliability"`` kind (varied missions) or the ``"transit"``
+kind (long transits beside rough features, :mod:`auvplan.scenarios.transit`); :func:`check`
+verifies a ``plan`` output folder with its own interpolation and its own plain-numpy vehicle
+model, independently of the solver's report.
 """
 
 from __future__ import annotations

@@ -141,7 +141,7 @@ def draw_terrain(
     if kind == "bank":
         seed = int(rng.integers(1, 1000))
         grid = synthetic_bank(seed=seed)
-        return _with_maps(kind, {"synthetic": True, "seed": seed}, grid, None, f"bank {seed}")
+        return with_maps(kind, {"synthetic": True, "seed": seed}, grid, None, f"bank {seed}")
     if kind == "synthetic":
         return _synthetic(rng, max_distance, safety_radius)
     path = (data_dir / REAL_GRIDS[kind]).resolve()
@@ -167,7 +167,7 @@ def draw_terrain(
         grid = read_bathymetry(path, window_lat=(south, north_edge), window_lon=(west, east_edge))
         window = {"lat": [south, north_edge], "lon": [west, east_edge]}
         label = f"{kind} window {size[0] / 1e3:.1f} x {size[1] / 1e3:.1f} km"
-        drawn = _with_maps(kind, {"file": str(path), "window": window}, grid, None, label)
+        drawn = with_maps(kind, {"file": str(path), "window": window}, grid, None, label)
         if np.mean(np.isfinite(drawn.cost)) >= MIN_WATER_FRACTION:
             return drawn
     return None
@@ -191,16 +191,17 @@ def _synthetic(rng: np.random.Generator, max_distance: float, safety_radius: flo
         spectral_exponent=float(rng.uniform(2.6, 3.6)),
     )
     label = f"synthetic bank {sides[0] / 1e3:.1f} x {sides[1] / 1e3:.1f} km (seed {seed})"
-    return _with_maps("synthetic", {"file": SYNTHETIC_FILE}, grid, grid, label)
+    return with_maps("synthetic", {"file": SYNTHETIC_FILE}, grid, grid, label)
 
 
-def _with_maps(
+def with_maps(
     kind: str,
     table: dict[str, Any],
     grid: BathymetryGrid,
     synthetic: BathymetryGrid | None,
     label: str,
 ) -> DrawnTerrain:
+    """``grid`` with its cost map as ``auvplan plan`` computes it (block by its spacing)."""
     geometry = grid.geometry
     block = _block_for(max(geometry.spacing_north, geometry.spacing_east))
     maps = compute_terrain_maps(grid, MapParameters(block=block))

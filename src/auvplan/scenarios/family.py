@@ -1,6 +1,7 @@
 """A public, seeded family of valid missions that nobody tuned the planner to.
 
-:func:`generate` draws, from ``numpy.random.default_rng(seed)`` only:
+:func:`generate` with the default ``kind="reliability"`` draws, from
+``numpy.random.default_rng(seed)`` only:
 
 * the horizon ``T``, log-uniform in 10 min – 3 h (a multiple of 10 s), and ``dt_s`` as a user
   would choose it: 0.5 s up to 15 min, 1 s up to 50 min, 2 s beyond;
@@ -19,23 +20,28 @@
   of every start and goal; sometimes (30 %) one or two communication pairs whose range is
   comfortably above what their straight lines need.
 
-Valid means ``auvplan plan --stage preplan`` accepts the mission.
+Valid means ``auvplan plan --stage preplan`` accepts the mission. ``kind="transit"`` draws
+long transits instead (:mod:`auvplan.scenarios.transit`).
 """
 
 from __future__ import annotations
 
 import math
-import os
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Final
 
 import numpy as np
-import tomli_w
 
+from auvplan.errors import InputError
 from auvplan.planning import CircleObstacle, PolygonObstacle
-from auvplan.scenarios import _poses, _terrain
-from auvplan.terrain import BathymetryGrid
+from auvplan.scenarios import _poses, _terrain, transit
+from auvplan.scenarios._scenario import (
+    DT_BY_HORIZON,
+    MISSION_FILE,
+    VEHICLE_NAMES,
+    Scenario,
+    position_table,
+)
 
 #: Horizon range [s].
 HORIZON_RANGE_S: Final = (600.0, 10800.0)
@@ -45,57 +51,23 @@ SPEED_RANGE: Final = (0.25, 0.6)
 DETOUR: Final = 1.2
 #: Fleet sizes drawn.
 FLEET_SIZES: Final = (2, 6)
-#: ``(largest horizon [s], dt_s)``: the step a user picks for a mission of that length.
-DT_BY_HORIZON: Final = ((900.0, 0.5), (3000.0, 1.0), (math.inf, 2.0))
 SAFETY_RADII_M: Final = (2.5, 5.0, 5.0, 10.0)
-VEHICLE_NAMES: Final = ("blue", "green", "orange", "purple", "red", "cyan")
-MISSION_FILE: Final = "mission.toml"
 #: Terrain draws tried before falling back to a synthetic bank.
 TERRAIN_ATTEMPTS: Final = 4
+#: Family kinds :func:`generate` draws from.
+KINDS: Final = ("reliability", "transit")
+
+__all__ = [
+    "DT_BY_HORIZON",
+    "KINDS",
+    "MISSION_FILE",
+    "VEHICLE_NAMES",
+    "Scenario",
+    "generate",
+]
 
 
-@dataclass(frozen=True)
-class Scenario:
-    """One generated mission.
-
-    ``mission`` is the TOML document as a dict (a real grid's ``terrain.file`` is absolute;
-    :meth:`write` makes it relative to the scenario folder). ``synthetic_terrain`` is written
-    next to the mission as ``terrain.nc`` when the terrain is generated.
-    """
-
-    seed: int
-    mission: dict[str, Any]
-    terrain: str
-    n_vehicles: int
-    horizon_s: float
-    dt_s: float
-    description: str
-    synthetic_terrain: BathymetryGrid | None = field(default=None, repr=False)
-
-    def toml(self, folder: Path | None = None) -> str:
-        """The mission file's text; a real grid's path is relative to ``folder`` if given."""
-        document = dict(self.mission)
-        terrain = dict(document["terrain"])
-        if folder is not None and "file" in terrain and Path(terrain["file"]).is_absolute():
-            terrain["file"] = os.path.relpath(terrain["file"], Path(folder).resolve())
-        document["terrain"] = terrain
-        header = f"# auvplan scenario {self.seed}: {self.description}\n\n"
-        return header + tomli_w.dumps(document)
-
-    def write(self, folder: Path | str) -> Path:
-        """Write ``mission.toml`` (and ``terrain.nc`` if generated) into ``folder``; its path."""
-        folder = Path(folder)
-        folder.mkdir(parents=True, exist_ok=True)
-        if self.synthetic_terrain is not None:
-            _terrain.write_synthetic_terrain(
-                self.synthetic_terrain, folder / _terrain.SYNTHETIC_FILE
-            )
-        path = folder / MISSION_FILE
-        path.write_text(self.toml(folder), encoding="utf-8")
-        return path
-
-
-def generate(seed: int, *, data_dir: Path | None = None) -> Scenario:
+def generate(seed: int, *, data_dir: Path | None = None, kind: str = "reliability") -> Scenario:
     """The scenario of ``seed`` (deterministic for a given availability of the real grids).
 
     Parameters
@@ -105,11 +77,24 @@ def generate(seed: int, *, data_dir: Path | None = None) -> Scenario:
     data_dir : Path, optional
         Folder of the real bathymetry grids; default
         :func:`auvplan.scenarios._terrain.default_data_dir`. Grids not found are skipped.
+    kind : {"reliability", "transit"}
+        ``"reliability"`` (this module's family, the default) or ``"transit"``: a long
+        transit over a plain with rough features beside the line, or over a real grid
+        (:func:`auvplan.scenarios.transit.generate_transit`).
 
     Returns
     -------
     Scenario
+
+    Raises
+    ------
+    InputError
+        If ``kind`` is not one of :data:`KINDS`.
     """
+    if kind == "transit":
+        return transit.generate_transit(seed, data_dir=data_dir)
+    if kind != "reliability":
+        raise InputError(f"scenario kind must be one of {', '.join(KINDS)}, got {kind!r}")
     rng = np.random.default_rng(seed)
     data_dir = _terrain.default_data_dir() if data_dir is None else Path(data_dir)
     horizon = 10.0 * round(math.exp(rng.uniform(*np.log(HORIZON_RANGE_S))) / 10.0)
@@ -177,15 +162,6 @@ def generate(seed: int, *, data_dir: Path | None = None) -> Scenario:
     )
 
 
-def _position(point: np.ndarray, drawn: _terrain.DrawnTerrain) -> dict[str, float]:
-    """A point as ``{lat, lon}`` on geographic terrain, else ``{north, east}``."""
-    projection = drawn.grid.projection
-    if projection is None:
-        return {"north": round(float(point[0]), 2), "east": round(float(point[1]), 2)}
-    lat, lon = projection.to_geographic(np.array([point[0]]), np.array([point[1]]))
-    return {"lat": round(float(lat[0]), 7), "lon": round(float(lon[0]), 7)}
-
-
 def _heading_deg(rng: np.random.Generator, line: np.ndarray) -> float:
     """Bearing of ``line`` (north, east) in degrees, perturbed by N(0, 20°), in (-180, 180]."""
     bearing = math.degrees(math.atan2(line[1], line[0])) + rng.normal(0.0, 20.0)
@@ -208,11 +184,11 @@ def _vehicle_tables(
                 "name": VEHICLE_NAMES[i],
                 "type": "medusa",
                 "start": {
-                    **_position(start, drawn),
+                    **position_table(start, drawn),
                     "heading_deg": _heading_deg(rng, line),
                     "speed": round(speed, 2),
                 },
-                "goal": {**_position(goal, drawn), "heading_deg": _heading_deg(rng, line)},
+                "goal": {**position_table(goal, drawn), "heading_deg": _heading_deg(rng, line)},
             }
         )
     return tables
@@ -224,5 +200,5 @@ def _obstacle_table(
     """A circle's centre in lat/lon on geographic terrain; polygons always in north/east."""
     if isinstance(obstacle, CircleObstacle):
         centre = np.array([obstacle.north, obstacle.east])
-        return {"center": _position(centre, drawn), "radius_m": round(obstacle.radius, 2)}
+        return {"center": position_table(centre, drawn), "radius_m": round(obstacle.radius, 2)}
     return {"polygon": [[round(float(n), 2), round(float(e), 2)] for n, e in obstacle.vertices]}
