@@ -3,55 +3,14 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 
-import numpy as np
 import pytest
-from scipy.ndimage import gaussian_filter
 
 from auvplan.cli.main import main
-from auvplan.scenarios._terrain import write_synthetic_terrain
-from auvplan.terrain import BathymetryGrid, GridGeometry
 
-SPACING = 10.0
-N = 160  # 1.6 km square
-
-
-def _plain(path: Path, *, ridge: bool) -> Path:
-    """A featureless plain, with a rough ridge 160 m north of the transit line if asked."""
-    rows = np.arange(N)[:, None] + np.zeros((1, N))
-    depth = 60.0 + 0.002 * SPACING * np.arange(N)[None, :] + np.zeros((N, N))
-    if ridge:
-        band = np.exp(-0.5 * ((rows - 96) / 4.0) ** 2)
-        rough = gaussian_filter(np.random.default_rng(5).normal(0.0, 10.0, (N, N)), 1.5)
-        depth = depth - 15.0 * band + band * rough
-    write_synthetic_terrain(BathymetryGrid(depth, GridGeometry(N, N, SPACING, SPACING)), path)
-    return path
-
-
-def _mission(folder: Path, *, ridge: bool, navigation: str = "") -> Path:
-    _plain(folder / "terrain.nc", ridge=ridge)
-    mission = folder / "mission.toml"
-    mission.write_text(
-        f"""
-[terrain]
-file = "terrain.nc"
-[fleet]
-horizon_s = 2200.0
-safety_radius_m = 5.0
-[solver]
-dt_s = 2.0
-[navigation]
-settle_s = 300.0
-{navigation}
-[[vehicle]]
-name = "blue"
-start = {{ north = 800.0, east = 50.0, heading_deg = 90.0 }}
-goal = {{ north = 800.0, east = 1550.0, heading_deg = 90.0 }}
-""",
-        encoding="utf-8",
-    )
-    return mission
+TransitMission = Callable[..., Path]
 
 
 def _preplan(mission: Path, out: Path) -> dict[str, object]:
@@ -61,10 +20,12 @@ def _preplan(mission: Path, out: Path) -> dict[str, object]:
     return navigation
 
 
-def test_automatic_routes_buy_navigation_only_where_it_is_worth_it(tmp_path: Path) -> None:
+def test_automatic_routes_buy_navigation_only_where_it_is_worth_it(
+    tmp_path: Path, transit_mission: TransitMission
+) -> None:
     (tmp_path / "ridge").mkdir()
     (tmp_path / "flat").mkdir()
-    ridge = _preplan(_mission(tmp_path / "ridge", ridge=True), tmp_path / "ridge" / "out")
+    ridge = _preplan(transit_mission(tmp_path / "ridge", ridge=True), tmp_path / "ridge" / "out")
     assert ridge["mode"] == "automatic"
     assert ridge["budget_m"] is not None  # it paid for the ridge
     rms, base = ridge["route_predicted_rms_m"], ridge["energy_only_route_predicted_rms_m"]
@@ -72,19 +33,21 @@ def test_automatic_routes_buy_navigation_only_where_it_is_worth_it(tmp_path: Pat
     assert isinstance(base, float)
     assert rms <= 0.8 * base
     assert 0.0 < float(ridge["route_energy_increase"]) <= 0.08  # type: ignore[arg-type]
-    flat = _preplan(_mission(tmp_path / "flat", ridge=False), tmp_path / "flat" / "out")
+    flat = _preplan(transit_mission(tmp_path / "flat", ridge=False), tmp_path / "flat" / "out")
     assert flat["budget_m"] is None
     assert flat["route_energy_increase"] == 0.0
     assert flat["route_predicted_rms_m"] == flat["energy_only_route_predicted_rms_m"]
 
 
-def test_an_explicit_budget_is_met_by_the_route(tmp_path: Path) -> None:
-    free = _preplan(_mission(tmp_path, ridge=True, navigation="max_energy_increase = 0.0"),
+def test_an_explicit_budget_is_met_by_the_route(
+    tmp_path: Path, transit_mission: TransitMission
+) -> None:
+    free = _preplan(transit_mission(tmp_path, ridge=True, navigation="max_energy_increase = 0.0"),
                     tmp_path / "free")  # fmt: skip
     assert free["budget_m"] is None  # nothing is worth 0 % more energy
     budget = 0.6 * float(free["energy_only_route_predicted_peak_m"])  # type: ignore[arg-type]
     kept = _preplan(
-        _mission(tmp_path, ridge=True, navigation=f"max_error_m = {budget:.2f}"),
+        transit_mission(tmp_path, ridge=True, navigation=f"max_error_m = {budget:.2f}"),
         tmp_path / "kept",
     )
     assert kept["mode"] == "budget"
@@ -93,9 +56,9 @@ def test_an_explicit_budget_is_met_by_the_route(tmp_path: Path) -> None:
 
 
 def test_an_impossible_budget_exits_3_naming_the_smallest_feasible(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], transit_mission: TransitMission
 ) -> None:
-    mission = _mission(tmp_path, ridge=False, navigation="max_error_m = 2.0")
+    mission = transit_mission(tmp_path, ridge=False, navigation="max_error_m = 2.0")
     out = tmp_path / "out"
     code = main(["-q", "plan", str(mission), "-o", str(out), "--stage", "preplan"])
     assert code == 3
@@ -119,9 +82,13 @@ def test_an_impossible_budget_exits_3_naming_the_smallest_feasible(
     ],
 )
 def test_bad_navigation_values_exit_2_naming_the_key(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str], table: str, key: str
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    transit_mission: TransitMission,
+    table: str,
+    key: str,
 ) -> None:
-    mission = _mission(tmp_path, ridge=False, navigation=table)
+    mission = transit_mission(tmp_path, ridge=False, navigation=table)
     out = tmp_path / "out"
     assert main(["-q", "plan", str(mission), "-o", str(out)]) == 2
     (line,) = capsys.readouterr().err.strip().splitlines()
@@ -129,11 +96,13 @@ def test_bad_navigation_values_exit_2_naming_the_key(
     assert not out.exists()
 
 
-def test_evaluate_flies_the_missions_navigation_model(tmp_path: Path) -> None:
+def test_evaluate_flies_the_missions_navigation_model(
+    tmp_path: Path, transit_mission: TransitMission
+) -> None:
     """The folder's [navigation] table is the evaluator's model; flags override it."""
     from auvplan.mission.folder import folder_navigation
 
-    mission = _mission(tmp_path, ridge=False, navigation="drift_percent = 0.5")
+    mission = transit_mission(tmp_path, ridge=False, navigation="drift_percent = 0.5")
     out = tmp_path / "out"
     assert main(["-q", "plan", str(mission), "-o", str(out), "--stage", "preplan"]) == 0
     table, depth = folder_navigation(out, {})

@@ -6,24 +6,24 @@ the last fixes:
 
 .. math::
 
-    \Delta = \max\left(\sigma_b^2 \left((d + \ell)^2 - d^2\right),\; w\right), \quad
+    \delta = \sigma_b^2 \left((d + \ell)^2 - d^2\right), \quad
     d = \sqrt{V} / \sigma_b, \qquad
-    P^- = P + \Delta I, \quad V^- = V + \Delta,
+    P^- = P + \max(\delta, w)\, I, \quad V^- = V + \delta,
 
 .. math::
 
     P^+ = \left((P^-)^{-1} + F\right)^{-1}, \qquad
     V^+ = V^- \, \operatorname{tr} P^+ / \operatorname{tr} P^-.
 
-Dead reckoning with a scale and heading bias :math:`\sigma_b` (per metre) makes the error
-of a straight leg grow as :math:`\sigma_b D` — quadratically in variance, from the last
-fix on: :math:`d` is the distance flown since it, and a fix shrinks it with the error.
-Over a flat seabed (:math:`F = 0`) the variance is exactly
-:math:`\sigma_0^2 + \sigma_b^2 D^2` per axis, the dead-reckoning error. ``w`` [m²] is the
-white variance the filter itself adds over the step (its process noise): it sets the growth
-where dead reckoning grows slower (just after a fix), and so the accuracy a filter keeps
-over informative seabed. :math:`F` [1/m²] is the Fisher information of the soundings of the
-step. With :math:`\sigma_b = 0` this is the posterior Cramér-Rao recursion of
+Dead reckoning with a scale and heading bias :math:`\sigma_b` (per metre) makes the error of a
+straight leg grow as :math:`\sigma_b D` — quadratically in variance, from the last fix on:
+:math:`d` is the distance flown since it, and a fix shrinks it with the error. Over a flat
+seabed (:math:`F = 0`) the variance is exactly :math:`\sigma_0^2 + \sigma_b^2 D^2` per axis, the
+dead-reckoning error. ``w`` [m²] is the white variance the filter itself adds over the step (its
+process noise): it sets the growth where dead reckoning grows slower (just after a fix), and so
+the accuracy a filter keeps over informative seabed, but it is no drift: it does not advance
+:math:`d`. :math:`F` [1/m²] is the Fisher information of the soundings of the step. With
+:math:`\sigma_b = 0` this is the posterior Cramér-Rao recursion of
 :mod:`~auvplan.navigation.pcrb`.
 """
 
@@ -55,13 +55,14 @@ def propagate(
     ``drift_variance`` is :math:`\sigma_b^2` [1], ``grown`` is :math:`V` [m²], ``length``
     is :math:`\ell` [m]; returns ``p00, p01, p11`` and :math:`V` after the step.
     """
-    increment = white
+    drift = 0.0
     if drift_variance > 0.0:
         since = math.sqrt(grown / drift_variance)
-        increment = max(drift_variance * length * (2.0 * since + length), white)
+        drift = drift_variance * length * (2.0 * since + length)
+    increment = max(drift, white)
     p00 += increment
     p11 += increment
-    grown += increment
+    grown += drift
     before = p00 + p11
     det = p00 * p11 - p01 * p01
     j00 = p11 / det + f00

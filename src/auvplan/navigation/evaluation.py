@@ -130,11 +130,13 @@ def navigation_summary(
     """The ``navigation.json`` document.
 
     Per plan: ``energy_J``, ``rmse_m`` (mean over vehicles and runs of the run RMSE) and its
-    spread ``rmse_std_m``, ``error_p95_m`` (95th percentile of the error over every run and
-    update), ``predicted_rmse_m`` (the planner's predicted error, RMS along each track,
-    mean over vehicles), ``dead_reckoning_rmse_m``, ``pcrb_rms_m``, ``convergence_time_s``
-    (median over the runs that converged), ``converged_fraction``, ``divergence_rate``, and the
-    same per vehicle under ``vehicles`` (with percentiles, the final error, mean NEES and ESS).
+    spread ``rmse_std_m``, ``error_p95_m`` and ``error_rms_m`` (95th percentile and root mean
+    square of the error over every run and update: the latter is what the predicted 1-σ
+    radial error estimates), ``predicted_rmse_m`` (the planner's predicted error, RMS along
+    each track, mean over vehicles), ``dead_reckoning_rmse_m``, ``pcrb_rms_m``,
+    ``convergence_time_s`` (median over the runs that converged), ``converged_fraction``,
+    ``divergence_rate``, and the same per vehicle under ``vehicles`` (with percentiles, the
+    final error, mean NEES and ESS).
     With both plans, ``comparison`` holds the RMSE reduction and energy increase of the
     terrain-aware plan (the mission's) over the energy-only one, and ``paper_comparison``
     those of the paper's plan when the folder has it. ``plan_records`` (``summary.json``'s plan
@@ -195,12 +197,14 @@ def _predicted(predictions: list[ErrorPrediction]) -> dict[str, Any]:
 def _statistics(results: list[MonteCarloResult]) -> dict[str, Any]:
     """Aggregates over every run of ``results`` (one or several vehicles)."""
     run_rmse = np.concatenate([result.rmse for result in results])
+    errors = np.concatenate([result.error.ravel() for result in results])
     convergence = np.concatenate([result.convergence_time for result in results])
     converged = convergence[np.isfinite(convergence)]
     return {
         "rmse_m": float(np.mean(run_rmse)),
         "rmse_std_m": float(np.std(run_rmse)),
-        "error_p95_m": float(np.percentile(np.concatenate([r.error.ravel() for r in results]), 95)),
+        "error_p95_m": float(np.percentile(errors, 95)),
+        "error_rms_m": float(np.sqrt(np.mean(errors**2))),
         "dead_reckoning_rmse_m": float(
             np.mean(np.concatenate([result.dead_reckoning_rmse for result in results]))
         ),
