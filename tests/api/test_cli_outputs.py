@@ -26,7 +26,15 @@ def test_plan_writes_pdf_figures_a_report_and_plain_progress(
     assert code == 0, captured.err
     pdfs = sorted(path.stem for path in out.glob("*.pdf"))
     assert pdfs == sorted(
-        ["maps", "paths", "paths_cost", "coordination", "time_series", "separation"]
+        [
+            "maps",
+            "paths",
+            "paths_cost",
+            "coordination",
+            "time_series",
+            "separation",
+            "navigation_predicted",
+        ]
     )
     assert not list(out.glob("*.png"))
     assert all(path.read_bytes().startswith(b"%PDF-") for path in out.glob("*.pdf"))

@@ -15,7 +15,7 @@ def test_report_embeds_every_figure_and_states_the_plan(saved_folder: Path) -> N
     text = (saved_folder / "report.html").read_text(encoding="utf-8")
     page = parse_html(text)
     figures = sorted(saved_folder.glob("*.png"))
-    assert len(figures) == 6
+    assert len(figures) == 7
     assert sorted(page.ids) == sorted(path.stem for path in figures)
     assert [kind for kind, _ in page.images] == ["image/png"] * len(figures)
     embedded = {data for _, data in page.images}
@@ -25,6 +25,7 @@ def test_report_embeds_every_figure_and_states_the_plan(saved_folder: Path) -> N
     assert "plan CONVERGED" in words
     assert f"iterations {summary['optimization']['n_iter']}" in " ".join(words.split())
     assert summary["deconfliction"]["method"] in words
+    assert "Navigation (predicted TAN error, 1-σ radial)" in words
     for name in NAMES:  # shown as written, escaped in the source
         assert name in words
     assert "blue &lt;1&gt;" in text

@@ -75,6 +75,7 @@ def render_report(
         "<h2>Status and vehicles</h2>",
         render_overview(summary),
         *_optimizer(summary.get("optimization"), "Optimiser"),
+        *_navigation(summary),
         *_comparison(summary),
         *_deconfliction(summary),
         "<h2>Wall time</h2>",
@@ -216,6 +217,49 @@ def _optimizer(record: Mapping[str, Any] | None, title: str) -> list[str]:
             ),
         ]  # fmt: skip
     return parts
+
+
+def _navigation(summary: Mapping[str, Any]) -> list[str]:
+    """Per vehicle: how its route was chosen and the predicted TAN error of each plan [m]."""
+    plans = {
+        label: (summary.get(key) or {}).get("vehicles", {})
+        for label, key in (("plan", "optimization"), ("energy-only", "energy_only"),
+                           ("paper", "paper"))
+    }  # fmt: skip
+    rows = []
+    for vehicle in summary.get("vehicles", []):
+        route = vehicle.get("preplan", {}).get("navigation")
+        predicted = {
+            label: records.get(vehicle["name"], {}).get("predicted_navigation_error", {})
+            for label, records in plans.items()
+        }
+        if route is None and not any(predicted.values()):
+            continue
+        route = route or {}
+        rows.append(
+            (
+                vehicle["name"],
+                route.get("mode"),
+                route.get("budget_m"),
+                route.get("route_predicted_rms_m"),
+                route.get("energy_only_route_predicted_rms_m"),
+                route.get("route_energy_increase"),
+                *(predicted[label].get("rms_m") for label in plans),
+                predicted["plan"].get("peak_after_settle_m"),
+            )
+        )
+    if not rows:
+        return []
+    headers = (
+        "vehicle", "route", "budget [m]", "route RMS [m]", "shortest route RMS [m]",
+        "route energy [+]", "plan RMS [m]", "energy-only plan RMS [m]", "paper plan RMS [m]",
+        "plan peak after settling [m]",
+    )  # fmt: skip
+    formats: tuple[Callable[[Any], str], ...] = (str, str, *([_fixed(2)] * 8))
+    return [
+        "<h2>Navigation (predicted TAN error, 1-σ radial)</h2>",
+        _table(headers, rows, formats),
+    ]
 
 
 def _comparison(summary: Mapping[str, Any]) -> list[str]:

@@ -16,6 +16,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from auvplan.navigation.evaluation import PlanNavigation, time_series
+from auvplan.navigation.prediction import ErrorPrediction
 from auvplan.terrain import BathymetryGrid
 from auvplan.viz.geography import add_geographic_axes
 from auvplan.viz.style import plain_tick_labels, vehicle_colors
@@ -160,3 +161,36 @@ def _draw_errors(
     axes.grid(alpha=0.3)
     if is_first:
         axes.legend(fontsize="x-small", ncol=2, loc="upper right")
+
+
+def plot_predicted_error(
+    names: tuple[str, ...],
+    plans: Mapping[str, tuple[ErrorPrediction, ...]],
+    *,
+    budget: float | None = None,
+    settle_s: float = 0.0,
+) -> Figure:
+    """The predicted TAN error (1-σ radial) [m] against time, one panel per vehicle.
+
+    ``plans`` maps a plan's title to each vehicle's prediction along its flown track (the
+    first drawn solid, the others dashed and dotted); ``budget`` [m], if given, is drawn from
+    ``settle_s`` [s] on.
+    """
+    figure = Figure(figsize=(9.0, 1.2 + 2.0 * len(names)), layout="constrained")
+    axes_list = figure.subplots(len(names), 1, sharex=True, squeeze=False)[:, 0]
+    colors = vehicle_colors(len(names))
+    styles = ("-", "--", ":")
+    for index, (name, axes) in enumerate(zip(names, axes_list, strict=True)):
+        for style, (title, predictions) in zip(styles, plans.items(), strict=False):
+            prediction = predictions[index]
+            axes.plot(prediction.time, prediction.sigma, style, color=colors[index], label=title)
+        if budget is not None:
+            end = max(float(p[index].time[-1]) for p in plans.values())
+            axes.hlines(budget, settle_s, end, colors="r", linestyles="--", label="budget")
+        axes.set_ylabel(f"{name}: σ [m]")
+        axes.set_ylim(bottom=0.0)
+        axes.grid(alpha=0.3)
+        axes.legend(fontsize="small", loc="upper left")
+    axes_list[-1].set_xlabel("time [s]")
+    figure.suptitle("Predicted TAN position error along the flown plans")
+    return plain_tick_labels(figure)

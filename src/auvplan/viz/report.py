@@ -14,6 +14,7 @@ from matplotlib.figure import Figure
 from auvplan._figures import DEFAULT_DPI, FIGURE_FORMATS
 from auvplan.errors import InputError
 from auvplan.mission.evaluation import OptimizedPlan
+from auvplan.mission.navigation import budget_of
 from auvplan.mission.pipeline import MissionResult
 from auvplan.planning import CircleObstacle, PolygonObstacle
 from auvplan.vehicle import positions
@@ -21,6 +22,7 @@ from auvplan.viz.coordination import plot_coordination_space
 from auvplan.viz.current import add_current_arrows
 from auvplan.viz.maps import plot_terrain_maps
 from auvplan.viz.mission import plot_mission_paths, plot_separation, plot_time_series
+from auvplan.viz.navigation import plot_predicted_error
 
 #: What each figure of :func:`mission_figures` shows, by file stem.
 FIGURE_CAPTIONS: Final = {
@@ -37,6 +39,8 @@ FIGURE_CAPTIONS: Final = {
     "deflections) and electrical power.",
     "separation": "Distance between every pair of vehicles and to every obstacle, on the "
     "closed-loop replay.",
+    "navigation_predicted": "Predicted TAN position error (1-σ radial) along each flown plan, "
+    "with the navigation budget.",
 }
 
 
@@ -138,6 +142,8 @@ def figure_builders(result: MissionResult) -> dict[str, Callable[[], Figure]]:
             _tracks(paper, paper_plan.states), safety_radius=radius, circles=circles,
             polygons=polygons, title="The paper's plan: information-map routes and their optimum",
         )  # fmt: skip
+    if plan is not None:
+        builders["navigation_predicted"] = lambda: _predicted_error(result)
     if stage2 is not None and len(preplan.names) >= 2:
         builders["coordination"] = lambda: plot_coordination_space(
             stage2.problem, stage2.coordination, pair=(0, 1)
@@ -151,6 +157,28 @@ def figure_builders(result: MissionResult) -> dict[str, Callable[[], Figure]]:
                 plan.fine_time, plan.fine_distances, 2 * radius
             )
     return builders
+
+
+def _predicted_error(result: MissionResult) -> Figure:
+    """The predicted TAN error of the plan and of its comparisons, per vehicle."""
+    assert result.plan is not None
+    paper = None if result.paper is None else result.paper.plan
+    plans = {
+        title: plan.predicted_navigation
+        for title, plan in (
+            ("plan", result.plan),
+            ("energy-only plan", result.energy_only),
+            ("paper's plan", paper),
+        )
+        if plan is not None
+    }
+    navigation = result.config.navigation
+    return plot_predicted_error(
+        result.preplan.names,
+        plans,
+        budget=budget_of(result.config),
+        settle_s=navigation.settle,
+    )
 
 
 def _tracks(result: MissionResult, states: np.ndarray) -> list[np.ndarray]:
