@@ -124,7 +124,9 @@ def assemble_problem(
 ) -> AssembledProblem:
     """The stacked fleet problem for PRONTO (and the IPOPT reference), with its initial guess.
 
-    ``terrain_weight`` overrides ``weights.terrain`` (0 for the energy-only comparison). The
+    ``terrain_weight`` overrides ``weights.terrain`` (0 for the energy-only comparison); a
+    navigation-aware route that buys no navigation (the shortest route) is not tracked: its
+    vehicle's plan is the energy-optimal one. The
     guess is the desired trajectory with zero inputs; PRONTO projects it onto the dynamics.
     ``current`` (None: still water) enters each stage linearised about the desired position.
     """
@@ -147,7 +149,12 @@ def assemble_problem(
     functions = build_fleet_functions(
         layout,
         goal_poses(layout, preplan.goals, desired),
-        FleetWeights(terrain=terrain_weight, energy=weights.energy, terminal=weights.terminal),
+        FleetWeights(
+            terrain=terrain_weight,
+            energy=weights.energy,
+            terminal=weights.terminal,
+            tracked=tuple(choice.pays_for_navigation for choice in preplan.navigation or ()),
+        ),
         limits,
         has_current=current is not None,
     )

@@ -219,11 +219,20 @@ class FleetProblemFunctions:
 
 @dataclass(frozen=True)
 class FleetWeights:
-    """Trade-off multipliers (see :class:`auvplan.mission.config.WeightsConfig`)."""
+    """Trade-off multipliers (see :class:`auvplan.mission.config.WeightsConfig`).
+
+    ``tracked`` says, per vehicle, whether its desired trajectory is tracked (with weight
+    ``terrain``) or not (0: its plan is energy-optimal); empty: every vehicle is.
+    """
 
     terrain: float
     energy: float
     terminal: float
+    tracked: tuple[bool, ...] = ()
+
+    def terrain_of(self, index: int) -> float:
+        """The tracking weight of vehicle ``index``."""
+        return self.terrain if not self.tracked or self.tracked[index] else 0.0
 
 
 @dataclass(frozen=True)
@@ -280,7 +289,9 @@ def build_fleet_functions(
     blocks = tuple(
         StageBlock(
             *vehicle_stage_functions(model, has_current=has_current),
-            weights=np.array([weights.energy, weights.terrain, INPUT_WEIGHT, *tracking(model)]),
+            weights=np.array(
+                [weights.energy, weights.terrain_of(i), INPUT_WEIGHT, *tracking(model)]
+            ),
             states=layout.state_slice(i),
             inputs=layout.input_slice(i),
             parameters=layout.parameter_slice(i, has_current=has_current),

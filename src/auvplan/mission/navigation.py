@@ -21,6 +21,9 @@ recursion of :mod:`auvplan.navigation.prediction` at the vehicle's nominal speed
 
 ``weights.navigation`` [W/m²] adds ``λ σ² / U`` joules per metre to every edge (a soft
 price on the predicted error variance, integrated over time).
+
+The optimiser tracks a route (``weights.terrain``) only where it pays for navigation; a
+vehicle whose route is the shortest one gets the energy-optimal plan (tracking weight 0).
 """
 
 from __future__ import annotations
@@ -78,6 +81,11 @@ class NavigationChoice:
     message: str = ""
 
     @property
+    def pays_for_navigation(self) -> bool:
+        """Whether the route differs from the shortest one to lower the predicted error."""
+        return self.rms_m < self.energy_only_rms_m
+
+    @property
     def budget_met(self) -> bool:
         """Whether the route meets the mission's budget (always without one)."""
         return self.smallest_budget_m is None
@@ -94,6 +102,7 @@ class NavigationChoice:
             "route_energy_increase": self.energy_increase,
             "searches": self.searches,
             "smallest_feasible_budget_m": self.smallest_budget_m,
+            "tracked_by_the_optimiser": self.pays_for_navigation,
         }
 
 
