@@ -4,6 +4,7 @@ Run::
 
     .venv/bin/python benchmarks/bench_reliability.py N [--first-seed S] [--jobs 1]
         [--timeout 1800] [--max-horizon-s T] [--output DIR] [--data-dir DIR]
+        [--edge-model navigation|paper|crossed]
 
 For seeds ``S .. S+N-1`` (with ``--max-horizon-s``, seeds whose horizon is longer are skipped
 and the following seeds taken instead, until N scenarios ran), each scenario of
@@ -17,13 +18,16 @@ check passes. Failure classes: ``exit 2 (bug)`` (a valid mission refused as a us
 
 Prints the success rate, a table of failure classes with counts and seeds, and the median and
 95th percentile of wall time and peak memory; writes the rows to ``DIR/results.json`` and
-``DIR/results.csv``.
+``DIR/results.csv``. ``--edge-model`` plans every scenario on those routes instead of its own
+draw (the family draws the paper's and the crossed edge model; ``navigation`` is the default
+of a mission that names none).
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import dataclasses
 import json
 import os
 import re
@@ -142,8 +146,13 @@ def classify(row: Row, stderr: str) -> str:
     return "success" if row.status == "CONVERGED" else f"exit 0 ({row.status})"
 
 
-def run_scenario(scenario: Scenario, root: Path, timeout: float) -> Row:
-    """Write, plan and check one scenario."""
+def run_scenario(
+    scenario: Scenario, root: Path, timeout: float, edge_model: str | None = None
+) -> Row:
+    """Write, plan and check one scenario (its routes' ``edge_model`` replaced if given)."""
+    if edge_model is not None:
+        planner = {**scenario.mission.get("planner", {}), "edge_model": edge_model}
+        scenario = dataclasses.replace(scenario, mission={**scenario.mission, "planner": planner})
     folder = scenario_folder(root, scenario.seed)
     mission = scenario.write(folder)
     row = Row(
@@ -225,6 +234,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--max-horizon-s", type=float, default=None, help="skip longer missions")
     parser.add_argument("--output", type=Path, default=Path("out/bench_reliability"))
     parser.add_argument("--data-dir", type=Path, default=None, help="real bathymetry grids")
+    parser.add_argument(
+        "--edge-model",
+        choices=("navigation", "paper", "crossed"),
+        default=None,
+        help="plan every scenario with these routes (default: each scenario's own draw)",
+    )
     args = parser.parse_args(argv)
     scenarios = select_scenarios(args.n, args.first_seed, args.max_horizon_s, args.data_dir)
     args.output.mkdir(parents=True, exist_ok=True)
@@ -235,7 +250,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
 
     def one(scenario: Scenario) -> Row:
-        row = run_scenario(scenario, args.output, args.timeout)
+        row = run_scenario(scenario, args.output, args.timeout, args.edge_model)
         print(
             f"seed {row.seed:4d}  {row.failure_class:<40.40s} {row.wall_s:7.1f} s "
             f"{row.peak_rss_mb:7.0f} MB  {row.description}",
