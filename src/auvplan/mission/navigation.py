@@ -141,9 +141,13 @@ class VehicleNavigation:
                 searches += 1
                 route = search(self.with_budget(self.max_error), False)
             except BudgetInfeasible:
-                floor = _peak(search(self.model, True))
-                route = search(self.with_budget(floor + self.model.bin_width), False)
+                lowest = search(self.model, True)
+                floor = _peak(lowest)
                 searches += 2
+                try:  # the cheapest route within it (coarser bins may miss it: the lowest one)
+                    route = search(self.with_budget(floor + self.model.bin_width), False)
+                except BudgetInfeasible:
+                    route = lowest
                 unmet = choice(route, "budget", self.max_error, floor)
                 logger.info("%s", unmet.message)  # the plan's verdict tells the user
                 return route, unmet

@@ -9,16 +9,16 @@ proxy ``ℓ f (c_u + c_v) / 2`` of :class:`~auvplan.planning.problem.EdgeModel` 
 radial error σ. A hard budget forbids every move after the first ``settle_distance`` metres
 whose σ exceeds ``max_error``.
 
-Moves: the 8 king moves and, without move factors, the 8 knight moves too (16-connected:
-a straight line costs at most 2.7 % more than its length, against 8.2 % on 8 moves, so that
+Moves: the 8 king moves and, without move factors, the 8 knight moves too (16-connected: a
+straight line costs at most 2.7 % more than its length, against 8.2 % on 8 moves, so that
 routes that turn off the axes to reach informative seabed are not charged for the grid).
 Label setting with dominance (Bry & Roy's RRBT on a grid): at each cell, a label is kept
-only if its σ, quantised to ``bin_width`` bins, is lower than that of every cheaper label
-there (:mod:`auvplan.planning._belief_kernel`). With a consistent A* heuristic (Euclidean
-distance times the least cost per metre; the budget and the soft term only add cost or
-remove moves) the first label to reach the goal is the cheapest path of the quantised state
-space; at most ``n_bins`` labels per cell are expanded. Without a budget or a soft term the
-search is plain A* (one bin).
+only if its σ, quantised to bins (0.5 m, or 1/16 of a larger budget), is lower than that of
+every cheaper label there (:mod:`auvplan.planning._belief_kernel`). With a consistent A*
+heuristic (Euclidean distance times the least cost per metre; the budget and the soft term
+only add cost or remove moves) the first label to reach the goal is the cheapest path of the
+quantised state space; at most ``n_bins`` labels per cell are expanded. Without a budget or
+a soft term the search is plain A* (one bin).
 
 ``bottleneck=True`` instead minimises the peak σ after settling (the smallest budget any
 path can meet): labels leave the heap in order of their peak.
@@ -39,6 +39,9 @@ from auvplan.planning.problem import MOVES, PathResult, PlanningProblem, SearchS
 
 #: Bins of σ when there is no budget to bound them (σ above the last bin share it).
 UNBOUNDED_BINS: Final = 160
+#: Most bins of σ under a budget: the bins widen to ``max_error / MAX_BUDGET_BINS`` for large
+#: budgets (σ resolved to 6 % of the budget; fewer labels per cell).
+MAX_BUDGET_BINS: Final = 16
 #: Width of the ring of impassable cells around the grid (knight moves jump two cells).
 _PAD: Final = 2
 
@@ -67,7 +70,7 @@ class BeliefModel:
     error_weight : float
         Soft weight λ [cost per m² of σ² per metre travelled].
     bin_width : float
-        Quantisation of σ [m] for dominance.
+        Quantisation of σ [m] for dominance (at least; see :attr:`width`).
     max_labels : int
         Labels created before the search gives up (bounds the memory, 64 B per label).
     """
@@ -93,10 +96,17 @@ class BeliefModel:
                 raise InputError(f"belief model {name} must be > 0, got {getattr(self, name)}")
 
     @property
+    def width(self) -> float:
+        """Width [m] of the σ bins: ``bin_width``, or a budget's :data:`MAX_BUDGET_BINS`-th."""
+        if math.isfinite(self.max_error):
+            return max(self.bin_width, self.max_error / MAX_BUDGET_BINS)
+        return self.bin_width
+
+    @property
     def n_bins(self) -> int:
         """Bins of σ: up to the budget, else :data:`UNBOUNDED_BINS` (1 for plain A*)."""
         if math.isfinite(self.max_error):
-            return math.ceil(self.max_error / self.bin_width) + 1
+            return math.ceil(self.max_error / self.width) + 1
         return UNBOUNDED_BINS if self.error_weight > 0.0 else 1
 
 
@@ -159,7 +169,8 @@ def search_belief(
         _padded(np.moveaxis(model.fisher, -1, 0), 0.0).reshape(3, -1).T.copy(),
         model.updates_per_metre, model.drift_rate**2, model.process_variance,
         model.initial_sigma**2, math.inf if bottleneck else model.max_error,
-        model.settle_distance, model.error_weight, model.bin_width,
+        model.settle_distance, model.error_weight,
+        model.bin_width if bottleneck else model.width,
         UNBOUNDED_BINS if bottleneck else model.n_bins, bottleneck, model.max_labels,
     )  # fmt: skip
     if code == TOO_MANY_LABELS:
