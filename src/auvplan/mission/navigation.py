@@ -11,11 +11,12 @@ recursion of :mod:`auvplan.navigation.prediction` at the vehicle's nominal speed
   stays within it. If no route does, the cheapest route within the smallest budget any
   route meets (its ``smallest_budget_m``), and a warning naming where the shortest route
   breaks the budget: the plan then fails its check (exit 3) with that smallest budget.
-* **Automatic** (no ``max_error_m``): budgets are tried on a geometric ladder from the
-  energy-only route's peak error down to the smallest feasible one; the route with the lowest
-  predicted RMS error whose energy exceeds the energy-only route's by at most
-  ``max_energy_increase`` is taken, if it cuts the predicted RMS error by at least
-  ``min_error_reduction`` — otherwise the energy-only route. Energy of a route of length
+* **Automatic** (no ``max_error_m``): budgets are tried on a geometric ladder down from the
+  shortest route's peak error (:data:`LADDER_RATIO`), loosest first, until one is infeasible
+  or its route costs more than ``max_energy_increase`` over the shortest route's energy (a
+  tighter budget costs at least as much); of those, the route with the lowest predicted RMS
+  error is taken if it cuts the shortest route's by at least ``min_error_reduction``, else
+  the shortest route. Energy of a route of length
   ``L``: ``P(L / T) T`` with a fixed horizon ``T`` (faster on a longer route), ``e(U) L``
   at a cruise speed (``P`` the vehicle's steady power, ``e`` its energy per metre).
 
@@ -49,8 +50,10 @@ from auvplan.vehicle.trim import energy_per_metre, top_speed, trim_surge
 
 logger = logging.getLogger(__name__)
 
-#: Budgets tried by the automatic mode between the energy-only peak and the smallest feasible.
-LADDER_STEPS: Final = 6
+#: Budgets tried by the automatic mode: the shortest route's peak error times
+#: ``LADDER_RATIO ** k``, ``k = 1 … LADDER_STEPS`` (down to 27 % of it), loosest first.
+LADDER_STEPS: Final = 8
+LADDER_RATIO: Final = 0.85
 
 #: One search: a belief model (None: plain A*) and whether to minimise the peak error.
 RouteSearch = Callable[[BeliefModel, bool], Route]
@@ -152,21 +155,18 @@ class VehicleNavigation:
                 logger.info("%s", unmet.message)  # the plan's verdict tells the user
                 return route, unmet
             return route, choice(route, "budget", self.max_error)
-        floor = _peak(search(self.model, True))
-        searches += 1
         best, best_budget = cheapest, None
-        if floor < base_peak * (1.0 - self.min_error_reduction):
-            for budget in np.geomspace(base_peak, floor, LADDER_STEPS + 1)[1:]:
-                try:
-                    route = search(self.with_budget(float(budget) + self.model.bin_width), False)
-                except BudgetInfeasible:
-                    continue
-                finally:
-                    searches += 1
-                energy = self.energy(route_length(route))
-                fits = energy <= (1.0 + self.max_energy_increase) * base_energy
-                if fits and route_rms(route) < route_rms(best):
-                    best, best_budget = route, float(budget) + self.model.bin_width
+        for step in range(1, LADDER_STEPS + 1):  # tighter budgets cost at least as much
+            budget = base_peak * LADDER_RATIO**step
+            try:
+                searches += 1
+                route = search(self.with_budget(budget), False)
+            except BudgetInfeasible:
+                break
+            if self.energy(route_length(route)) > (1.0 + self.max_energy_increase) * base_energy:
+                break
+            if route_rms(route) < route_rms(best):
+                best, best_budget = route, budget
         if route_rms(best) > (1.0 - self.min_error_reduction) * base_rms:
             best, best_budget = cheapest, None
         return best, choice(best, "automatic", best_budget)
