@@ -21,4 +21,7 @@ def test_notebook_api_example_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPat
     assert (tmp_path / "out" / "notebook_api_paths.png").is_file()
     assert (tmp_path / "out" / "notebook_api" / "report.html").is_file()
     svg = {path.stem for path in (tmp_path / "out" / "notebook_api").glob("*.svg")}
-    assert svg == {"maps", "paths", "paths_cost", "coordination", "time_series", "separation"}
+    assert svg == {
+        "maps", "paths", "paths_cost", "coordination", "time_series", "separation",
+        "navigation_predicted",
+    }  # fmt: skip

@@ -111,3 +111,16 @@ def test_evaluate_flies_the_missions_navigation_model(
     assert folder_navigation(out, {"drift_percent": 2.0})[0].drift == 2.0
     settings = table.settings(vehicle_depth=depth)
     assert settings.motion.drift_fraction == pytest.approx(0.005)
+
+
+def test_a_mission_within_its_settling_time_flies_the_shortest_route(
+    tmp_path: Path, transit_mission: TransitMission
+) -> None:
+    """No budget applies before settle_s: nothing to buy, the shortest route (no crash)."""
+    mission = transit_mission(tmp_path, ridge=True, navigation="")
+    text = mission.read_text(encoding="utf-8").replace("settle_s = 300.0", "settle_s = 1e5")
+    mission.write_text(text, encoding="utf-8")
+    route = _preplan(mission, tmp_path / "out")
+    assert route["route_predicted_peak_m"] == 0.0
+    assert route["budget_m"] is None
+    assert route["tracked_by_the_optimiser"] is False

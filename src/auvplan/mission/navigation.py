@@ -156,7 +156,8 @@ class VehicleNavigation:
                 return route, unmet
             return route, choice(route, "budget", self.max_error)
         best, best_budget = cheapest, None
-        for step in range(1, LADDER_STEPS + 1):  # tighter budgets cost at least as much
+        steps = LADDER_STEPS if base_peak > 0.0 else 0  # 0: the route ends within settle_s
+        for step in range(1, steps + 1):  # tighter budgets cost at least as much
             budget = base_peak * LADDER_RATIO**step
             try:
                 searches += 1
