@@ -124,3 +124,19 @@ def test_a_mission_within_its_settling_time_flies_the_shortest_route(
     assert route["route_predicted_peak_m"] == 0.0
     assert route["budget_m"] is None
     assert route["tracked_by_the_optimiser"] is False
+
+
+def test_a_route_around_a_polygon_is_tracked_even_when_it_buys_nothing(
+    tmp_path: Path, transit_mission: TransitMission
+) -> None:
+    """The optimiser avoids circles and vehicles itself, not polygons: their routes stay."""
+    (tmp_path / "open").mkdir()
+    (tmp_path / "polygon").mkdir()
+    free = _preplan(transit_mission(tmp_path / "open", ridge=False), tmp_path / "open" / "out")
+    assert free["tracked_by_the_optimiser"] is False
+    mission = transit_mission(tmp_path / "polygon", ridge=False)
+    with mission.open("a", encoding="utf-8") as file:
+        file.write("[[obstacle]]\npolygon = [[700.0, 700.0], [900.0, 700.0], [800.0, 850.0]]\n")
+    around = _preplan(mission, tmp_path / "polygon" / "out")
+    assert around["budget_m"] is None
+    assert around["tracked_by_the_optimiser"] is True

@@ -125,8 +125,8 @@ def assemble_problem(
     """The stacked fleet problem for PRONTO (and the IPOPT reference), with its initial guess.
 
     ``terrain_weight`` overrides ``weights.terrain`` (0 for the energy-only comparison); a
-    navigation-aware route that buys no navigation (the shortest route) is not tracked: its
-    vehicle's plan is the energy-optimal one. The
+    navigation-aware route that buys no navigation (the shortest route) and has nothing to go
+    around is not tracked: its vehicle's plan is the energy-optimal one. The
     guess is the desired trajectory with zero inputs; PRONTO projects it onto the dynamics.
     ``current`` (None: still water) enters each stage linearised about the desired position.
     """
@@ -153,7 +153,7 @@ def assemble_problem(
             terrain=terrain_weight,
             energy=weights.energy,
             terminal=weights.terminal,
-            tracked=tuple(choice.pays_for_navigation for choice in preplan.navigation or ()),
+            tracked=tuple(choice.tracked for choice in preplan.navigation or ()),
         ),
         limits,
         has_current=current is not None,

@@ -23,8 +23,9 @@ recursion of :mod:`auvplan.navigation.prediction` at the vehicle's nominal speed
 ``weights.navigation`` [W/m²] adds ``λ σ² / U`` joules per metre to every edge (a soft
 price on the predicted error variance, integrated over time).
 
-The optimiser tracks a route (``weights.terrain``) only where it pays for navigation; a
-vehicle whose route is the shortest one gets the energy-optimal plan (tracking weight 0).
+The optimiser tracks a route (``weights.terrain``) only where it pays for navigation or has
+to go around land or a polygon; a vehicle whose route is the shortest one, with a straight
+line clear of both, gets the energy-optimal plan (tracking weight 0).
 """
 
 from __future__ import annotations
@@ -69,7 +70,8 @@ class NavigationChoice:
     ``energy_increase``: predicted extra energy of the route (fraction); ``searches``: the
     searches run; ``smallest_budget_m``: when no route meets the budget, the smallest one
     any route meets (the route is then within it), and ``message`` says where the shortest
-    route breaks the budget.
+    route breaks the budget; ``straight_clear``: whether the straight line from start to goal
+    keeps clear of land, no-data cells and polygons (which only the routes avoid).
     """
 
     mode: str
@@ -82,11 +84,21 @@ class NavigationChoice:
     searches: int
     smallest_budget_m: float | None = None
     message: str = ""
+    straight_clear: bool = False
 
     @property
     def pays_for_navigation(self) -> bool:
         """Whether the route differs from the shortest one to lower the predicted error."""
         return self.rms_m < self.energy_only_rms_m
+
+    @property
+    def tracked(self) -> bool:
+        """Whether the optimiser must follow the route.
+
+        It must when the route buys navigation or the straight line is not clear (the
+        optimiser itself avoids only circles and the other vehicles).
+        """
+        return self.pays_for_navigation or not self.straight_clear
 
     @property
     def budget_met(self) -> bool:
@@ -105,7 +117,7 @@ class NavigationChoice:
             "route_energy_increase": self.energy_increase,
             "searches": self.searches,
             "smallest_feasible_budget_m": self.smallest_budget_m,
-            "tracked_by_the_optimiser": self.pays_for_navigation,
+            "tracked_by_the_optimiser": self.tracked,
         }
 
 

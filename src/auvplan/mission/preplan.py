@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 from collections.abc import Callable
@@ -259,6 +260,21 @@ def _with_discs(
     return blocked
 
 
+def _straight_clear(
+    start: FloatArray,
+    goal: FloatArray,
+    spacing: float,
+    is_blocked: Callable[[FloatArray, FloatArray], BoolArray],
+) -> bool:
+    """Whether the straight line from ``start`` to ``goal`` [m] crosses no blocked point.
+
+    The line is sampled every ``spacing`` [m].
+    """
+    n = max(2, math.ceil(float(np.hypot(*(goal - start))) / spacing) + 1)
+    line = start[None, :] + np.linspace(0.0, 1.0, n)[:, None] * (goal - start)[None, :]
+    return not bool(np.any(is_blocked(line[:, 0], line[:, 1])))
+
+
 def plan_routes(
     maps: TerrainMaps,
     names: tuple[str, ...],
@@ -339,6 +355,11 @@ def plan_routes(
             except InfeasibleError:  # the keep-outs close every way: timing must do it
                 (route, choice), keep_out = search(()), ()
             routes.append(route)
+            if choice is not None:
+                clear = _straight_clear(
+                    starts[index, :2], goals[index, :2], 0.25 * cell, is_blocked
+                )
+                choice = dataclasses.replace(choice, straight_clear=clear)
             choices.append(choice)
             if choice is not None:
                 logger.info(
