@@ -25,7 +25,7 @@ from auvplan.viz.style import plain_tick_labels, vehicle_colors
 MAP_MARGIN_M = 40.0
 MAP_MIN_ASPECT = 0.8
 PLAN_TITLES = {
-    "terrain_aware": "terrain-aware plan",
+    "terrain_aware": "mission's plan",
     "energy_only": "energy-only plan",
     "paper": "paper's plan (information map)",
 }
