@@ -139,3 +139,35 @@ def test_missing_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> N
     assert main(["evaluate", str(tmp_path / "nowhere")]) == 2
     assert "not found" in capsys.readouterr().err
     assert not (tmp_path / "nowhere").exists()
+
+
+def test_evaluate_flies_the_folders_navigation_table_and_flags_override_it(
+    plan_folder: Path,
+) -> None:
+    """The plan's [navigation] table is the evaluator's model; a flag given overrides it."""
+    (plan_folder / "mission.toml").write_text(
+        "[navigation]\ndrift_percent = 0.5\ninitial_sigma_m = 3.0\n[mission]\ndepth_m = 5.0\n",
+        encoding="utf-8",
+    )
+    assert main(["-q", "evaluate", str(plan_folder), *FAST, "--no-figure"]) == 0
+    settings = json.loads((plan_folder / "navigation.json").read_text())["settings"]
+    assert settings["dead_reckoning"]["drift_fraction"] == pytest.approx(0.005)
+    assert settings["particle_filter"]["initial_sigma"] == 3.0
+    assert settings["sensor"]["vehicle_depth"] == 5.0
+    assert settings["update_period_s"] == 2.0  # the flag
+    assert main(["-q", "evaluate", str(plan_folder), *FAST, "--no-figure", "--drift", "2"]) == 0
+    settings = json.loads((plan_folder / "navigation.json").read_text())["settings"]
+    assert settings["dead_reckoning"]["drift_fraction"] == pytest.approx(0.02)
+    assert settings["particle_filter"]["initial_sigma"] == 3.0
+
+
+@pytest.mark.parametrize(
+    ("flag", "value"), [("--update-period", "1e-4"), ("--drift", "1e6"), ("--initial-sigma", "-1")]
+)
+def test_navigation_flags_out_of_range_exit_2_naming_the_key(
+    plan_folder: Path, capsys: pytest.CaptureFixture[str], flag: str, value: str
+) -> None:
+    assert main(["-q", "evaluate", str(plan_folder), "--runs", "2", flag, value]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line.startswith("auvplan: error: navigation.")
+    assert not (plan_folder / "navigation.json").exists()
