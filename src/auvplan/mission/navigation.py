@@ -40,6 +40,8 @@ from typing import Any, Final
 import numpy as np
 
 from auvplan._typing import FloatArray
+from auvplan.mission.config import MissionConfig
+from auvplan.mission.tables import NavigationConfig
 from auvplan.navigation import Track, process_noise_sigma
 from auvplan.navigation.prediction import ErrorPrediction, fisher_map, predict_error
 from auvplan.planning import Route
@@ -239,7 +241,7 @@ def _peak(route: Route) -> float:
 
 def vehicle_navigation(
     maps: TerrainMaps,
-    navigation: Any,
+    navigation: NavigationConfig,
     names: tuple[str, ...],
     models: tuple[VehicleModel, ...] | list[VehicleModel],
     straight: FloatArray,
@@ -321,7 +323,7 @@ def _cruise_energy(per_metre: float) -> Callable[[float], float]:
 
 
 def predict_tracks(
-    navigation: Any,
+    navigation: NavigationConfig,
     bathymetry: BathymetryGrid,
     time: FloatArray,
     tracks: FloatArray,
@@ -344,9 +346,8 @@ def predict_tracks(
     )
 
 
-def budget_of(config: Any) -> float | None:
+def budget_of(config: MissionConfig) -> float | None:
     """The mission's explicit navigation budget [m], if its routes are navigation-aware."""
     if config.planner.edge_model != "navigation":
         return None
-    budget: float | None = config.navigation.max_error
-    return budget
+    return config.navigation.max_error
