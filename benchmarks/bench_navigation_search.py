@@ -267,8 +267,8 @@ class Case:
 
     def ladder(self) -> dict[str, Any]:
         from auvplan.errors import InputError
-        from auvplan.mission.navigation import VehicleNavigation, route_length
-        from auvplan.planning import EdgeModel, Route, plan_route
+        from auvplan.mission.navigation import VehicleNavigation
+        from auvplan.planning import EdgeModel, Route, path_length, plan_route
         from auvplan.planning.belief import BeliefModel
 
         assert self.model is not None
@@ -295,7 +295,7 @@ class Case:
             "budget": choice.budget_m,
             "searches": choice.searches,
             "labels": sum(labels),
-            "cost": route_length(route),
+            "cost": path_length(route.points),
             "peak": choice.peak_m,
             "rms": choice.rms_m,
             "energy_only_rms": choice.energy_only_rms_m,

@@ -172,8 +172,7 @@ def _exit_code(result: Any) -> int:
             if not choice.budget_met:
                 print(f"auvplan: plan NAVIGATION_BUDGET: {choice.message}", file=sys.stderr)
                 return EXIT_NOT_CONVERGED
-    paper = None if result.paper is None else result.paper.plan
-    comparisons = (("energy-only plan", result.energy_only), ("paper's plan", paper))
+    comparisons = (("energy-only plan", result.energy_only), ("paper's plan", result.paper_plan))
     for label, plan in (("plan", result.plan), *comparisons):
         if plan is not None and not plan.verdict.success:
             print(
@@ -204,7 +203,7 @@ def _print_report(result: Any, written: list[Path]) -> None:
                 f"   arrival error {plan.arrival_error[i]:.2f} m   closest {closest:.2f} m",
                 file=out,
             )
-    paper = None if result.paper is None else result.paper.plan
+    paper = result.paper_plan
     if paper is not None:
         print(
             f"paper's plan (information-map routes): energy {paper.energy.sum():.1f} J, plan "

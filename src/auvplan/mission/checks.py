@@ -138,22 +138,8 @@ def judge_plan(
                 )
             )
     budget = budget_of(config)
-    for i, prediction in enumerate(predicted if budget is not None else ()):
-        assert budget is not None
-        late = prediction.time - prediction.time[0] >= config.navigation.settle
-        if np.any(late):
-            value, when = _worst(prediction.sigma[late], prediction.time[late], largest=True)
-            if value > budget * (1.0 + NAVIGATION_TOLERANCE):
-                floor = None if routes is None else routes[i].smallest_budget_m
-                advice = (
-                    "raise navigation.max_error_m or settle_s, or weights.terrain"
-                    if floor is None
-                    else f"no route meets it: the smallest budget any route meets is "
-                    f"{smallest_budget(floor):g} m; raise navigation.max_error_m or settle_s"
-                )
-                violations.append(
-                    Violation("navigation error", names[i], value, budget, when, advice)
-                )
+    if budget is not None:
+        violations += _navigation_violations(config, names, budget, predicted, routes)
     if not result.success:
         status = PlanStatus.NOT_CONVERGED
         message = (
@@ -167,3 +153,30 @@ def judge_plan(
     else:
         status, message = PlanStatus.CONVERGED, "every constraint holds between samples"
     return PlanVerdict(status, tuple(violations), message)
+
+
+def _navigation_violations(
+    config: MissionConfig,
+    names: tuple[str, ...],
+    budget: float,
+    predicted: tuple[ErrorPrediction, ...],
+    routes: tuple[NavigationChoice, ...] | None,
+) -> list[Violation]:
+    """Vehicles whose predicted error exceeds the budget [m] after ``settle_s`` (with slack)."""
+    violations = []
+    for i, prediction in enumerate(predicted):
+        late = prediction.time - prediction.time[0] >= config.navigation.settle
+        if not np.any(late):
+            continue
+        value, when = _worst(prediction.sigma[late], prediction.time[late], largest=True)
+        if value <= budget * (1.0 + NAVIGATION_TOLERANCE):
+            continue
+        floor = None if routes is None else routes[i].smallest_budget_m
+        advice = (
+            "raise navigation.max_error_m or settle_s, or weights.terrain"
+            if floor is None
+            else f"no route meets it: the smallest budget any route meets is "
+            f"{smallest_budget(floor):g} m; raise navigation.max_error_m or settle_s"
+        )
+        violations.append(Violation("navigation error", names[i], value, budget, when, advice))
+    return violations

@@ -152,7 +152,7 @@ def parse_mission(
     try:
         config = MissionConfig.model_validate({**data, "source": source})
     except ValidationError as error:
-        raise InputError(_one_line(error)) from None
+        raise InputError(one_line(error)) from None
     if config.terrain.file is not None and not config.terrain.file.is_absolute():
         terrain = config.terrain.model_copy(update={"file": base_dir / config.terrain.file})
         config = config.model_copy(update={"terrain": terrain})
@@ -239,12 +239,17 @@ def _keys_of(location: tuple[int | str, ...]) -> list[str]:
     return [f.alias or name for name, f in model.model_fields.items() if not f.exclude]
 
 
-def _one_line(error: ValidationError) -> str:
-    """The first validation error as one line naming the key path and the value."""
+def one_line(error: ValidationError, within: tuple[str, ...] = ()) -> str:
+    """The first validation error as one line naming the key path and the value.
+
+    ``within``: the path of the validated table in the mission (e.g. ``("navigation",)`` for
+    a :class:`~auvplan.mission.tables.NavigationConfig` validated on its own).
+    """
     first = error.errors(include_url=False)[0]
-    path = _key_path(tuple(first["loc"]))
+    location = (*within, *first["loc"])
+    path = _key_path(location)
     if first["type"] == "extra_forbidden":
-        allowed = ", ".join(_keys_of(tuple(first["loc"])[:-1]))
+        allowed = ", ".join(_keys_of(location[:-1]))
         return f"unknown key {path!r} (allowed here: {allowed})"
     if first["type"] == "missing":
         return f"{path} is required"

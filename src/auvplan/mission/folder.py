@@ -23,6 +23,7 @@ from auvplan.export.plan import CircleZone, ExportPlan, PolygonZone, VehicleTrac
 from auvplan.io.results import read_trajectories_csv
 from auvplan.io.text import read_json, read_toml
 from auvplan.io.trajectories_file import read_trajectories_netcdf
+from auvplan.mission.config import one_line
 from auvplan.mission.tables import NavigationConfig
 
 logger = logging.getLogger(__name__)
@@ -167,7 +168,5 @@ def folder_navigation(
             {**(table if isinstance(table, dict) else {}), **overrides}
         )
     except ValidationError as error:
-        first = error.errors(include_url=False)[0]
-        key = ".".join(str(part) for part in first["loc"])
-        raise InputError(f"navigation.{key}: {first['msg']}, got {first.get('input')!r}") from None
+        raise InputError(one_line(error, within=("navigation",))) from None
     return config, float(depth) if isinstance(depth, int | float) else 0.0

@@ -44,11 +44,11 @@ from auvplan.mission.config import MissionConfig
 from auvplan.mission.tables import NavigationConfig
 from auvplan.navigation import Track, process_noise_sigma
 from auvplan.navigation.prediction import ErrorPrediction, fisher_map, predict_error
-from auvplan.planning import Route
+from auvplan.planning import Route, path_length
 from auvplan.planning.belief import BeliefModel
 from auvplan.planning.route import BudgetInfeasible
 from auvplan.terrain import BathymetryGrid, TerrainMaps
-from auvplan.vehicle import VehicleModel
+from auvplan.vehicle import VehicleModel, optimal_cruise_speed
 from auvplan.vehicle.trim import energy_per_metre, top_speed, trim_surge
 
 logger = logging.getLogger(__name__)
@@ -58,7 +58,7 @@ logger = logging.getLogger(__name__)
 LADDER_STEPS: Final = 8
 LADDER_RATIO: Final = 0.85
 
-#: One search: a belief model (None: plain A*) and whether to minimise the peak error.
+#: One search: a belief model and whether to minimise the peak error instead of the cost.
 RouteSearch = Callable[[BeliefModel, bool], Route]
 
 
@@ -137,14 +137,14 @@ class VehicleNavigation:
     def route(self, search: RouteSearch) -> tuple[Route, NavigationChoice]:
         """The vehicle's route by its budget or automatically (module notes)."""
         cheapest = search(self.model, False)
-        base_energy = self.energy(route_length(cheapest))
+        base_energy = self.energy(path_length(cheapest.points))
         base_peak, base_rms = _peak(cheapest), route_rms(cheapest)
         searches = 1
 
         def choice(
             route: Route, mode: str, budget: float | None, smallest: float | None = None
         ) -> NavigationChoice:
-            increase = self.energy(route_length(route)) / base_energy - 1.0
+            increase = self.energy(path_length(route.points)) / base_energy - 1.0
             message = "" if smallest is None else self._budget_message(cheapest, smallest)
             return NavigationChoice(
                 mode, budget, _peak(route), route_rms(route), base_peak, base_rms, increase,
@@ -178,7 +178,10 @@ class VehicleNavigation:
                 route = search(self.with_budget(budget), False)
             except BudgetInfeasible:
                 break
-            if self.energy(route_length(route)) > (1.0 + self.max_energy_increase) * base_energy:
+            if (
+                self.energy(path_length(route.points))
+                > (1.0 + self.max_energy_increase) * base_energy
+            ):
                 break
             if route_rms(route) < route_rms(best):
                 best, best_budget = route, budget
@@ -188,12 +191,7 @@ class VehicleNavigation:
 
     def with_budget(self, budget: float) -> BeliefModel:
         """The model with a budget [m]."""
-        return BeliefModel(
-            self.model.fisher, self.model.updates_per_metre, self.model.drift_rate,
-            self.model.process_variance, self.model.initial_sigma, budget,
-            self.model.settle_distance, self.model.error_weight, self.model.bin_width,
-            self.model.max_labels,
-        )  # fmt: skip
+        return dataclasses.replace(self.model, max_error=budget)
 
     def _budget_message(self, cheapest: Route, floor: float) -> str:
         """One line: where the cheapest route breaks the budget, and the smallest budget."""
@@ -217,11 +215,6 @@ class VehicleNavigation:
 def smallest_budget(floor: float) -> float:
     """A route's smallest peak error [m] rounded up to the decimetre, as users are told."""
     return math.ceil(floor * 10.0) / 10.0
-
-
-def route_length(route: Route) -> float:
-    """Length [m] of a route's polyline."""
-    return float(np.sum(np.hypot(*np.diff(route.points, axis=0).T)))
 
 
 def route_rms(route: Route) -> float:
@@ -278,13 +271,14 @@ def vehicle_navigation(
         fastest = top_speed(model)
         if horizon is not None:
             speed = min(max(float(distance) / horizon, 0.05), fastest)
-            energy = _horizon_energy(model, horizon, fastest)
         else:
-            from auvplan.vehicle import optimal_cruise_speed
-
             speed = cruise_speed if cruise_speed is not None else optimal_cruise_speed(model).speed
-            per_metre = energy_per_metre(model, speed)
-            energy = _cruise_energy(per_metre)
+        per_metre = energy_per_metre(model, speed)
+        energy = (
+            _horizon_energy(model, horizon, fastest)
+            if horizon is not None
+            else _cruise_energy(per_metre)
+        )
         step = speed * settings.update_period
         process = float(process_noise_sigma(settings.motion, np.array([[step, 0.0]]))[0] ** 2)
         model_nav = BeliefModel(
@@ -294,7 +288,7 @@ def vehicle_navigation(
             process_variance=process,
             initial_sigma=settings.filter.initial_sigma,
             settle_distance=navigation.settle * speed,
-            error_weight=weight / (speed * energy_per_metre(model, speed)),
+            error_weight=weight / (speed * per_metre),
         )
         vehicles.append(
             VehicleNavigation(

@@ -69,6 +69,11 @@ class MissionResult:
     current_comparison: CurrentComparison | None = None
     paper: MissionResult | None = None
 
+    @property
+    def paper_plan(self) -> OptimizedPlan | None:
+        """The optimised plan of :attr:`paper`, if it was planned and optimised."""
+        return None if self.paper is None else self.paper.plan
+
 
 def run_mission(
     config: MissionConfig,

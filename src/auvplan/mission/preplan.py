@@ -41,7 +41,6 @@ from auvplan.planning import (
     smooth_path,
 )
 from auvplan.planning.belief import BeliefModel
-from auvplan.planning.route import BudgetInfeasible
 from auvplan.terrain import BathymetryGrid, MapParameters, TerrainMaps, compute_terrain_maps
 from auvplan.terrain.synthetic import synthetic_bank
 from auvplan.vehicle import optimal_cruise_speed, turning_radius
@@ -350,8 +349,6 @@ def plan_routes(
             keep_out = goal_keep_outs(starts, goals, index, clearance, cell)
             try:
                 route, choice = search(keep_out)
-            except BudgetInfeasible:
-                raise
             except InfeasibleError:  # the keep-outs close every way: timing must do it
                 (route, choice), keep_out = search(()), ()
             routes.append(route)
@@ -360,8 +357,6 @@ def plan_routes(
                     starts[index, :2], goals[index, :2], 0.25 * cell, is_blocked
                 )
                 choice = dataclasses.replace(choice, straight_clear=clear)
-            choices.append(choice)
-            if choice is not None:
                 logger.info(
                     "navigation %s: %s route, predicted error RMS %.1f m, peak %.1f m "
                     "(shortest route: %.1f m, %.1f m), energy %+.1f %%",
@@ -369,6 +364,7 @@ def plan_routes(
                     choice.rms_m, choice.peak_m, choice.energy_only_rms_m,
                     choice.energy_only_peak_m, 100.0 * choice.energy_increase,
                 )  # fmt: skip
+            choices.append(choice)
             # near the route, never through a no-go cell nor within 2 r_c of a kept-out goal
             radius = 0.0 if turning_radii is None else float(turning_radii[index])
             path = smooth_path(

@@ -6,6 +6,7 @@ Each key has one home here: its type, default, physical range, unit and TOML nam
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import types
 from datetime import UTC, datetime
@@ -377,12 +378,13 @@ class NavigationConfig(TableModel):
             SensorModel,
         )
 
-        sensor = SensorModel.named(self.sensor)
+        sensor = dataclasses.replace(
+            SensorModel.named(self.sensor),
+            map_variance=self.map_variance,
+            vehicle_depth=vehicle_depth,
+        )
         return NavigationSettings(
-            sensor=SensorModel(
-                sensor.n_beams, sensor.swath_angle, sensor.range_error_fraction,
-                self.map_variance, vehicle_depth,
-            ),
+            sensor=sensor,
             motion=DeadReckoningModel(
                 drift_fraction=self.drift / 100.0, velocity_noise=self.velocity_noise
             ),

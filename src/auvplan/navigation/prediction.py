@@ -79,11 +79,6 @@ class ErrorPrediction:
         late = self.sigma[self.time - self.time[0] >= settle_s]
         return float(np.max(late)) if late.size else 0.0
 
-    def first_above(self, limit: float, settle_s: float) -> int | None:
-        """Index of the first update after ``settle_s`` whose sigma exceeds ``limit``."""
-        late = (self.time - self.time[0] >= settle_s) & (self.sigma > limit)
-        return int(np.argmax(late)) if np.any(late) else None
-
 
 def predict_error(
     grid: BathymetryGrid, track: Track, settings: NavigationSettings

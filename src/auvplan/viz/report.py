@@ -162,13 +162,12 @@ def figure_builders(result: MissionResult) -> dict[str, Callable[[], Figure]]:
 def _predicted_error(result: MissionResult) -> Figure:
     """The predicted TAN error of the plan and of its comparisons, per vehicle."""
     assert result.plan is not None
-    paper = None if result.paper is None else result.paper.plan
     plans = {
         title: plan.predicted_navigation
         for title, plan in (
             ("plan", result.plan),
             ("energy-only plan", result.energy_only),
-            ("paper's plan", paper),
+            ("paper's plan", result.paper_plan),
         )
         if plan is not None
     }
