@@ -81,3 +81,9 @@ def test_a_crossing_blocked_both_ways_is_left_as_it_was() -> None:
 
     out = skirt_discs(line, np.array([[0.0, 0.0]]), np.array([3.0]), is_blocked=walls)
     assert np.max(np.abs(out[:, 0])) == 0.0
+
+
+def test_discs_too_small_to_draw_leave_the_path_as_it_is() -> None:
+    """Radii that buffer to nothing (e.g. a safety radius of 1e-300 m) skirt nothing."""
+    path = np.array([[0.0, -10.0], [0.0, 10.0]])
+    assert skirt_discs(path, np.array([[0.0, 0.0]]), np.array([1e-300])) is path

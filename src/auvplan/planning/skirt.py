@@ -21,7 +21,7 @@ from collections.abc import Callable
 from typing import Final
 
 import numpy as np
-from shapely import LineString, MultiPolygon, Point, Polygon
+from shapely import LineString, Point, Polygon
 from shapely.ops import substring, unary_union
 
 from auvplan._typing import BoolArray, FloatArray
@@ -76,7 +76,8 @@ def skirt_discs(
         [Point(float(c[0]), float(c[1])).buffer(float(r) * _CIRCUMSCRIBE, quad_segs=_QUAD_SEGS)
          for c, r in zip(centres, radii, strict=True)]
     )  # fmt: skip
-    components = list(union.geoms) if isinstance(union, MultiPolygon) else [union]
+    parts = union.geoms if hasattr(union, "geoms") else [union]  # discs too small vanish
+    components = [part for part in parts if isinstance(part, Polygon) and not part.is_empty]
     if any(component.contains(Point(*end)) for component in components for end in path[[0, -1]]):
         return path
     out = path
