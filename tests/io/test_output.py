@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import os
+import shutil
 import signal
+import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -147,6 +149,48 @@ def test_a_file_folder_clash_fails_with_nothing_changed(
     assert _tree(previous.parent) == before
 
 
+@pytest.fixture
+def no_exchange(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A system without an atomic exchange of two names: the swap takes two renames."""
+    monkeypatch.setattr(output, "_exchange", lambda first, second: False)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="renameat2 is Linux's")
+def test_the_swap_is_one_atomic_exchange_on_linux(
+    previous: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The new folder takes the name in the same step the old one leaves it."""
+    deleted: dict[str, bytes] = {}
+    original = shutil.rmtree
+
+    def inspect_then_delete(path: Path, **options: bool) -> None:
+        deleted.update(_tree(Path(path)))
+        deleted["target maps.nc"] = (previous / "maps.nc").read_bytes()
+        original(path, **options)
+
+    monkeypatch.setattr(output.shutil, "rmtree", inspect_then_delete)
+    with staged_output_dir(previous) as staging:
+        (staging / "maps.nc").write_bytes(b"new maps")
+    assert deleted["maps.nc"] == b"old maps"  # the old folder, under the staging name
+    assert deleted["target maps.nc"] == b"new maps"
+    assert [name for name in _tree(previous.parent) if name.startswith(".")] == []
+
+
+def test_a_failed_exchange_leaves_the_old_folder(
+    previous: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    before = _tree(previous.parent)
+
+    def failing_exchange(first: Path, second: Path) -> bool:
+        raise OSError(5, "Input/output error", str(second))
+
+    monkeypatch.setattr(output, "_exchange", failing_exchange)
+    with pytest.raises(OSError, match="Input/output"), staged_output_dir(previous) as staging:
+        (staging / "maps.nc").write_bytes(b"new maps")
+    assert _tree(previous.parent) == before
+
+
+@pytest.mark.usefixtures("no_exchange")
 def test_a_failed_swap_restores_the_old_folder(
     previous: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -197,7 +241,7 @@ def test_sigterm_while_writing_cleans_up(previous: Path) -> None:
     assert _tree(previous.parent) == before
 
 
-@pytest.mark.usefixtures("sigterm_raises")
+@pytest.mark.usefixtures("sigterm_raises", "no_exchange")
 def test_a_signal_during_the_swap_waits_until_it_is_complete(
     previous: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

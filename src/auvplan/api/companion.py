@@ -32,6 +32,7 @@ import importlib
 import io
 import logging
 import multiprocessing
+import signal
 import time
 import warnings
 from collections.abc import Callable, Iterator
@@ -39,11 +40,12 @@ from contextlib import AbstractContextManager, contextmanager
 from multiprocessing.pool import AsyncResult, Pool
 from pathlib import Path
 from types import TracebackType
-from typing import TYPE_CHECKING, Final
+from typing import TYPE_CHECKING, Final, TypeVar
 
 import numba
 
 import auvplan
+from auvplan.interrupts import checkpoint
 from auvplan.mission.config import MissionConfig
 from auvplan.mission.progress import ProgressReporter
 from auvplan.mission.warmup import warm_up, warm_up_missions
@@ -54,9 +56,12 @@ if TYPE_CHECKING:
     from auvplan.viz.report import RenderedFigure
 
 logger = logging.getLogger(__name__)
+T = TypeVar("T")
 
 #: The stage that needs the warm-up's kernels (a name of the pipeline's progress).
 NEEDS_KERNELS = "optimize"
+#: How often a wait for the worker checks for a stop request, in seconds.
+POLL_S: Final = 0.05
 #: The figures that the worker draws: about half of the drawing time of a run (the maps,
 #: coordination and separation figures take about as long as these).
 WORKER_FIGURES: Final = frozenset({"paths", "paths_cost", "paths_energy_only", "time_series"})
@@ -120,7 +125,7 @@ class Companion(AbstractContextManager["Companion"]):
         task, marker, started = self._warm_up
         self._warm_up = None
         try:
-            task.get()
+            _result(task)
         except Exception as error:  # noqa: BLE001 (the mission compiles what it needs itself)
             logger.info("kernel warm-up failed (%s); the optimiser compiles its kernels", error)
             return
@@ -161,7 +166,8 @@ class Companion(AbstractContextManager["Companion"]):
         task = self._pool.apply_async(draw, (result,), {"stems": theirs})
         ours = draw(result, stems=set(stems) - set(theirs))
         try:
-            rendered = {**ours, **task.get()}
+            drawn: dict[str, RenderedFigure] = _result(task)
+            rendered = {**ours, **drawn}
         except Exception as error:  # noqa: BLE001 (e.g. a result that does not pickle)
             logger.info("figures of the second process failed (%s); drawing them here", error)
             rendered = {**ours, **draw(result, stems=theirs)}
@@ -189,11 +195,22 @@ class Companion(AbstractContextManager["Companion"]):
         self.close()
 
 
+def _result(task: AsyncResult[T]) -> T:
+    """``task.get()``, honouring stop requests while it waits (the worker runs on)."""
+    while not task.ready():
+        task.wait(POLL_S)
+        checkpoint()
+    return task.get()
+
+
 def _prepare() -> None:
     """The worker's start: import what it will run while the mission's process plans.
 
-    Its logs and warnings are dropped: the mission's process reports.
+    It ignores SIGINT: Ctrl-C in a terminal reaches every process of the group, and the
+    mission's process, which reports it, stops the worker (:meth:`Companion.close`). Its logs
+    and warnings are dropped: the mission's process reports.
     """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     logging.getLogger("auvplan").addHandler(logging.NullHandler())
     logging.getLogger("auvplan").propagate = False
     warnings.simplefilter("ignore")

@@ -11,9 +11,12 @@ Failures are one line on stderr, never a traceback:
 * a usage error (unknown option, bad number), every :class:`~auvplan.errors.AuvplanError` and
   every file-system error: exit code 2;
 * SIGINT (Ctrl-C): exit code 130; SIGTERM: exit code 143 (128 + the signal number, as a
-  shell reports a process killed by it). Both are turned into exceptions, so the output
-  writers (:func:`auvplan.io.output.staged_output_dir`) delete their staging files and leave
-  the output folder as it was.
+  shell reports a process killed by it). Both are stop requests (:mod:`auvplan.interrupts`)
+  raised at the next safe point, so the output writers
+  (:func:`auvplan.io.output.staged_output_dir`) delete their staging files and leave the
+  output folder as it was, and the worker process is stopped with the run. The console
+  script (:func:`console`) keeps the handlers until the process ends: a signal after the run
+  finished changes nothing.
 """
 
 from __future__ import annotations
@@ -23,13 +26,10 @@ import importlib
 import logging
 import signal
 import sys
-import threading
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
-from types import FrameType
+from collections.abc import Sequence
 from typing import Any, NoReturn
 
-from auvplan import __version__
+from auvplan import __version__, interrupts
 from auvplan.errors import AuvplanError
 
 #: Modules of :mod:`auvplan.cli` that provide a verb, in help order.
@@ -45,10 +45,6 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         self.exit(EXIT_USER_ERROR, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
-
-
-class _Terminated(BaseException):
-    """SIGTERM, raised in the main thread like KeyboardInterrupt is for SIGINT."""
 
 
 def _add_verbosity(parser: argparse.ArgumentParser, *, default: Any) -> None:
@@ -92,7 +88,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         logging.WARNING if args.quiet else logging.DEBUG if args.verbose else logging.INFO
     )
     try:
-        with _sigterm_raises():
+        with interrupts.stop_requests():
             if getattr(args, "output", None) is not None:  # every verb's -o is a folder
                 from auvplan.io.output import check_output_dir  # heavy package: only now
 
@@ -108,7 +104,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("auvplan: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
-    except _Terminated:
+    except interrupts.Terminated:
         print("auvplan: terminated", file=sys.stderr)
         return EXIT_TERMINATED
     finally:
@@ -116,22 +112,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     return code
 
 
-@contextmanager
-def _sigterm_raises() -> Iterator[None]:
-    """While the block runs, SIGTERM raises :class:`_Terminated` in the main thread."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def terminate(_signum: int, _frame: FrameType | None) -> NoReturn:
-        raise _Terminated
-
-    previous = signal.signal(signal.SIGTERM, terminate)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
+def console() -> int:
+    """The ``auvplan`` console script: :func:`main` with stop requests from the first moment."""
+    interrupts.install()
+    return main()
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(console())

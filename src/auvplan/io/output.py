@@ -6,31 +6,37 @@
 1. the files and sub-folders already in the target that the run does not write are carried
    over into the staging folder (hard links, else copies), so **a successful run keeps unrelated
    files** and replaces only the files it writes;
-2. the target is renamed aside (``.NAME.XXXX.old``), the staging folder renamed into its place,
-   and the old folder deleted; if the second rename fails the first is undone.
+2. the staging folder and the target trade names in one atomic step (Linux's
+   ``renameat2(RENAME_EXCHANGE)``) and the old folder, now under the staging name, is deleted;
+   where the system cannot exchange, the target is renamed aside (``.NAME.XXXX.old``) and the
+   staging folder renamed into its place (the first rename undone if the second fails).
 
 The target is checked before any work (:func:`check_output_dir`). Any failure, including
-SIGINT/SIGTERM turned into exceptions by the command line, deletes the staging folder and any
+a stop request (SIGINT/SIGTERM, :mod:`auvplan.interrupts`), deletes the staging folder and any
 parent folder the run created, so the file system is left exactly as it was. The two renames
-and the deletion run with SIGINT and SIGTERM held back, so a signal never cuts them in half:
-at every instant the target holds either the complete old or the complete new output.
+and the deletion run in a :func:`~auvplan.interrupts.held` section, so a signal never cuts
+them in half: at every instant the target holds either the complete old or the complete new
+output (or, for the instant between the renames, nothing under its name).
 :func:`staged_output_file` does the same for a single file (a figure).
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
+import errno
+import logging
 import os
 import shutil
-import signal
 import tempfile
-import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from types import FrameType
 
 from auvplan.errors import InputError
+from auvplan.interrupts import checkpoint, held
+
+logger = logging.getLogger(__name__)
 
 
 def check_output_dir(target: Path) -> None:
@@ -113,11 +119,12 @@ def staged_output_dir(target: Path) -> Iterator[Path]:
         )
         staging.chmod(_mode_of(destination, 0o777))  # mkdtemp's 0o700 is for the staging only
         yield staging
+        checkpoint()  # a stop requested while the files were written: before the swap
         if destination.exists():
             _carry_over(destination, staging, shown=target)
         _swap_in(staging, destination)
     except BaseException:
-        with _signals_deferred():
+        with held():
             if staging is not None:
                 shutil.rmtree(staging, ignore_errors=True)
             for folder in reversed(created[1:]):
@@ -175,7 +182,7 @@ def staged_output_file(target: Path) -> Iterator[Path]:
     try:
         temporary.chmod(_mode_of(target, 0o666))  # mkstemp's 0o600 is for the staging only
         yield temporary
-        with _signals_deferred():
+        with held():
             temporary.replace(target)
     except BaseException:
         temporary.unlink(missing_ok=True)
@@ -247,48 +254,62 @@ def _link_or_copy(source: str | Path, destination: str | Path) -> None:
 
 
 def _swap_in(staging: Path, destination: Path) -> None:
-    """Rename ``staging`` to ``destination``, replacing and then deleting an existing folder."""
-    with _signals_deferred():
+    """Put ``staging`` in the place of ``destination``, then delete the old folder.
+
+    Where the kernel can (Linux ≥ 3.15: ``renameat2(RENAME_EXCHANGE)`` on local file systems)
+    the two folders trade names in one atomic step, so ``destination`` names a complete folder
+    at every instant, even if the process is killed outright. Elsewhere the old folder is
+    renamed aside first and the staging folder renamed into its place (the first rename is
+    undone if the second fails). An old folder that cannot be deleted is named in a warning.
+    """
+    with held():
         if not destination.exists():
             staging.replace(destination)
             return
-        aside = Path(
-            tempfile.mkdtemp(prefix=f".{destination.name}.", suffix=".old", dir=destination.parent)
-        )
-        try:
-            destination.replace(aside)  # onto the empty folder mkdtemp made
-        except BaseException:
-            aside.rmdir()
-            raise
-        try:
-            staging.replace(destination)
-        except BaseException:
-            aside.replace(destination)
-            raise
+        if _exchange(staging, destination):
+            aside = staging
+        else:
+            aside = Path(
+                tempfile.mkdtemp(
+                    prefix=f".{destination.name}.", suffix=".old", dir=destination.parent
+                )
+            )
+            try:
+                destination.replace(aside)  # onto the empty folder mkdtemp made
+            except BaseException:
+                aside.rmdir()
+                raise
+            try:
+                staging.replace(destination)
+            except BaseException:
+                aside.replace(destination)
+                raise
         shutil.rmtree(aside, ignore_errors=True)
+        if aside.exists():
+            logger.warning("could not delete the previous output %s; delete it by hand", aside)
 
 
-@contextmanager
-def _signals_deferred() -> Iterator[None]:
-    """Hold SIGINT and SIGTERM until the block ends, then deliver the first one received.
+def _exchange(first: Path, second: Path) -> bool:
+    """Swap the names of two paths atomically; False where the system cannot.
 
-    Python runs signal handlers in the main thread only, so swapping the handlers there
-    defers the signal whichever thread the kernel delivers it to.
+    Linux's ``renameat2(..., RENAME_EXCHANGE)`` through the C library (glibc ≥ 2.28, musl);
+    ``EINVAL``/``ENOSYS``/``ENOTSUP`` (old kernels, file systems without it) mean "cannot".
     """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    received: list[int] = []
-
-    def record(signum: int, _frame: FrameType | None) -> None:
-        received.append(signum)
-
-    signals = (signal.SIGINT, signal.SIGTERM)
-    previous = {number: signal.signal(number, record) for number in signals}
-    try:
-        yield
-    finally:
-        for number, handler in previous.items():
-            signal.signal(number, signal.SIG_DFL if handler is None else handler)
-        if received:
-            signal.raise_signal(received[0])
+    renameat2 = getattr(ctypes.CDLL(None, use_errno=True), "renameat2", None)
+    if renameat2 is None:
+        return False
+    renameat2.argtypes = (
+        ctypes.c_int,
+        ctypes.c_char_p,
+        ctypes.c_int,
+        ctypes.c_char_p,
+        ctypes.c_uint,
+    )
+    renameat2.restype = ctypes.c_int
+    at_cwd, exchange = -100, 2  # AT_FDCWD, RENAME_EXCHANGE from <fcntl.h>, <linux/fs.h>
+    if renameat2(at_cwd, os.fsencode(first), at_cwd, os.fsencode(second), exchange) == 0:
+        return True
+    code = ctypes.get_errno()
+    if code in (errno.EINVAL, errno.ENOSYS, errno.ENOTSUP):
+        return False
+    raise OSError(code, os.strerror(code), str(second))

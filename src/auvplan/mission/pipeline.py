@@ -31,7 +31,7 @@ from auvplan.mission.evaluation import OptimizedPlan, evaluate_plan
 from auvplan.mission.fleet import FleetLayout
 from auvplan.mission.models import vehicle_model
 from auvplan.mission.preplan import PreplanStage, run_preplan
-from auvplan.mission.progress import ProgressReporter, no_progress
+from auvplan.mission.progress import ProgressReporter, no_progress, with_checkpoints
 from auvplan.mission.still_water import CurrentComparison, compare_with_still_water
 from auvplan.mission.timing import DeconflictStage, run_deconfliction
 from auvplan.optimization import solve_pronto
@@ -108,6 +108,7 @@ def run_mission(
         (:mod:`auvplan.mission.progress`).
     """
     timings: dict[str, float] = {}
+    progress = with_checkpoints(progress)
 
     def timed(name: str, work: Callable[[], Any]) -> Any:
         started = wallclock.perf_counter()

@@ -15,6 +15,8 @@ from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager, contextmanager
 from typing import Protocol
 
+from auvplan.interrupts import checkpoint
+
 
 class ProgressReporter(Protocol):
     """``progress(name, total=None)``: a context manager around one stage (module notes)."""
@@ -43,4 +45,26 @@ def no_progress(name: str, *, total: int | None = None) -> Iterator[Callable[[st
     yield advance
 
 
-__all__ = ["ProgressReporter", "no_progress"]
+def with_checkpoints(progress: ProgressReporter) -> ProgressReporter:
+    """``progress`` that also honours stop requests (:func:`auvplan.interrupts.checkpoint`).
+
+    A pending SIGINT/SIGTERM is raised as a stage begins, after each unit of work and as the
+    stage ends: the safe points between path searches and stages.
+    """
+
+    @contextmanager
+    def reporter(name: str, *, total: int | None = None) -> Iterator[Callable[[str], None]]:
+        checkpoint()
+        with progress(name, total=total) as advance:
+
+            def advance_and_check(label: str) -> None:
+                advance(label)
+                checkpoint()
+
+            yield advance_and_check
+        checkpoint()
+
+    return reporter
+
+
+__all__ = ["ProgressReporter", "no_progress", "with_checkpoints"]

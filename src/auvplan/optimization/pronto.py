@@ -33,6 +33,7 @@ from threadpoolctl import threadpool_limits
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError, SolverError
+from auvplan.interrupts import checkpoint
 from auvplan.optimization.linesearch import armijo_step, converged
 from auvplan.optimization.model import ModelCache, ProntoModel
 from auvplan.optimization.options import ProntoOptions
@@ -144,6 +145,7 @@ def _iterate_level(
         )
         if callback is not None:
             callback(record)
+        checkpoint()  # a stop request (SIGINT/SIGTERM) between iterations
         if is_done:
             return None
         assert result is not None

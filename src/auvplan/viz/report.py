@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import io
-from collections.abc import Callable, Collection
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Final
@@ -13,6 +13,7 @@ from matplotlib.figure import Figure
 
 from auvplan._figures import DEFAULT_DPI, FIGURE_FORMATS
 from auvplan.errors import InputError
+from auvplan.interrupts import checkpoint
 from auvplan.mission.evaluation import OptimizedPlan
 from auvplan.mission.navigation import budget_of
 from auvplan.mission.pipeline import MissionResult
@@ -82,6 +83,7 @@ def render_figure(
         figure.savefig(buffer, format=file_format, dpi=dpi, metadata=metadata)
         return buffer.getvalue()
 
+    checkpoint()  # a stop request (SIGINT/SIGTERM) between figures
     data = render(figure_format)
     if figure_format == "pdf":
         return RenderedFigure(figure_format, data, render("png"), FIGURE_FORMATS["png"])
@@ -180,7 +182,7 @@ def _predicted_error(result: MissionResult) -> Figure:
     )
 
 
-def _tracks(result: MissionResult, states: np.ndarray) -> list[np.ndarray]:
+def _tracks(result: MissionResult, states: Sequence[np.ndarray]) -> list[np.ndarray]:
     """North/east ``(n_t, 2)`` of each vehicle's states."""
     assert result.deconfliction is not None  # a plan exists only after stage 2
     models = result.deconfliction.layout.models
