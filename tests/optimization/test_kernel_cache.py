@@ -11,10 +11,13 @@ import importlib
 import json
 import logging
 import os
+import shutil
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 import casadi as ca
@@ -22,13 +25,14 @@ import numpy as np
 import pytest
 
 import auvplan
-from auvplan.optimization import BlockKernels, block_kernels
-from auvplan.optimization._kernel_cache import cache_root, kernel_path
+from auvplan.optimization import BlockKernels, _kernel_cache, block_kernels
+from auvplan.optimization._kernel_cache import cache_root, kernel_path, load_kernel_module
 from auvplan.optimization._numba_codegen import UnsupportedOperation
 
 from ._kernel_models import pendulum
 
 kernel_module = importlib.import_module("auvplan.optimization.block_kernels")
+SLOW = pytest.mark.slow
 
 #: A fresh process: the pendulum kernels (``g = argv[2]``) from the cache ``argv[1]`` at the
 #: point ``argv[3]`` (JSON); reports whether the module was generated or compiled, and results.
@@ -255,3 +259,102 @@ def test_cache_root_and_module_names(tmp_path: Path, monkeypatch: pytest.MonkeyP
     assert kernel_path("key").parent == tmp_path / "explicit" / "kernels"
     assert kernel_path("key", tmp_path / "mine").parent == tmp_path / "mine"
     assert kernel_path("key") == kernel_path("key") != kernel_path("another key")
+
+
+#: How a cache file is damaged: its first half (a full disk), bytes that mean nothing, nothing.
+DAMAGES: dict[str, Callable[[bytes], bytes]] = {
+    "truncated": lambda content: content[: len(content) // 2],
+    "garbage": lambda content: np.random.default_rng(28).bytes(max(len(content), 64)),
+    "empty": lambda content: b"",
+}
+TRIPLE = "import numba\n@numba.njit(cache=True)\ndef triple(a):\n    return 3.0 * a + 0.25\n"
+
+
+@pytest.mark.parametrize("damage", DAMAGES)
+def test_a_damaged_module_is_generated_again_with_one_warning(
+    damage: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    generated: list[bool] = []
+
+    def source() -> str:
+        generated.append(True)
+        return TRIPLE
+
+    def load() -> ModuleType:
+        monkeypatch.setattr(_kernel_cache, "_LOADED", {})  # as a later process
+        return load_kernel_module("tripling", source, tmp_path)[0]
+
+    path = Path(str(load().__file__))
+    path.write_bytes(DAMAGES[damage](path.read_bytes()))
+    with caplog.at_level(logging.WARNING, logger="auvplan.optimization._kernel_cache"):
+        module = load()
+        assert [record.getMessage() for record in caplog.records] == [
+            f"kernel cache file {path} is damaged: generated again"
+        ]
+        caplog.clear()
+        assert load().triple is not None  # the rebuilt module is whole: no warning
+    assert module.triple.py_func(1.5) == 4.75
+    assert caplog.records == []
+    assert len(generated) == 2
+    assert list(tmp_path.glob("k_*")) == [path]
+    assert not list(tmp_path.glob("*.tmp"))  # the new module was renamed into place
+
+
+#: Cache files of the pendulum kernel ``value_batch`` (a kernel called from Python).
+KERNEL_FILES: dict[str, Callable[[Path], Path]] = {
+    "module": lambda module: module,
+    "nbi": lambda module: _only(module.parent, f"__pycache__/{module.stem}.value_batch-*.nbi"),
+    "nbc": lambda module: _only(module.parent, f"__pycache__/{module.stem}.value_batch-*.nbc"),
+}
+HEALING_GRAVITY = "2.5"  # a model of these tests only
+
+
+def _only(folder: Path, pattern: str) -> Path:
+    (path,) = folder.glob(pattern)
+    return path
+
+
+@pytest.fixture(scope="module")
+def pendulum_cache(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A kernel folder holding the compiled pendulum kernels (numba's files beside them)."""
+    cache = tmp_path_factory.mktemp("healing") / "kernels"
+    block_kernels(*pendulum(float(HEALING_GRAVITY)), cache)
+    return cache
+
+
+def _later_run(cache: Path, point: str) -> tuple[dict[str, Any], list[str]]:
+    """A fresh process loading the pendulum kernels from ``cache``: its report and stderr."""
+    script = LATER_PROCESS.format(helpers=str(Path(__file__).parent))
+    process = _start(script, str(cache), HEALING_GRAVITY, point)
+    stdout, stderr = process.communicate(timeout=300)
+    assert process.returncode == 0, stderr  # no traceback
+    return json.loads(stdout.strip().splitlines()[-1]), stderr.splitlines()
+
+
+@pytest.mark.parametrize(
+    ("kind", "damage"),
+    [
+        pytest.param(kind, damage, marks=[] if (kind, damage) == ("nbc", "truncated") else [SLOW])
+        for kind in KERNEL_FILES
+        for damage in DAMAGES
+    ],
+)
+def test_a_damaged_cache_file_is_rebuilt_and_the_next_run_is_clean(
+    kind: str, damage: str, pendulum_cache: Path, tmp_path: Path
+) -> None:
+    cache = tmp_path / "kernels"
+    shutil.copytree(pendulum_cache, cache)  # (copy2 keeps the times numba compares)
+    module = _only(cache, "k_*.py")
+    damaged = KERNEL_FILES[kind](module)
+    damaged.write_bytes(DAMAGES[damage](damaged.read_bytes()))
+    point = json.dumps([[[0.3, -0.2]], [[0.4]], [[0.0]], [[1.0, 0.5]], [[1.0, -2.0]]])
+
+    first, warnings = _later_run(cache, point)
+    assert len(warnings) == 1  # one line
+    assert f"{damaged} is damaged" in warnings[0]
+    assert first["generated"] == (kind == "module")
+    second, silence = _later_run(cache, point)
+    assert silence == []
+    assert (second["generated"], second["compiled"], second["loaded"]) == (0, 0, 4)
+    assert second["step"] == first["step"]
+    assert second["hessian"] == first["hessian"]

@@ -6,6 +6,7 @@ two vehicles come closer than ``2 r_c``, certified in continuous time.
 
 from __future__ import annotations
 
+from auvplan import _numba_cache  # noqa: F401 (damaged numba cache files heal: first)
 from auvplan.deconfliction.conflicts import (
     ConflictTable,
     build_conflict_table,

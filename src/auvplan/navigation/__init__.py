@@ -8,6 +8,7 @@ of what the terrain allows. Defaults and their sources are in each model's docst
 
 from __future__ import annotations
 
+from auvplan import _numba_cache  # noqa: F401 (damaged numba cache files heal: first)
 from auvplan.navigation.depth import depth_at, depth_gradient_at
 from auvplan.navigation.evaluation import (
     PlanNavigation,

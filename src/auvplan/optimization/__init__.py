@@ -23,6 +23,7 @@ Modules, in the order of the data flow:
 
 from __future__ import annotations
 
+from auvplan import _numba_cache  # noqa: F401 (damaged numba cache files heal: first)
 from auvplan.optimization.barrier import (
     BarrierKind,
     barrier_expression,

@@ -9,6 +9,12 @@ vehicle type) is paid by the first mission only; later missions and processes lo
 well under a second. A model change changes the key, hence the file: a stale kernel is
 never used. Files are written to a temporary name and renamed into place, so concurrent
 processes never read a partial file (numba writes its cache files the same way).
+
+A module ends with the SHA-256 of its text (:func:`_sealed`); one whose text does not match
+(truncated, garbage or empty, e.g. after a full disk or a crash) is discarded with one
+warning naming it and generated again. numba's files of the module's kernels (``.nbi``,
+``.nbc``) live in ``__pycache__`` beside it, or under ``$NUMBA_CACHE_DIR`` when that is set;
+:mod:`auvplan._numba_cache` discards and rebuilds those the same way.
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
+from typing import Final
 
 import numba
 
@@ -29,6 +36,10 @@ __all__ = ["cache_root", "kernel_path", "load_kernel_module"]
 
 logger = logging.getLogger(__name__)
 _LOADED: dict[str, ModuleType] = {}
+#: Version of the file layout (the seal); part of every module's name.
+CACHE_FORMAT: Final = 2
+#: Last line of a module: this prefix and the SHA-256 (hex) of the text before it.
+SEAL_PREFIX: Final = "# auvplan kernel cache seal sha256 "
 
 
 def cache_root() -> Path:
@@ -55,7 +66,8 @@ def _writable(directory: Path) -> Path:
 
 def kernel_path(key: str, cache_dir: Path | None = None) -> Path:
     """Where the module of ``key`` lives (the name hashes the key and the toolchain)."""
-    text = f"{key}\n# numba {numba.__version__} python {sys.version_info[:2]}"
+    toolchain = f"numba {numba.__version__} python {sys.version_info[:2]} format {CACHE_FORMAT}"
+    text = f"{key}\n# {toolchain}"
     digest = hashlib.sha256(text.encode("utf-8")).hexdigest()[:24]
     return (cache_root() / "kernels" if cache_dir is None else cache_dir) / f"k_{digest}.py"
 
@@ -71,7 +83,7 @@ def load_kernel_module(
         Identifies the source completely (e.g. the serialised model and the generator
         version): equal keys must give equal sources.
     make_source : callable
-        Generates the source; called only when the module is not on disk yet.
+        Generates the source; called only when the module is not on disk yet, or damaged.
     cache_dir : Path, optional
         Folder of the modules; default ``cache_root() / "kernels"``.
 
@@ -88,13 +100,17 @@ def load_kernel_module(
         return loaded, False
     directory = _writable(path.parent)
     path = directory / path.name
+    is_whole = _is_sealed(path)
+    if not is_whole and path.exists():
+        logger.warning("kernel cache file %s is damaged: generated again", path)
+        path.with_suffix(".ready").unlink(missing_ok=True)
     is_new = not path.with_suffix(".ready").exists()
-    if not path.exists():
-        source = make_source()  # first: a model it refuses leaves nothing behind
+    if not is_whole:  # (a damaged file is replaced, never deleted: others may be reading it)
+        text = _sealed(make_source())  # first: a model it refuses leaves nothing behind
         with tempfile.NamedTemporaryFile(
             "w", dir=directory, suffix=".tmp", delete=False, encoding="utf-8"
         ) as handle:
-            handle.write(source)
+            handle.write(text)
         Path(handle.name).replace(path)
     spec = importlib.util.spec_from_file_location(f"auvplan_kernels_{path.stem}", path)
     assert spec is not None
@@ -104,6 +120,22 @@ def load_kernel_module(
     spec.loader.exec_module(module)
     _LOADED[str(path)] = module
     return module, is_new
+
+
+def _sealed(source: str) -> str:
+    """``source`` followed by its seal line (:data:`SEAL_PREFIX` and the SHA-256 of ``source``)."""
+    body = source if source.endswith("\n") else source + "\n"
+    return f"{body}{SEAL_PREFIX}{hashlib.sha256(body.encode('utf-8')).hexdigest()}\n"
+
+
+def _is_sealed(path: Path) -> bool:
+    """Whether the module at ``path`` exists and is whole: its last line seals the rest."""
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except (FileNotFoundError, UnicodeDecodeError):
+        return False
+    body, newline, _ = text.removesuffix("\n").rpartition("\n")
+    return _sealed(body + newline) == text
 
 
 def mark_compiled(module: ModuleType) -> None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from auvplan import _numba_cache  # noqa: F401 (damaged numba cache files heal: first)
 from auvplan.planning.astar import heuristic_map, plan_astar
 from auvplan.planning.obstacles import (
     CircleObstacle,

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from auvplan import _numba_cache  # noqa: F401 (damaged numba cache files heal: first)
 from auvplan._typing import FloatArray
 from auvplan.terrain.grid import GridGeometry
 
