@@ -17,6 +17,7 @@ import time
 from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 import pytest
@@ -53,18 +54,57 @@ def _write(path: Path, content: str | bytes) -> str:
 
 
 def _maps_on_netcdf(
-    name: str, lat: tuple[float, float], lon: tuple[float, float], elevation: float | np.ndarray
+    name: str,
+    lat: tuple[float, float],
+    lon: tuple[float, float],
+    elevation: float | np.ndarray,
+    netcdf_format: Literal["NETCDF4", "NETCDF3_CLASSIC"] = "NETCDF4",
 ) -> Callable[[Path], list[str]]:
-    """Arguments of ``auvplan maps`` on a 12 x 12 lat/lon NetCDF of ``elevation`` [m]."""
+    """Arguments of ``auvplan maps`` on a 12 x 12 lat/lon NetCDF of ``elevation`` [m], the
+    coordinates stored first as in GEBCO's and NCEI's files."""
 
     def build(tmp: Path) -> list[str]:
-        xr.Dataset(
-            {"elevation": (("lat", "lon"), np.broadcast_to(elevation, (12, 12)))},
-            coords={"lat": np.linspace(*lat, 12), "lon": np.linspace(*lon, 12)},
-        ).to_netcdf(tmp / name)
+        dataset = xr.Dataset(coords={"lat": np.linspace(*lat, 12), "lon": np.linspace(*lon, 12)})
+        dataset["elevation"] = ("lat", "lon"), np.broadcast_to(elevation, (12, 12))
+        dataset.to_netcdf(tmp / name, format=netcdf_format)
         return ["maps", str(tmp / name), "-o", str(tmp / "out")]
 
     return build
+
+
+def _maps_on_raster(name: str, driver: str) -> Callable[[Path], list[str]]:
+    """Arguments of ``auvplan maps`` on a 60 x 60 metric GeoTIFF or ESRI ASCII grid (a slope)."""
+
+    def build(tmp: Path) -> list[str]:
+        import rasterio
+        from affine import Affine
+
+        depth = 40.0 + 0.1 * np.add.outer(np.arange(60.0), np.arange(60.0))
+        profile = {"height": 60, "width": 60, "count": 1, "dtype": "float32"}
+        with rasterio.open(
+            tmp / name,
+            "w",
+            driver=driver,
+            transform=Affine(10.0, 0.0, 0.0, 0.0, -10.0, 600.0),
+            **profile,
+        ) as raster:
+            raster.write(depth.astype(np.float32), 1)
+        return ["maps", str(tmp / name), "-o", str(tmp / "out")]
+
+    return build
+
+
+def _cut_to_a_third(build: Callable[[Path], list[str]]) -> Callable[[Path], list[str]]:
+    """The same arguments, the input file (``argv[1]``) cut to its first third of bytes, as an
+    interrupted download leaves it."""
+
+    def cut(tmp: Path) -> list[str]:
+        argv = build(tmp)
+        data = Path(argv[1]).read_bytes()
+        Path(argv[1]).write_bytes(data[: len(data) // 3])
+        return argv
+
+    return cut
 
 
 def _maps_on_xyz(name: str, table: np.ndarray) -> Callable[[Path], list[str]]:
@@ -142,6 +182,29 @@ CASES: dict[str, tuple[Callable[[Path], list[str]], str]] = {
         _maps_on_netcdf("huge.nc", (40.0, 40.1), (10.0, 10.1), -1e308),
         "huge.nc: no valid value: all 144 values are no data or beyond ±12000 m",
     ),
+    # 3b. bathymetry cut short (an interrupted download): refused, naming what is missing
+    "netcdf-3 cut to a third": (
+        _cut_to_a_third(
+            _maps_on_netcdf("cut3.nc", (40.0, 40.1), (10.0, 10.1), -50.0, "NETCDF3_CLASSIC")
+        ),
+        "cut3.nc: truncated NetCDF: the file has",
+    ),
+    "netcdf-4 cut to a third": (
+        _cut_to_a_third(_maps_on_netcdf("cut4.nc", (40.0, 40.1), (10.0, 10.1), -50.0)),
+        "cut4.nc: truncated NetCDF-4: the file has",
+    ),
+    "geotiff cut to a third": (
+        _cut_to_a_third(_maps_on_raster("cut.tif", "GTiff")),
+        "cut.tif: truncated GeoTIFF: the file has",
+    ),
+    "esri ascii cut to a third": (
+        _cut_to_a_third(_maps_on_raster("cut.asc", "AAIGrid")),
+        "cut.asc: ESRI ASCII grid cut short: the header declares 60 x 60 = 3600 values",
+    ),
+    "xyz cut to a third": (
+        _cut_to_a_third(_maps_on_xyz("cut.xyz", _survey(301))),  # 30-byte lines: cut in line 101
+        "cut.xyz: line 101 has 1 column, need 3",
+    ),
     # 4. vehicle numbers outside their physical range
     "vehicle n_max = 1e-9": (
         lambda tmp: [
@@ -216,8 +279,15 @@ def test_bad_input_exits_2_with_one_line_and_leaves_nothing(
     case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     build, expected = CASES[case]
-    argv = build(tmp_path)
-    before = _tree(tmp_path)
+    _assert_refused(build(tmp_path), tmp_path, expected, capsys)
+    assert not Path("/proc/auvplan-test").exists()
+
+
+def _assert_refused(
+    argv: list[str], tmp: Path, expected: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``argv`` exits 2 with one stderr line holding ``expected``, and ``tmp`` is unchanged."""
+    before = _tree(tmp)
     code, out, err = _run(argv, capsys)
     assert code == 2, err
     lines = err.splitlines()
@@ -226,8 +296,21 @@ def test_bad_input_exits_2_with_one_line_and_leaves_nothing(
     assert expected in lines[0]
     assert "Traceback" not in err
     assert out == ""
-    assert _tree(tmp_path) == before
-    assert not Path("/proc/auvplan-test").exists()
+    assert _tree(tmp) == before
+
+
+def test_real_netcdf_cut_to_a_third_is_refused(
+    bathymetry_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """NCEI's Monterey grid (NetCDF-3) cut to its first third: read before as two thirds of
+    no data plus garbage rows, and mapped with exit 0."""
+    data = (bathymetry_dir / "monterey_canyon_head_ncei_13arcsec.nc").read_bytes()
+    cut = _write(tmp_path / "monterey.nc", data[: len(data) // 3])
+    expected = (
+        "monterey.nc: truncated NetCDF: the file has 70848 bytes but its header places data "
+        "past them; 69 % of the values of elevation are missing"
+    )
+    _assert_refused(["maps", cut, "-o", str(tmp_path / "out")], tmp_path, expected, capsys)
 
 
 def test_current_folder_as_output_is_refused(

@@ -14,6 +14,11 @@ from pyproj import CRS
 
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError
+from auvplan.io._complete import (
+    check_ascii_grid_complete,
+    check_netcdf_complete,
+    check_tiff_complete,
+)
 from auvplan.io._raster import Raster, first_line, increasing, looks_geographic
 from auvplan.terrain.projection import GEOGRAPHIC_CRS
 
@@ -45,6 +50,7 @@ def read_netcdf(path: Path) -> Raster:
     """
     import xarray as xr
 
+    check_netcdf_complete(path)
     try:
         dataset = xr.open_dataset(path, decode_times=False, cache=False)
     except (OSError, ValueError, RuntimeError, TypeError, KeyError) as error:
@@ -167,6 +173,11 @@ def _is_geographic(
 
 
 def read_rasterio(path: Path) -> Raster:
+    """Read band 1 of a GeoTIFF or ESRI ASCII grid (rasterio), its axes and its CRS.
+
+    The file must hold every value its header declares (:mod:`auvplan.io._complete`); GDAL's
+    own read errors are reported by their first cause, not by rasterio's summary.
+    """
     import rasterio
     from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
 
@@ -174,10 +185,14 @@ def read_rasterio(path: Path) -> Raster:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", NotGeoreferencedWarning)
             with rasterio.open(path) as source:
+                if source.driver == "GTiff":
+                    check_tiff_complete(source, path.stat().st_size)
+                elif source.driver == "AAIGrid":
+                    check_ascii_grid_complete(path, source.height, source.width)
                 band = source.read(1, masked=True)
                 transform, crs = source.transform, source.crs
     except (RasterioIOError, ValueError, IndexError) as error:
-        raise DataFormatError(f"unreadable raster ({first_line(error)})") from None
+        raise DataFormatError(f"unreadable raster ({first_line(_root_cause(error))})") from None
     values = np.asarray(np.ma.filled(band.astype(np.float64), np.nan))
     if transform.b != 0.0 or transform.d != 0.0:
         raise DataFormatError("rotated rasters are not supported")
@@ -192,3 +207,10 @@ def read_rasterio(path: Path) -> Raster:
     else:
         georeference = None
     return Raster(values, north_axis, east_axis, georeference, None)
+
+
+def _root_cause(error: BaseException) -> BaseException:
+    """The first error of a chain: GDAL's own message behind rasterio's "See previous exception"."""
+    while (cause := error.__cause__ or error.__context__) is not None:
+        error = cause
+    return error

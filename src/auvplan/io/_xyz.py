@@ -9,7 +9,6 @@ after the conversion to the local frame.
 
 from __future__ import annotations
 
-import io
 import logging
 from pathlib import Path
 from typing import Final, Literal
@@ -38,11 +37,9 @@ def read_xyz(path: Path, coordinates: XyzCoordinates) -> Raster:
     """Read an XYZ text file into a lattice raster or a one-row raster of scattered points."""
     try:
         text = path.read_text(encoding="utf-8", errors="strict")
-        lines = [line.split("#", 1)[0].replace(",", " ") for line in text.splitlines()]
-        numeric = [line for line in lines if line.strip() and _is_numeric(line)]
-        table = np.loadtxt(io.StringIO("\n".join(numeric)), ndmin=2, usecols=(0, 1, 2))
-    except (UnicodeDecodeError, ValueError) as error:
+    except UnicodeDecodeError as error:
         raise DataFormatError(f"unreadable XYZ text ({first_line(error)})") from None
+    table = _numeric_table(text)
     if table.shape[0] < 4:
         raise DataFormatError(f"XYZ file has {table.shape[0]} points, need at least 4")
     first, second, z = drop_stray_fixes(table[:, 0], table[:, 1], table[:, 2], path)
@@ -108,12 +105,36 @@ def drop_stray_fixes(
     return first[keep], second[keep], z[keep]
 
 
-def _is_numeric(line: str) -> bool:
-    try:
-        [float(word) for word in line.split()]
-    except ValueError:
-        return False
-    return True
+def _numeric_table(text: str) -> FloatArray:
+    """The first three columns of the data lines of an XYZ text, as floats.
+
+    Lines before the first data line may be headers; after it, every line that is not blank
+    or a ``#`` comment must hold at least three numbers. A line cut short or garbled (an
+    interrupted download, a corrupted copy) is a DataFormatError naming it, not a line
+    silently skipped.
+    """
+    rows: list[list[float]] = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        words = line.split("#", 1)[0].replace(",", " ").split()
+        if not words:
+            continue
+        try:
+            values = [float(word) for word in words]
+        except ValueError:
+            if not rows:
+                continue  # a header line
+            raise DataFormatError(
+                f"line {number} is not numeric ({line.strip()[:40]!r}): the data lines before "
+                "it are numbers; a corrupted copy?"
+            ) from None
+        if len(values) < 3:
+            raise DataFormatError(
+                f"line {number} has {len(values)} column{'s' if len(values) > 1 else ''}, "
+                "need 3 (lon lat z or east north z): cut short by an interrupted download or "
+                "copy? fetch the file again"
+            )
+        rows.append(values[:3])
+    return np.array(rows, dtype=np.float64).reshape(-1, 3)
 
 
 def _as_lattice(
