@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Final
 
 import numpy as np
 
 from auvplan._typing import FloatArray
+from auvplan.errors import InputError
 from auvplan.mission.config import CommConfig, WeightsConfig
 from auvplan.mission.fleet import (
     FleetLayout,
@@ -26,6 +28,12 @@ from auvplan.optimization import PathConstraint, Trajectory, TrajectoryProblem
 from auvplan.planning import CircleObstacle
 from auvplan.vehicle import headings, reference_states, regulator_floor, stable_rk4_step
 
+#: Largest working memory [bytes] the optimiser may need before the mission is refused.
+MEMORY_BUDGET: Final = 16 * 2**30
+#: Dense arrays of size ``(n_x + n_u)²`` the optimiser keeps per solver step (Jacobians,
+#: Hessian blocks, gains, Riccati matrices), with a safety factor.
+ARRAYS_PER_STEP: Final = 16
+
 
 @dataclass(frozen=True)
 class AssembledProblem:
@@ -34,6 +42,28 @@ class AssembledProblem:
     functions: FleetProblemFunctions
     problem: TrajectoryProblem
     guess: Trajectory
+
+
+def check_optimizer_memory(layout: FleetLayout, n_steps: int) -> None:
+    """Refuse a problem whose optimiser would need more than ``MEMORY_BUDGET`` bytes.
+
+    Checked when stage 3 is assembled, before anything large is allocated (the earlier
+    stages need no such memory: ``--stage deconflict`` runs any fleet).
+
+    Raises
+    ------
+    InputError
+        When ``n_steps`` dense ``(n_x + n_u)²`` blocks would need more than ``MEMORY_BUDGET``;
+        names the keys to change.
+    """
+    size = layout.n_x + layout.n_u
+    needed = float(n_steps) * ARRAYS_PER_STEP * size * size * 8
+    if needed > MEMORY_BUDGET:
+        raise InputError(
+            f"{n_steps} solver steps x {layout.n_vehicles} vehicles need ~{needed / 2**30:.0f} GiB "
+            f"(budget {MEMORY_BUDGET / 2**30:.0f} GiB); use a larger solver.dt_s or a shorter "
+            "horizon"
+        )
 
 
 def integration_substeps(layout: FleetLayout, dt: float) -> int:
@@ -129,7 +159,13 @@ def assemble_problem(
     around is not tracked: its vehicle's plan is the energy-optimal one. The
     guess is the desired trajectory with zero inputs; PRONTO projects it onto the dynamics.
     ``current`` (None: still water) enters each stage linearised about the desired position.
+
+    Raises
+    ------
+    InputError
+        When the optimiser would need too much memory (:func:`check_optimizer_memory`).
     """
+    check_optimizer_memory(layout, deconfliction.time.size - 1)
     desired = deconfliction.desired_states
     circles = [
         (obstacle, name)

@@ -50,11 +50,6 @@ HORIZON_ATTEMPTS: Final = 4
 #: Fraction of the steady turn rate on the tightest turning radius that the desired heading
 #: uses to turn from the start heading and onto the goal heading.
 TURN_RATE_FRACTION: Final = 0.5
-#: Largest working memory [bytes] the optimiser may need before the mission is refused.
-MEMORY_BUDGET: Final = 16 * 2**30
-#: Dense arrays of size ``(n_x + n_u)²`` the optimiser keeps per solver step (Jacobians,
-#: Hessian blocks, gains, Riccati matrices), with a safety factor.
-ARRAYS_PER_STEP: Final = 16
 
 
 @dataclass(frozen=True)
@@ -75,26 +70,17 @@ class DeconflictStage:
     desired_states: tuple[FloatArray, ...]
 
 
-def check_problem_size(layout: FleetLayout, horizon: float, dt: float) -> int:
-    """The number of solver steps, refused before anything large is allocated.
+def solver_steps(horizon: float, dt: float) -> int:
+    """The number of solver steps of interval ``dt`` [s] in the horizon ``horizon`` [s].
 
     Raises
     ------
     InputError
-        When ``horizon / dt`` is not an integer or the optimiser's arrays would need more than
-        ``MEMORY_BUDGET``; names the keys to change.
+        When ``horizon / dt`` is not an integer.
     """
     n_steps = round(horizon / dt)
     if n_steps < 1 or not math.isclose(n_steps * dt, horizon, rel_tol=1e-9):
         raise InputError(f"solver.dt_s = {dt:g} s does not divide the horizon {horizon:g} s")
-    size = layout.n_x + layout.n_u
-    needed = float(n_steps) * ARRAYS_PER_STEP * size * size * 8
-    if needed > MEMORY_BUDGET:
-        raise InputError(
-            f"{n_steps} solver steps x {layout.n_vehicles} vehicles need ~{needed / 2**30:.0f} GiB "
-            f"(budget {MEMORY_BUDGET / 2**30:.0f} GiB); use a larger solver.dt_s or a shorter "
-            "horizon"
-        )
     return n_steps
 
 
@@ -194,7 +180,7 @@ def run_deconfliction(
             )
     else:
         raise InfeasibleError(f"horizon_s = {horizon:g} s is too short after deconfliction")
-    n_steps = check_problem_size(layout, horizon, dt)
+    n_steps = solver_steps(horizon, dt)
     coordination = retime_for_arrival(coordination, problem, horizon)
     time = dt * np.arange(n_steps + 1, dtype=np.float64)
     desired = desired_states(
