@@ -5,7 +5,10 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import os
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import gpxpy
@@ -142,6 +145,30 @@ def test_export_from_csv_when_the_netcdf_is_gone(planned_folder: Path, tmp_path:
             )
         else:
             assert from_csv == from_netcdf
+
+
+def test_export_from_a_csv_with_a_nan_cell_ends_with_exit_2(
+    planned_folder: Path, tmp_path: Path
+) -> None:
+    """A NaN in trajectories.csv (no trajectories.nc) made `auvplan export` loop forever."""
+    folder = tmp_path / "copy"
+    shutil.copytree(planned_folder, folder, ignore=shutil.ignore_patterns("export"))
+    (folder / "trajectories.nc").unlink()
+    table = pd.read_csv(folder / "trajectories.csv")
+    table.loc[5, "north"] = np.nan
+    table.to_csv(folder / "trajectories.csv", index=False)
+    before = sorted(p.name for p in folder.iterdir())
+    source = Path(__file__).parents[2] / "src"
+    env = {**os.environ, "PYTHONPATH": f"{source}{os.pathsep}{os.environ.get('PYTHONPATH', '')}"}
+    command = [sys.executable, "-m", "auvplan.cli.main", "export", str(folder), "--format", "gpx"]
+    done = subprocess.run(
+        command, env=env, capture_output=True, text=True, timeout=120, check=False
+    )
+    assert done.returncode == 2, done.stderr
+    (line,) = done.stderr.splitlines()
+    assert line.startswith("auvplan: error: ")
+    assert "north" in line
+    assert sorted(p.name for p in folder.iterdir()) == before
 
 
 def _fails_cleanly(args: list[str], where: Path, capsys: pytest.CaptureFixture[str]) -> str:

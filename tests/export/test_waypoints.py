@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import signal
+from collections.abc import Iterator
+from contextlib import contextmanager
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -91,6 +95,37 @@ def test_thinning_compresses_a_smooth_track() -> None:
 def test_bad_tolerance_names_the_key(tolerance: float) -> None:
     with pytest.raises(InputError, match="tolerance_m"):
         thin_track(synthetic_track("a", 0.0), tolerance)
+
+
+@contextmanager
+def _deadline(seconds: float) -> Iterator[None]:
+    """Raise TimeoutError in the block after ``seconds`` [s] of wall time (Unix timers)."""
+
+    def expire(signum: int, frame: object) -> None:
+        raise TimeoutError(f"still running after {seconds:g} s")
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+@pytest.mark.parametrize(
+    ("column", "value"), [("north", np.nan), ("east", np.inf), ("lat", np.nan), ("lon", -np.inf)]
+)
+def test_a_non_finite_track_is_an_error_not_an_endless_loop(column: str, value: float) -> None:
+    """A NaN position never falls within the tolerance: the refinement looped forever."""
+    track = synthetic_track("blue", 0.0)
+    getattr(track, column)[17] = value
+    with _deadline(10.0), pytest.raises(InputError) as raised:
+        thin_track(track, 0.5)
+    assert str(raised.value) == (
+        f"track blue: {column} is {value} at sample 17 (1 non-finite of {track.time.size}); "
+        "a track holds finite numbers only"
+    )
 
 
 def test_a_zero_tolerance_terminates_when_the_last_leg_rounds() -> None:

@@ -126,7 +126,8 @@ def thin_track(track: VehicleTrack, tolerance: float) -> Waypoints:
     Raises
     ------
     InputError
-        If ``tolerance`` is negative or not finite.
+        If ``tolerance`` is negative or not finite, or a time or position of the track is not
+        finite (NaN or inf: the thinning's distances would never fall within ``tolerance``).
 
     Examples
     --------
@@ -140,6 +141,7 @@ def thin_track(track: VehicleTrack, tolerance: float) -> Waypoints:
     """
     if not (np.isfinite(tolerance) and tolerance >= 0.0):
         raise InputError(f"tolerance_m must be >= 0 m, got {tolerance!r}")
+    _check_finite(track)
     from shapely import LineString
 
     points = np.column_stack([track.north, track.east])
@@ -168,6 +170,18 @@ def thin_track(track: VehicleTrack, tolerance: float) -> Waypoints:
 def by_file_stem(fleet: Sequence[Waypoints]) -> list[tuple[str, Waypoints]]:
     """Each vehicle's waypoints with the stem of its file names (:func:`.file_stems`)."""
     return list(zip(file_stems([waypoints.name for waypoints in fleet]), fleet, strict=True))
+
+
+def _check_finite(track: VehicleTrack) -> None:
+    """Raise InputError naming the vehicle, column and first sample that is not finite."""
+    for column in ("time", "north", "east", "lat", "lon"):
+        values = getattr(track, column)
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            raise InputError(
+                f"track {track.name}: {column} is {values[bad[0]]} at sample {bad[0]} "
+                f"({bad.size} non-finite of {values.size}); a track holds finite numbers only"
+            )
 
 
 def _sample_indices(samples: FloatArray, vertices: FloatArray) -> IntArray:
