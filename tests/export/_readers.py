@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import re
 from pathlib import Path
 from typing import Any
@@ -22,12 +23,19 @@ def validate_json(text: str, schema: str) -> Any:
     return document
 
 
+#: Behaviour parameters that may appear more than once (MOOS-IvP: conditions are conjunctive,
+#: every endflag is posted).
+REPEATABLE = ("condition", "endflag")
+
+
 def parse_moos(text: str) -> tuple[dict[str, str], list[dict[str, str]]]:
     """Top-level ``key = value`` lines and ``Behavior = NAME { key = value ... }`` blocks.
 
     MOOS-IvP syntax: ``//`` starts a comment; the first ``=`` of a line separates key and value
     (a value may hold more ``=``, as in ``condition = DEPLOY = true``); a behaviour's
-    parameters sit between ``{`` and ``}`` lines.
+    parameters sit between ``{`` and ``}`` lines; ``initialize VAR = value`` lines set the
+    helm's variables (returned as ``initialize VAR``). Repeated :data:`REPEATABLE` parameters
+    are joined with ``" & "``.
     """
     settings: dict[str, str] = {}
     blocks: list[dict[str, str]] = []
@@ -47,10 +55,17 @@ def parse_moos(text: str) -> tuple[dict[str, str], list[dict[str, str]]]:
             blocks.append(current)
             current = None
             continue
+        initial = re.fullmatch(r"initialize\s+([A-Za-z_]\w*)\s*=\s*(\S+)", line)
+        if initial and current is None:
+            settings[f"initialize {initial[1]}"] = initial[2]
+            continue
         match = re.fullmatch(r"([A-Za-z_]\w*)\s*=\s*(.*)", line)
         assert match, f"not a MOOS line: {raw!r}"
         key, value = match.groups()
         if current is not None:
+            if key in REPEATABLE and key in current:
+                current[key] += f" & {value}"
+                continue
             assert key not in current, f"repeated parameter {key}"
             current[key] = value
         elif key == "Behavior":
@@ -60,6 +75,50 @@ def parse_moos(text: str) -> tuple[dict[str, str], list[dict[str, str]]]:
     assert current is None, "unterminated block"
     assert pending is None, "a Behavior line without its block"
     return settings, blocks
+
+
+def fly_moos(
+    settings: dict[str, str], blocks: list[dict[str, str]], start: tuple[float, float]
+) -> list[tuple[float, float, float]]:
+    """A minimal pHelmIvP: run the behaviours as their conditions and endflags say.
+
+    Sets ``DEPLOY = true``, then repeatedly runs the one waypoint or timer behaviour whose
+    conditions all hold: a waypoint behaviour flies straight to its point at its speed, a timer
+    waits its duration; either then posts its endflags. Returns ``(t, x, y)`` after each
+    behaviour, until no behaviour can run; a behaviour that would run twice is an error.
+    """
+    variables = {
+        key.removeprefix("initialize "): value
+        for key, value in settings.items()
+        if key.startswith("initialize ")
+    }
+    variables["DEPLOY"] = "true"
+
+    def holds(block: dict[str, str]) -> bool:
+        conditions = block.get("condition", "").split(" & ")
+        pairs = [condition.split("=") for condition in conditions if condition]
+        return all(variables.get(name.strip()) == value.strip() for name, value in pairs)
+
+    steps = [block for block in blocks if block["Behavior"] in ("BHV_Waypoint", "BHV_Timer")]
+    done: set[str] = set()
+    time, (x, y) = 0.0, start
+    visited = [(time, x, y)]
+    while running := [block for block in steps if holds(block) and block["name"] not in done]:
+        assert len(running) == 1, f"{len(running)} leg behaviours at once"
+        (block,) = running
+        if block["Behavior"] == "BHV_Waypoint":
+            ((x_next, y_next),) = moos_points(block["points"])
+            time += math.hypot(x_next - x, y_next - y) / float(block["speed"])
+            x, y = x_next, y_next
+        else:
+            time += float(block["duration"])
+        done.add(block["name"])
+        for flag in block["endflag"].split(" & "):
+            name, value = flag.split("=")
+            variables[name.strip()] = value.strip()
+        visited.append((time, x, y))
+    assert variables.get("PLAN_DONE") == "true", "the plan never finished"
+    return visited
 
 
 def moos_points(value: str) -> list[tuple[float, float]]:

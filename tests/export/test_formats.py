@@ -9,15 +9,17 @@ from xml.etree import ElementTree
 import gpxpy
 import numpy as np
 import pytest
-from pyproj import Geod
+from pyproj import Geod, Proj
 
 from auvplan.errors import InputError
 from auvplan.export import FORMATS, parse_formats, render_exports
+from auvplan.export.moos import moos_xy
 from auvplan.export.plan import CircleZone, ExportPlan, PolygonZone, file_stems
 from auvplan.export.waypoints import Waypoints, thin_track
 from auvplan.terrain import LocalProjection
 
-from ._readers import moos_points, parse_moos, validate_json
+from ._plans import synthetic_plan
+from ._readers import fly_moos, parse_moos, validate_json
 
 TOLERANCE = 0.5
 GEOD = Geod(ellps="WGS84")
@@ -156,8 +158,18 @@ def test_imc_follow_trajectory_plans(export_plan: ExportPlan) -> None:
         assert data["timeout"] >= waypoints.time[-1]
 
 
-def test_moos_behaviours_and_origin(export_plan: ExportPlan) -> None:
-    files = _render(export_plan, "moos")
+def _utm_offsets(plan: ExportPlan, lat: np.ndarray, lon: np.ndarray) -> np.ndarray:
+    """MOOSGeodesy's LatLong2LocalUTM, independently: PROJ's UTM of the origin's zone."""
+    zone = int((plan.origin_lon + 180.0) // 6.0) + 1
+    utm = Proj(proj="utm", zone=zone, ellps="WGS84", south=plan.origin_lat < 0.0)
+    east_0, north_0 = utm(plan.origin_lon, plan.origin_lat)
+    east, north = utm(lon, lat)
+    return np.column_stack([np.asarray(east) - east_0, np.asarray(north) - north_0])
+
+
+@pytest.mark.parametrize("frame", ["utm", "local"])
+def test_moos_flies_the_plans_path_and_timing(export_plan: ExportPlan, frame: str) -> None:
+    files = render_exports(export_plan, ["moos"], tolerance=TOLERANCE, moos_frame=frame)
     origin, _ = parse_moos(files["origin.moos"])
     lat_0, lon_0 = float(origin["LatOrigin"]), float(origin["LongOrigin"])
     assert (lat_0, lon_0) == pytest.approx(
@@ -165,18 +177,42 @@ def test_moos_behaviours_and_origin(export_plan: ExportPlan) -> None:
     )
     stems = file_stems([track.name for track in export_plan.tracks])
     for stem, waypoints in zip(stems, _fleet(export_plan), strict=True):
-        settings, (block,) = parse_moos(files[f"{stem}.bhv"])
-        assert not settings
-        assert block["Behavior"] == "BHV_Waypoint"
-        assert block["condition"] == "DEPLOY = true"
-        assert float(block["capture_radius"]) == export_plan.capture_radius
-        assert float(block["slip_radius"]) > float(block["capture_radius"])
-        x, y = np.array(moos_points(block["points"])).T
-        lat, lon = LocalProjection(lat_0, lon_0).to_geographic(y, x)  # y north, x east
-        assert np.max(_distance_m(lat, lon, waypoints.lat, waypoints.lon)) < 0.01
+        settings, blocks = parse_moos(files[f"{stem}.bhv"])
+        assert settings["initialize DEPLOY"] == "false"
+        assert settings["initialize RETURN"] == "false"
+        (depth,) = [block for block in blocks if block["Behavior"] == "BHV_ConstantDepth"]
+        assert float(depth["depth"]) == export_plan.depth
+        assert depth["condition"] == "DEPLOY = true"
+        legs = [block for block in blocks if block["Behavior"] == "BHV_Waypoint"]
+        assert all(float(leg["capture_radius"]) == export_plan.capture_radius for leg in legs)
+        assert all(float(leg["slip_radius"]) > export_plan.capture_radius for leg in legs)
+        if frame == "utm":
+            expected = _utm_offsets(export_plan, waypoints.lat, waypoints.lon)
+        else:
+            north, east = LocalProjection(lat_0, lon_0).to_local(waypoints.lat, waypoints.lon)
+            expected = np.column_stack([east, north])
+        flown = np.array(fly_moos(settings, blocks, start=tuple(expected[0])))
+        # every waypoint in order, to 1 cm; a wait holds the position
+        np.testing.assert_allclose(flown[:, 1:], expected, atol=0.01)
+        # at the plan's times: leg speeds are true speeds, the grid scale differs by < 1e-3
         duration = waypoints.time[-1] - waypoints.time[0]
-        length = np.sum(np.hypot(np.diff(x), np.diff(y)))
-        assert float(block["speed"]) == pytest.approx(length / duration, abs=1e-3)
+        planned = waypoints.time - waypoints.time[0]
+        np.testing.assert_allclose(flown[:, 0], planned, atol=1e-3 * duration + 0.01)
+
+
+def test_moos_utm_frame_is_not_the_tangent_plane_away_from_the_origin() -> None:
+    """Near Monterey the two frames part by ≈ 1.2 % of the distance: UTM is MOOS-IvP's default."""
+    plan = synthetic_plan()
+    lat, lon = LocalProjection(plan.origin_lat, plan.origin_lon).to_geographic(
+        np.array([300.0]), np.array([400.0])
+    )
+    utm = np.column_stack(moos_xy(plan, lat, lon, "utm"))
+    local = np.column_stack(moos_xy(plan, lat, lon, "local"))
+    np.testing.assert_allclose(local, [[400.0, 300.0]], atol=1e-6)
+    np.testing.assert_allclose(utm, _utm_offsets(plan, lat, lon), atol=1e-3)
+    assert 4.0 < float(np.hypot(*(utm - local)[0])) < 8.0
+    with pytest.raises(InputError, match="MOOS frame 'grid'"):
+        render_exports(plan, ["moos"], moos_frame="grid")  # type: ignore[arg-type]
 
 
 def test_geojson_trajectories(export_plan: ExportPlan) -> None:

@@ -1,16 +1,16 @@
 """Exports of a finished plan for vehicles, ground stations and GIS.
 
-=========== ======================= ================================================
+=========== ======================= =============================================================
 format      files                   for
-=========== ======================= ================================================
-``moos``    ``NAME.bhv``,           MOOS-IvP pHelmIvP (``BHV_Waypoint``, local x/y)
+=========== ======================= =============================================================
+``moos``    ``NAME.bhv``,           MOOS-IvP pHelmIvP (a timed ``BHV_Waypoint`` per leg, UTM x/y)
             ``origin.moos``
 ``qgc``     ``NAME.plan``           QGroundControl / ArduSub (waypoints, geofences)
 ``imc``     ``NAME.imc.json``       Neptus / LSTS IMC (``FollowTrajectory``, timed)
 ``gpx``     ``trajectories.gpx``    GPX 1.1 viewers (timed tracks)
 ``kml``     ``trajectories.kml``    Google Earth (``gx:Track`` with time stamps)
 ``geojson`` ``trajectories.geojson`` GIS (``LineString`` per vehicle, times in properties)
-=========== ======================= ================================================
+=========== ======================= =============================================================
 
 Every format is written from the same waypoints: each track thinned to ``tolerance`` with its
 time law kept (:func:`auvplan.export.waypoints.thin_track`). The plan they are written from is
@@ -20,14 +20,17 @@ until a format is rendered, so that the command line starts fast.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import functools
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Final
 
 from auvplan.errors import InputError
 
 if TYPE_CHECKING:
+    from auvplan.export.moos import MoosFrame
     from auvplan.export.plan import ExportPlan
+    from auvplan.export.waypoints import Waypoints
 
 #: The export formats, each rendered by the module of the same name in this package.
 FORMATS: Final = ("moos", "qgc", "imc", "gpx", "kml", "geojson")
@@ -57,7 +60,11 @@ def parse_formats(text: str) -> tuple[str, ...]:
 
 
 def render_exports(
-    plan: ExportPlan, formats: Sequence[str], *, tolerance: float = DEFAULT_TOLERANCE_M
+    plan: ExportPlan,
+    formats: Sequence[str],
+    *,
+    tolerance: float = DEFAULT_TOLERANCE_M,
+    moos_frame: MoosFrame = "utm",
 ) -> dict[str, str]:
     """The text of every export file, by file name.
 
@@ -69,6 +76,8 @@ def render_exports(
         Names from :data:`FORMATS`.
     tolerance : float
         Waypoint tolerance [m].
+    moos_frame : {"utm", "local"}
+        The frame of the MOOS-IvP ``points`` (:mod:`auvplan.export.moos`).
 
     Returns
     -------
@@ -78,8 +87,10 @@ def render_exports(
     from auvplan.export import geojson, gpx, imc, kml, moos, qgc
     from auvplan.export.waypoints import thin_track
 
-    renderers = {
-        "moos": moos.render,
+    if moos_frame not in moos.MOOS_FRAMES:
+        raise InputError(f"MOOS frame {moos_frame!r} is not one of {', '.join(moos.MOOS_FRAMES)}")
+    renderers: dict[str, Callable[[ExportPlan, list[Waypoints]], dict[str, str]]] = {
+        "moos": functools.partial(moos.render, frame=moos_frame),
         "qgc": qgc.render,
         "imc": imc.render,
         "gpx": gpx.render,
@@ -99,11 +110,13 @@ def write_exports(
     formats: Sequence[str],
     *,
     tolerance: float = DEFAULT_TOLERANCE_M,
+    moos_frame: MoosFrame = "utm",
 ) -> list[Path]:
     """Write :func:`render_exports` into ``directory`` (created) and return the paths."""
     from auvplan.io.results import write_text_files
 
-    return write_text_files(directory, render_exports(plan, formats, tolerance=tolerance))
+    files = render_exports(plan, formats, tolerance=tolerance, moos_frame=moos_frame)
+    return write_text_files(directory, files)
 
 
 __all__ = ["DEFAULT_TOLERANCE_M", "FORMATS", "parse_formats", "render_exports", "write_exports"]

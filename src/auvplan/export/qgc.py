@@ -10,8 +10,9 @@ on a submarine (``vehicleType`` 12 = MAV_TYPE_SUBMARINE):
   ("Alt above home must be negative");
 * a ``MAV_CMD_DO_CHANGE_SPEED`` (178, frame 2 = MAV_FRAME_MISSION, params
   ``[1 = ground speed, speed, -1 = throttle unchanged, 0, 0, 0, 0]``) before each leg, so
-  that the legs keep their durations; a leg slower
-  than :data:`STOP_SPEED` (a wait) is a hold [s] at its first waypoint instead;
+  that the legs keep their durations; a leg slower than
+  :data:`~auvplan.export.waypoints.STOP_SPEED` (a wait) is a hold [s] at its first waypoint
+  instead;
 * every obstacle as an exclusion geofence (``inclusion: false``): circles as circles, polygons
   with their vertices in clockwise order, as the format asks.
 """
@@ -33,8 +34,6 @@ FRAME_GLOBAL_RELATIVE_ALT: Final = 3
 FRAME_MISSION: Final = 2
 FIRMWARE_ARDUPILOT: Final = 3
 VEHICLE_SUBMARINE: Final = 12
-#: Legs slower than this [m/s] are flown as a hold at their first waypoint.
-STOP_SPEED: Final = 0.01
 
 
 def _geofence(plan: ExportPlan) -> dict[str, Any]:
@@ -61,7 +60,7 @@ def _geofence(plan: ExportPlan) -> dict[str, Any]:
 def mission_items(plan: ExportPlan, waypoints: Waypoints) -> list[dict[str, Any]]:
     """The mission's simple items: waypoints (holding through waits), speed changes before legs."""
     speeds = waypoints.leg_speeds
-    is_wait = speeds < STOP_SPEED
+    is_wait = waypoints.waits
     holds = np.append(np.where(is_wait, waypoints.leg_durations, 0.0), 0.0)
     commands: list[tuple[int, int, list[float | None]]] = []
     speed = None

@@ -31,12 +31,16 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Final
 
 import numpy as np
 
-from auvplan._typing import FloatArray, IntArray
+from auvplan._typing import BoolArray, FloatArray, IntArray
 from auvplan.errors import InputError
 from auvplan.export.plan import VehicleTrack, file_stems
+
+#: Legs slower than this [m/s] are waits: formats fly them as a hold, not as a leg.
+STOP_SPEED: Final = 0.01
 
 
 @dataclass(frozen=True)
@@ -69,6 +73,11 @@ class Waypoints:
     def leg_speeds(self) -> FloatArray:
         """Constant speed [m/s] that flies each leg in its duration."""
         return self.leg_lengths / self.leg_durations
+
+    @property
+    def waits(self) -> BoolArray:
+        """Whether each leg is a wait (slower than :data:`STOP_SPEED`)."""
+        return self.leg_speeds < STOP_SPEED
 
     @property
     def mean_speed(self) -> float:
