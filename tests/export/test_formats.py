@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+import json
 import math
 from datetime import datetime, timedelta
 from xml.etree import ElementTree
@@ -93,6 +95,46 @@ def test_kml_timed_tracks_and_obstacle_outlines(export_plan: ExportPlan) -> None
             np.testing.assert_allclose(ring[:-1, 0], zone.lon)
 
 
+def test_kml_validates_against_the_ogc_schema(export_plan: ExportPlan) -> None:
+    """OGC KML 2.2 + Google extension XSDs (shipped by fastkml), and fastkml's strict reader."""
+    from fastkml import KML as FastKML
+    from fastkml.validator import get_schema_parser
+    from lxml import etree
+
+    text = _render(export_plan, "kml")["trajectories.kml"]
+    schema = get_schema_parser()
+    document = etree.fromstring(text.encode())
+    assert schema.validate(document), [error.message for error in schema.error_log]
+    parsed = FastKML.from_string(etree.tostring(document, encoding="unicode"), strict=True)
+    (kml_document,) = parsed.features
+    placemarks = [p for folder in kml_document.features for p in folder.features]
+    names = [placemark.name for placemark in placemarks]
+    assert names == [t.name for t in export_plan.tracks] + [z.name for z in export_plan.zones]
+
+
+def test_qgc_numbers_are_mavlinks() -> None:
+    """Every MAVLink number of the QGC export, checked against pymavlink's enums."""
+    from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
+    from auvplan.export import qgc
+
+    assert qgc.NAV_WAYPOINT == mavlink.MAV_CMD_NAV_WAYPOINT
+    assert qgc.DO_CHANGE_SPEED == mavlink.MAV_CMD_DO_CHANGE_SPEED
+    assert qgc.FRAME_GLOBAL_RELATIVE_ALT == mavlink.MAV_FRAME_GLOBAL_RELATIVE_ALT
+    assert qgc.FRAME_MISSION == mavlink.MAV_FRAME_MISSION
+    assert qgc.FIRMWARE_ARDUPILOT == mavlink.MAV_AUTOPILOT_ARDUPILOTMEGA
+    assert qgc.VEHICLE_SUBMARINE == mavlink.MAV_TYPE_SUBMARINE
+
+
+def test_qgc_surface_plan_is_not_keep_current_depth() -> None:
+    """ArduSub reads altitude 0 as "keep the current depth": a surface plan must not write 0."""
+    plan = dataclasses.replace(synthetic_plan(), depth=0.0)
+    document = json.loads(render_exports(plan, ["qgc"])["blue.plan"])
+    nav = [item for item in document["mission"]["items"] if item["command"] == 16]
+    assert {item["params"][6] for item in nav} == {-0.01}
+    assert {item["Altitude"] for item in nav} == {-0.01}
+
+
 def test_qgc_plans_for_ardusub(export_plan: ExportPlan) -> None:
     files = _render(export_plan, "qgc")
     stems = file_stems([track.name for track in export_plan.tracks])
@@ -107,6 +149,9 @@ def test_qgc_plans_for_ardusub(export_plan: ExportPlan) -> None:
         lat, lon = (np.array([item["params"][k] for item in nav]) for k in (4, 5))
         assert np.max(_distance_m(lat, lon, waypoints.lat, waypoints.lon)) < 1e-6
         assert all(item["frame"] == 3 and item["params"][6] == -export_plan.depth for item in nav)
+        assert all(item["Altitude"] == -export_plan.depth for item in nav)  # QGC 4.x keys
+        assert all((item["AltitudeMode"], item["AMSLAltAboveTerrain"]) == (1, None) for item in nav)
+        assert mission["globalPlanAltitudeMode"] == 1
         # fly the items: hold, then each leg at the last commanded speed: the plan's times
         speed, clock, arrivals, last = None, 0.0, [], None
         for item in items:

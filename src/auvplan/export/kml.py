@@ -1,8 +1,14 @@
-"""KML for Google Earth: one timed ``gx:Track`` per vehicle (simplekml).
+"""KML 2.2 for Google Earth: one timed ``gx:Track`` per vehicle, obstacles as outlines.
 
 Each track pairs a ``<when>`` (UTC, ``start_time + t``) with a ``<gx:coord>`` (lon, lat,
 altitude = the depth, negated, ``absolute`` altitude mode), so Google Earth's time slider
-replays the plan. Obstacles are drawn as outlined polygons (circles as 72-gons).
+replays the plan. Obstacles are outlined polygons (circles as 72-gons) in their own folder.
+
+The document is built element by element (lxml) in the order the OGC KML 2.2 and Google
+extension schemas prescribe — ``name`` before styles in a ``Document``, ``altitudeMode``
+before the ``when``/``gx:coord`` pairs of a track — with ``id`` values that are ``xs:ID``
+(never starting with a digit), so that it validates against ``ogckml22.xsd``/``kml22gx.xsd``
+and strict readers (fastkml 1.x) accept it.
 """
 
 from __future__ import annotations
@@ -11,6 +17,7 @@ from collections.abc import Sequence
 from typing import Final
 
 import numpy as np
+from lxml import etree
 
 from auvplan import __version__
 from auvplan.export.plan import CircleZone, ExportPlan, PolygonZone, utc_text
@@ -19,6 +26,10 @@ from auvplan.terrain.projection import LocalProjection
 
 #: Vertices of the polygon that draws a circular obstacle.
 CIRCLE_VERTICES: Final = 72
+KML_NAMESPACE: Final = "http://www.opengis.net/kml/2.2"
+GX_NAMESPACE: Final = "http://www.google.com/kml/ext/2.2"
+#: Outline colour of the obstacles, KML ``aabbggrr`` (opaque red).
+ZONE_COLOUR: Final = "ff0000ff"
 
 
 def zone_outline(zone: CircleZone | PolygonZone) -> list[tuple[float, float]]:
@@ -34,26 +45,55 @@ def zone_outline(zone: CircleZone | PolygonZone) -> list[tuple[float, float]]:
     return [*ring, ring[0]]
 
 
+def _kml(tag: str) -> str:
+    return f"{{{KML_NAMESPACE}}}{tag}"
+
+
+def _child(
+    parent: etree._Element, tag: str, text: str | None = None, **attributes: str
+) -> etree._Element:
+    element = etree.SubElement(parent, tag, attributes)
+    element.text = text
+    return element
+
+
 def kml_document(plan: ExportPlan, fleet: Sequence[Waypoints]) -> str:
     """The KML text of the fleet's timed tracks and the obstacles."""
-    import simplekml
-
-    simplekml.Kml.resetidcounter()  # element ids from 0: the same plan gives the same file
-    document = simplekml.Kml(name=f"auvplan {__version__} plan, {utc_text(plan.start_time)}")
-    for waypoints in fleet:
-        track = document.newgxtrack(name=waypoints.name)
-        track.altitudemode = simplekml.AltitudeMode.absolute
-        track.newwhen([utc_text(plan.timestamp(seconds)) for seconds in waypoints.time])
-        track.newgxcoord(
-            [
-                (float(lon), float(lat), 0.0 - plan.depth)
-                for lat, lon in zip(waypoints.lat, waypoints.lon, strict=True)
-            ]
-        )
-    for zone in plan.zones:
-        outline = document.newpolygon(name=zone.name, outerboundaryis=zone_outline(zone))
-        outline.style.polystyle.fill = 0
-    return str(document.kml())
+    root = etree.Element(_kml("kml"), nsmap={None: KML_NAMESPACE, "gx": GX_NAMESPACE})
+    document = _child(root, _kml("Document"), id="auvplan_plan")
+    _child(document, _kml("name"), f"auvplan {__version__} plan, {utc_text(plan.start_time)}")
+    style = _child(document, _kml("Style"), id="zone_outline")
+    line = _child(style, _kml("LineStyle"))
+    _child(line, _kml("color"), ZONE_COLOUR)
+    _child(line, _kml("width"), "2")
+    _child(_child(style, _kml("PolyStyle")), _kml("fill"), "0")
+    vehicles = _child(document, _kml("Folder"), id="vehicles")
+    _child(vehicles, _kml("name"), "vehicles")
+    for number, waypoints in enumerate(fleet, start=1):
+        placemark = _child(vehicles, _kml("Placemark"), id=f"vehicle_{number}")
+        _child(placemark, _kml("name"), waypoints.name)
+        track = _child(placemark, f"{{{GX_NAMESPACE}}}Track")
+        _child(track, _kml("altitudeMode"), "absolute")
+        for seconds in waypoints.time:
+            _child(track, _kml("when"), utc_text(plan.timestamp(seconds)))
+        for lat, lon in zip(waypoints.lat, waypoints.lon, strict=True):
+            coord = f"{float(lon)!r} {float(lat)!r} {0.0 - plan.depth!r}"
+            _child(track, f"{{{GX_NAMESPACE}}}coord", coord)
+    if plan.zones:
+        obstacles = _child(document, _kml("Folder"), id="obstacles")
+        _child(obstacles, _kml("name"), "obstacles")
+        for number, zone in enumerate(plan.zones, start=1):
+            placemark = _child(obstacles, _kml("Placemark"), id=f"obstacle_{number}")
+            _child(placemark, _kml("name"), zone.name)
+            _child(placemark, _kml("styleUrl"), "#zone_outline")
+            ring = _child(
+                _child(_child(placemark, _kml("Polygon")), _kml("outerBoundaryIs")),
+                _kml("LinearRing"),
+            )
+            points = " ".join(f"{lon!r},{lat!r},0" for lon, lat in zone_outline(zone))
+            _child(ring, _kml("coordinates"), points)
+    text: bytes = etree.tostring(root, xml_declaration=True, encoding="UTF-8", pretty_print=True)
+    return text.decode()
 
 
 def render(plan: ExportPlan, fleet: Sequence[Waypoints]) -> dict[str, str]:

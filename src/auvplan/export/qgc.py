@@ -7,7 +7,12 @@ on a submarine (``vehicleType`` 12 = MAV_TYPE_SUBMARINE):
 * a ``MAV_CMD_NAV_WAYPOINT`` (16) per waypoint, frame 3 (MAV_FRAME_GLOBAL_RELATIVE_ALT), params
   ``[hold, acceptance radius, pass radius 0, yaw unchanged (null), lat, lon, altitude]``;
   the altitude is the depth as a negative number, since ArduSub refuses a waypoint above home
-  ("Alt above home must be negative");
+  ("Alt above home must be negative"). ArduSub's ``do_nav_wp`` reads an altitude of exactly 0
+  as "keep the current depth", so a surface plan (depth 0) is written at
+  :data:`SURFACE_DEPTH` (1 cm, the resolution of ArduPilot's ``Location`` altitudes), which
+  brings the vehicle up rather than leaving it wherever it is. QGroundControl 4.x reads the
+  same altitude from the item's ``Altitude`` with ``AltitudeMode`` 1 (relative to home,
+  ``globalPlanAltitudeMode`` 1) and ``AMSLAltAboveTerrain`` null;
 * a ``MAV_CMD_DO_CHANGE_SPEED`` (178, frame 2 = MAV_FRAME_MISSION, params
   ``[1 = ground speed, speed, -1 = throttle unchanged, 0, 0, 0, 0]``) before each leg, so
   that the legs keep their durations; a leg slower than
@@ -34,6 +39,10 @@ FRAME_GLOBAL_RELATIVE_ALT: Final = 3
 FRAME_MISSION: Final = 2
 FIRMWARE_ARDUPILOT: Final = 3
 VEHICLE_SUBMARINE: Final = 12
+#: QGroundControl's ``AltitudeMode`` of an item (and ``globalPlanAltitudeMode``): relative to home.
+ALTITUDE_MODE_RELATIVE: Final = 1
+#: Depth [m] written for a surface plan: ArduSub reads altitude 0 as "keep the current depth".
+SURFACE_DEPTH: Final = 0.01
 
 
 def _geofence(plan: ExportPlan) -> dict[str, Any]:
@@ -63,6 +72,7 @@ def mission_items(plan: ExportPlan, waypoints: Waypoints) -> list[dict[str, Any]
     is_wait = waypoints.waits
     holds = np.append(np.where(is_wait, waypoints.leg_durations, 0.0), 0.0)
     commands: list[tuple[int, int, list[float | None]]] = []
+    altitude = 0.0 - max(plan.depth, SURFACE_DEPTH)
     speed = None
     for k in range(waypoints.time.size):
         if k > 0 and not is_wait[k - 1]:
@@ -70,7 +80,7 @@ def mission_items(plan: ExportPlan, waypoints: Waypoints) -> list[dict[str, Any]
             if leg_speed != speed:
                 commands.append((DO_CHANGE_SPEED, FRAME_MISSION, [1, leg_speed, -1, 0, 0, 0, 0]))
                 speed = leg_speed
-        position = [float(waypoints.lat[k]), float(waypoints.lon[k]), 0.0 - plan.depth]
+        position = [float(waypoints.lat[k]), float(waypoints.lon[k]), altitude]
         parameters: list[float | None] = [float(holds[k]), plan.capture_radius, 0, None, *position]
         commands.append((NAV_WAYPOINT, FRAME_GLOBAL_RELATIVE_ALT, parameters))
     return [
@@ -81,6 +91,15 @@ def mission_items(plan: ExportPlan, waypoints: Waypoints) -> list[dict[str, Any]
             "doJumpId": number,
             "frame": frame,
             "params": parameters,
+            **(
+                {
+                    "Altitude": altitude,
+                    "AltitudeMode": ALTITUDE_MODE_RELATIVE,
+                    "AMSLAltAboveTerrain": None,
+                }
+                if command == NAV_WAYPOINT
+                else {}
+            ),
         }
         for number, (command, frame, parameters) in enumerate(commands, start=1)
     ]
@@ -97,6 +116,7 @@ def plan_document(plan: ExportPlan, waypoints: Waypoints) -> dict[str, Any]:
         "mission": {
             "version": 2,
             "firmwareType": FIRMWARE_ARDUPILOT,
+            "globalPlanAltitudeMode": ALTITUDE_MODE_RELATIVE,
             "vehicleType": VEHICLE_SUBMARINE,
             "cruiseSpeed": waypoints.mean_speed,
             "hoverSpeed": waypoints.mean_speed,
