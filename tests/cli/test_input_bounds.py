@@ -8,15 +8,104 @@ bounded time.
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import time
 from importlib import resources
 from pathlib import Path
 
 import pytest
-
-from ._cli import run_cli
+from _cli import one_error_line, run_cli
 
 DEMO = resources.files("auvplan").joinpath("data", "missions", "demo.toml").read_text()
+
+
+def _tree(root: Path) -> dict[str, bytes | None]:
+    """Every entry below ``root``: relative path -> file content (None for folders)."""
+    return {
+        str(path.relative_to(root)): path.read_bytes() if path.is_file() else None
+        for path in sorted(root.rglob("*"))
+    }
+
+
+def _auvplan(argv: list[str], *, timeout: float) -> tuple[int, str]:
+    """``auvplan argv`` as a process killed after ``timeout`` [s]: exit code and stderr."""
+    process = subprocess.run(
+        [sys.executable, "-m", "auvplan.cli.main", *argv],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        check=False,
+    )
+    return process.returncode, process.stderr
+
+
+@pytest.fixture(scope="module")
+def plan_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A real output folder of ``auvplan plan``: one MEDUSA for 300 s on the synthetic bank."""
+    root = tmp_path_factory.mktemp("plan")
+    head = DEMO.split("[[vehicle]]")[0].replace("horizon_s = 600.0", "horizon_s = 300.0")
+    mission = root / "one.toml"
+    mission.write_text(
+        f'{head}[[vehicle]]\nname = "blue"\ntype = "medusa"\n'
+        "start = { north = 10.0, east = 400.0, heading_deg = 0.0, speed = 0.5 }\n"
+        "goal = { north = 150.0, east = 420.0, heading_deg = 0.0 }\n"
+        '[planner]\nedge_model = "paper"\n[solver]\ndt_s = 2.0\n',
+        encoding="utf-8",
+    )
+    folder = root / "out"
+    command = ["-q", "plan", str(mission), "-o", str(folder), "--jobs", "1", "--no-figures"]
+    assert _auvplan(command, timeout=300)[0] == 0
+    return folder
+
+
+@pytest.mark.parametrize(
+    ("flags", "fragment"),
+    [
+        (["--seed", "-1"], "--seed must be a non-negative integer, got -1"),
+        (["--particles", "20000000000"], "at most 1000000 (--particles), got 20000000000"),
+        (["--particles", "2e10"], "--particles: invalid int value: '2e10'"),
+        (["--runs", "1e8"], "--runs: invalid int value: '1e8'"),
+        (["--drift", "1e10"], "navigation.drift_percent: Input should be less than or equal to 20"),
+        (["--initial-sigma", "1e300"], "navigation.initial_sigma_m: Input should be less than"),
+        (["--convergence-updates", "10" * 10], "<= 1728000 (the most updates of a run)"),
+    ],
+)
+def test_evaluate_numbers_out_of_bounds_are_one_line(
+    plan_folder: Path, capsys: pytest.CaptureFixture[str], flags: list[str], fragment: str
+) -> None:
+    """Each flag is bounded, and the work and memory of the runs are checked before any run."""
+    before = _tree(plan_folder.parent)
+    started = time.perf_counter()
+    code, out, err = run_cli(["evaluate", str(plan_folder), "--no-figure", *flags], capsys)
+    assert time.perf_counter() - started < 30.0
+    assert code == 2
+    assert out == ""
+    assert fragment in one_error_line(err.replace("auvplan evaluate: error:", "auvplan: error:"))
+    assert _tree(plan_folder.parent) == before
+
+
+@pytest.mark.parametrize(
+    ("flags", "fragment"),
+    [
+        (["--runs", "100000000"], "--runs must be >= 1 and <= 100000, got 100000000"),
+        (["--update-period", "1e-4"], "navigation.update_period_s: Input should be greater"),
+        (["--runs", "100000", "--particles", "1000000"], "more than the limit 1e+11"),
+        (
+            ["--runs", "100000", "--particles", "2", "--update-period", "0.1"],
+            "GiB of results, more than the limit 4 GiB",
+        ),
+    ],
+)
+def test_evaluate_refuses_what_used_to_hang_in_bounded_time(
+    plan_folder: Path, flags: list[str], fragment: str
+) -> None:
+    """Runs x particles x updates per run are checked from the bounds before any run."""
+    before = _tree(plan_folder.parent)
+    code, err = _auvplan(["evaluate", str(plan_folder), "--no-figure", *flags], timeout=60)
+    assert code == 2
+    assert fragment in one_error_line(err)
+    assert _tree(plan_folder.parent) == before
 
 
 def _wide_fleet_mission(n_vehicles: int, dt_s: float) -> str:

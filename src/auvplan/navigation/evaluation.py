@@ -26,6 +26,7 @@ from auvplan.navigation.montecarlo import (
     MonteCarloResult,
     NavigationSettings,
     Track,
+    check_monte_carlo,
     run_monte_carlo,
 )
 from auvplan.navigation.prediction import ErrorPrediction, predict_error
@@ -90,7 +91,17 @@ def evaluate_plans(
     -------
     dict of str to PlanNavigation
         By plan label.
+
+    Raises
+    ------
+    InputError
+        If the runs along a track are refused
+        (:func:`~auvplan.navigation.montecarlo.check_monte_carlo`); every track is checked
+        before the first run.
     """
+    for vehicles in plans.values():
+        for vehicle in vehicles.values():
+            check_monte_carlo(vehicle.track, settings, n_runs=n_runs, seed=seed)
     index: dict[str, int] = {}
     evaluations = {}
     for label, vehicles in plans.items():

@@ -19,6 +19,7 @@ released, all randomness from the run's generator).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Final
 
 import numpy as np
 
@@ -28,6 +29,10 @@ from auvplan.navigation._checks import require_nonnegative
 from auvplan.navigation._kernels import particle_filter
 from auvplan.terrain import BathymetryGrid
 
+#: Most particles of one filter: 100 times MB-System TRN's ``MAX_PARTICLES`` (10 000), about
+#: 60 MB of particle state per filter (seven arrays of N numbers).
+MAX_PARTICLES: Final = 1_000_000
+
 
 @dataclass(frozen=True)
 class ParticleFilterOptions:
@@ -36,8 +41,8 @@ class ParticleFilterOptions:
     Parameters
     ----------
     n_particles : int
-        Particle count ``N``. Default 5000 (MB-System TRN allows up to ``MAX_PARTICLES`` =
-        10 000; open Python TAN templates use 1000).
+        Particle count ``N``, 2 to :data:`MAX_PARTICLES`. Default 5000 (MB-System TRN allows
+        up to its ``MAX_PARTICLES`` = 10 000; open Python TAN templates use 1000).
     resample_fraction : float
         Resample when the effective sample size falls below ``f N``. Default 0.75: MB-System
         TRN's ``MIN_EFF_SAMP_SIZE`` (``particleFilterDefs.h``).
@@ -58,8 +63,11 @@ class ParticleFilterOptions:
     initial_sigma: float = 7.0
 
     def __post_init__(self) -> None:
-        if self.n_particles < 2:
-            raise InputError(f"particle filter needs >= 2 particles, got {self.n_particles}")
+        if not 2 <= self.n_particles <= MAX_PARTICLES:
+            raise InputError(
+                f"particle filter needs >= 2 particles and at most {MAX_PARTICLES} "
+                f"(--particles), got {self.n_particles}"
+            )
         if not 0.0 < self.resample_fraction <= 1.0:
             raise InputError(f"resample_fraction must be in (0, 1], got {self.resample_fraction}")
         require_nonnegative("roughening", self.roughening)

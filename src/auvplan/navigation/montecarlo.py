@@ -11,10 +11,12 @@ runs go in parallel threads.
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from typing import Final
 
 import numpy as np
 
@@ -40,6 +42,19 @@ from auvplan.terrain import BathymetryGrid
 
 #: Progress callback: called with the number of runs finished so far.
 Progress = Callable[[int], None]
+
+#: Most Monte-Carlo runs per track (``--runs``).
+MAX_RUNS: Final = 100_000
+#: Most filter updates in one run: a 48 h mission (the longest ``fleet.horizon_s``) updated
+#: every 0.1 s (the shortest ``navigation.update_period_s``).
+MAX_UPDATES: Final = 48 * 3600 * 10
+#: Most particle updates (runs x particles x updates per run) one track may cost: about 6 h
+#: of one core at the filter's ~5e6 particle updates per second.
+MAX_PARTICLE_UPDATES: Final = 10**11
+#: Bytes kept per run and update until a track's runs are summarised (estimates, dead
+#: reckoning, sigma, ESS and NEES of every run, then stacked), and the most they may take.
+RESULT_BYTES_PER_UPDATE: Final = 128
+RESULT_MEMORY_BUDGET: Final = 4 * 2**30
 
 
 @dataclass(frozen=True)
@@ -74,16 +89,31 @@ class Track:
         if not np.all(np.diff(self.time) > 0.0):
             raise InputError("track time must be strictly increasing")
 
-    def sampled(self, period: float) -> Track:
-        """The track at ``time[0] + k * period`` up to ``time[-1]``, linearly interpolated."""
+    @property
+    def duration(self) -> float:
+        """Time [s] from the first sample to the last."""
+        return float(self.time[-1] - self.time[0])
+
+    def n_updates(self, period: float) -> int:
+        """Samples of :meth:`sampled` at ``period`` [s]: ``floor(duration / period) + 1``.
+
+        Raises
+        ------
+        InputError
+            If ``period`` is not finite and > 0, or longer than the track.
+        """
         if not (np.isfinite(period) and period > 0.0):
             raise InputError(f"update period must be > 0 s, got {period}")
-        n_updates = int(np.floor((self.time[-1] - self.time[0]) / period + 1e-9)) + 1
+        n_updates = math.floor(self.duration / period + 1e-9) + 1
         if n_updates < 2:
             raise InputError(
-                f"the track lasts {self.time[-1] - self.time[0]:g} s, less than one update "
-                f"period ({period:g} s)"
+                f"the track lasts {self.duration:g} s, less than one update period ({period:g} s)"
             )
+        return n_updates
+
+    def sampled(self, period: float) -> Track:
+        """The track at ``time[0] + k * period`` up to ``time[-1]``, linearly interpolated."""
+        n_updates = self.n_updates(period)
         time = self.time[0] + period * np.arange(n_updates, dtype=np.float64)
         positions = np.column_stack(
             [np.interp(time, self.time, self.positions[:, axis]) for axis in range(2)]
@@ -121,8 +151,11 @@ class NavigationSettings:
     convergence_updates: int = CONVERGENCE_UPDATES
 
     def __post_init__(self) -> None:
-        if self.convergence_updates < 1:
-            raise InputError(f"convergence_updates must be >= 1, got {self.convergence_updates}")
+        if not 1 <= self.convergence_updates <= MAX_UPDATES:
+            raise InputError(
+                f"convergence_updates (--convergence-updates) must be >= 1 and <= {MAX_UPDATES} "
+                f"(the most updates of a run), got {self.convergence_updates}"
+            )
 
 
 @dataclass(frozen=True)
@@ -223,11 +256,10 @@ def run_monte_carlo(
     Raises
     ------
     InputError
-        If ``n_runs < 1``, the track is too short, or it starts where the sensor has no
-        sounding of the map.
+        If the runs are refused by :func:`check_monte_carlo`, or the track starts where the
+        sensor has no sounding of the map.
     """
-    if n_runs < 1:
-        raise InputError(f"need at least 1 Monte-Carlo run, got {n_runs}")
+    check_monte_carlo(track, settings, n_runs=n_runs, seed=seed)
     samples = track.sampled(settings.update_period)
     truth = samples.positions
     offsets, variances = beam_geometry(settings.sensor, grid, truth, samples.heading)
@@ -269,6 +301,53 @@ def run_monte_carlo(
         example_dead_reckoning=dead_reckoned[0],
         convergence_updates=settings.convergence_updates,
     )
+
+
+def check_monte_carlo(
+    track: Track, settings: NavigationSettings, *, n_runs: int, seed: int | Sequence[int]
+) -> int:
+    """The updates per run of ``n_runs`` runs along ``track``, refused before any allocation.
+
+    The bounds: ``1 <= n_runs <=`` :data:`MAX_RUNS`, seeds >= 0, at most :data:`MAX_UPDATES`
+    updates per run, at most :data:`MAX_PARTICLE_UPDATES` particle updates (runs x particles
+    x updates per run: the work) and at most :data:`RESULT_MEMORY_BUDGET` bytes of results
+    (runs x updates per run x :data:`RESULT_BYTES_PER_UPDATE`). Each message names the
+    ``auvplan evaluate`` flag to change and the limit.
+
+    Raises
+    ------
+    InputError
+        If a bound is broken, or the track lasts less than one update period.
+    """
+    if not 1 <= n_runs <= MAX_RUNS:
+        raise InputError(f"--runs must be >= 1 and <= {MAX_RUNS}, got {n_runs}")
+    seeds = [seed] if isinstance(seed, int) else list(seed)
+    if any(value < 0 for value in seeds):
+        raise InputError(f"--seed must be a non-negative integer, got {min(seeds)}")
+    period = settings.update_period
+    n_updates = track.n_updates(period)
+    updates = (
+        f"{n_updates} updates per run (--update-period {period:g} s over a "
+        f"{track.duration:g} s track)"
+    )
+    if n_updates > MAX_UPDATES:
+        raise InputError(f"{updates} are more than the limit {MAX_UPDATES}")
+    n_particles = settings.filter.n_particles
+    work = n_runs * n_particles * n_updates
+    if work > MAX_PARTICLE_UPDATES:
+        raise InputError(
+            f"--runs {n_runs} x --particles {n_particles} x {updates} = {work:.3g} particle "
+            f"updates, more than the limit {MAX_PARTICLE_UPDATES:.0e}: give fewer runs or "
+            "particles, or a longer update period"
+        )
+    needed = n_runs * n_updates * RESULT_BYTES_PER_UPDATE
+    if needed > RESULT_MEMORY_BUDGET:
+        raise InputError(
+            f"--runs {n_runs} x {updates} need ~{needed / 2**30:.0f} GiB of results, more "
+            f"than the limit {RESULT_MEMORY_BUDGET / 2**30:.0f} GiB: give fewer runs or a "
+            "longer update period"
+        )
+    return n_updates
 
 
 def _simulate_run(
