@@ -268,13 +268,51 @@ def test_geojson_trajectories(export_plan: ExportPlan) -> None:
         properties = feature["properties"]
         assert properties["name"] == waypoints.name
         lon, lat = np.array(feature["geometry"]["coordinates"]).T
-        np.testing.assert_array_equal(lat, waypoints.lat)
-        np.testing.assert_array_equal(lon, waypoints.lon)
-        assert [datetime.fromisoformat(t) for t in properties["times"]] == _times(
-            export_plan, waypoints
-        )
+        np.testing.assert_allclose(lat, waypoints.lat, atol=0.6e-7)  # 7 decimals: ≈ 1 cm
+        np.testing.assert_allclose(lon, waypoints.lon, atol=0.6e-7)
+        times = _times(export_plan, waypoints)
+        assert [datetime.fromisoformat(t) for t in properties["times"]] == times
+        assert datetime.fromisoformat(properties["end_time"]) == times[-1]
         np.testing.assert_array_equal(properties["t_s"], waypoints.time)
         np.testing.assert_allclose(properties["leg_speed_m_s"], waypoints.leg_speeds)
+
+
+def test_geojson_waypoints_carry_their_own_times(export_plan: ExportPlan) -> None:
+    """One timed point per waypoint: what QGIS's temporal controller animates."""
+    document = validate_json(
+        _render(export_plan, "geojson")["waypoints.geojson"], "geojson_waypoints"
+    )
+    features = document["features"]
+    for waypoints in _fleet(export_plan):
+        mine = [f for f in features if f["properties"]["name"] == waypoints.name]
+        assert [f["properties"]["waypoint"] for f in mine] == list(range(len(waypoints.time)))
+        times = [datetime.fromisoformat(f["properties"]["time"]) for f in mine]
+        assert times == _times(export_plan, waypoints)
+        lon, lat = np.array([f["geometry"]["coordinates"] for f in mine]).T
+        assert np.max(_distance_m(lat, lon, waypoints.lat, waypoints.lon)) < 0.02
+        speeds = [f["properties"]["speed_m_s"] for f in mine]
+        np.testing.assert_allclose(speeds[:-1], waypoints.leg_speeds)
+    coordinates = np.array([f["geometry"]["coordinates"] for f in features])
+    np.testing.assert_array_equal(coordinates, np.round(coordinates, 7))
+
+
+def test_geojson_obstacles_are_closed_counter_clockwise_rings(export_plan: ExportPlan) -> None:
+    files = _render(export_plan, "geojson")
+    if not export_plan.zones:
+        assert "obstacles.geojson" not in files
+        return
+    document = validate_json(files["obstacles.geojson"], "geojson_obstacles")
+    names = [feature["properties"]["name"] for feature in document["features"]]
+    assert names == [zone.name for zone in export_plan.zones]
+    for feature, zone in zip(document["features"], export_plan.zones, strict=True):
+        ring = np.array(feature["geometry"]["coordinates"][0])
+        assert ring[0].tolist() == ring[-1].tolist()
+        lon, lat = ring[:, 0], ring[:, 1]
+        assert np.dot(lon, np.roll(lat, -1)) - np.dot(lat, np.roll(lon, -1)) > 0.0  # CCW
+        if isinstance(zone, CircleZone):
+            centre = (np.full(len(ring), zone.lat), np.full(len(ring), zone.lon))
+            radius = _distance_m(*centre, lat, lon)
+            np.testing.assert_allclose(radius, zone.radius, atol=0.02)
 
 
 def test_every_format_renders_its_files(export_plan: ExportPlan) -> None:
@@ -282,6 +320,7 @@ def test_every_format_renders_its_files(export_plan: ExportPlan) -> None:
     stems = file_stems([track.name for track in export_plan.tracks])
     per_vehicle = {f"{stem}.{suffix}" for stem in stems for suffix in ("bhv", "plan", "imc.json")}
     shared = {"origin.moos", "trajectories.gpx", "trajectories.kml", "trajectories.geojson"}
+    shared |= {"waypoints.geojson"} | ({"obstacles.geojson"} if export_plan.zones else set())
     assert files == per_vehicle | shared
 
 

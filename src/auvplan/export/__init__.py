@@ -1,16 +1,18 @@
 """Exports of a finished plan for vehicles, ground stations and GIS.
 
-=========== ======================= =============================================================
-format      files                   for
-=========== ======================= =============================================================
-``moos``    ``NAME.bhv``,           MOOS-IvP pHelmIvP (a timed ``BHV_Waypoint`` per leg, UTM x/y)
-            ``origin.moos``
-``qgc``     ``NAME.plan``           QGroundControl / ArduSub (waypoints, geofences)
-``imc``     ``NAME.imc.json``       Neptus / LSTS IMC (``FollowTrajectory``, timed)
-``gpx``     ``trajectories.gpx``    GPX 1.1 viewers (timed tracks)
-``kml``     ``trajectories.kml``    Google Earth (``gx:Track`` with time stamps)
-``geojson`` ``trajectories.geojson`` GIS (``LineString`` per vehicle, times in properties)
-=========== ======================= =============================================================
+=========== ========================== ===================================================
+format      files                      for
+=========== ========================== ===================================================
+``moos``    ``NAME.bhv``,              MOOS-IvP pHelmIvP (a timed ``BHV_Waypoint`` per
+            ``origin.moos``            leg, UTM x/y)
+``qgc``     ``NAME.plan``              QGroundControl / ArduSub (waypoints, geofences)
+``imc``     ``NAME.imc.json``          Neptus / LSTS IMC (``FollowTrajectory``, timed)
+``gpx``     ``trajectories.gpx``       GPX 1.1 viewers (timed tracks)
+``kml``     ``trajectories.kml``       Google Earth (``gx:Track`` with time stamps)
+``geojson`` ``trajectories.geojson``,  GIS: a ``LineString`` per vehicle, a timed ``Point``
+            ``waypoints.geojson``,     per waypoint (QGIS temporal controller), keep-out
+            ``obstacles.geojson``      ``Polygon``s
+=========== ========================== ===================================================
 
 Every format is written from the same waypoints: each track thinned to ``tolerance`` with its
 time law kept (:func:`auvplan.export.waypoints.thin_track`). The plan they are written from is
