@@ -97,3 +97,66 @@ def transit_mission() -> TransitMission:
     ridge 160 m beside the line) and its ``terrain.nc`` into a folder; returns the mission file.
     ``navigation`` adds lines to its ``[navigation]`` table."""
     return _transit_mission
+
+
+#: Writes an output folder of hand-made trajectories through :func:`auvplan.record.write_record`.
+PlanFolderWriter = Callable[..., Path]
+
+
+@pytest.fixture
+def write_plan_folder() -> PlanFolderWriter:
+    """``write(folder, maps, plans, *, top_speed=2.0, extra=None, mission=None) -> folder``.
+
+    ``plans`` maps plan labels (``terrain_aware``, ``energy_only``, ``paper``) to tuples of
+    :class:`auvplan.record.VehicleTrajectory`; the summary is the smallest valid
+    :class:`auvplan.record.PlanSummary` of those vehicles (each of top speed ``top_speed``
+    [m/s]), with the ``extra`` entries and the files' digest.
+    """
+    from auvplan.record import PlanRecord, RunLayers, files_digest, parse_summary, write_record
+    from auvplan.record.files import PLAN_FILES
+    from auvplan.record.trajectories import VehicleTrajectory
+    from auvplan.terrain import TerrainMaps
+
+    def write(
+        folder: Path,
+        maps: TerrainMaps,
+        plans: dict[str, tuple[VehicleTrajectory, ...]],
+        *,
+        top_speed: float = 2.0,
+        extra: dict[str, object] | None = None,
+        mission: dict[str, object] | None = None,
+    ) -> Path:
+        tables = next(iter(plans.values()))
+        pose = {"north": 0.0, "east": 0.0, "heading_rad": 0.0}
+        vehicles = [
+            {"name": t.name, "type": "medusa", "start": pose, "goal": pose, "preplan": {},
+             "type_name": "medusa", "state_names": t.state_names, "input_names": t.input_names,
+             "top_speed_m_s": top_speed}
+            for t in tables
+        ]  # fmt: skip
+        outcomes = {
+            PLAN_FILES[label].record: {
+                "terrain_weight": 0.0 if label == "energy_only" else 1.0,
+                "plan_status": "CONVERGED",
+                "verdict": "",
+            }
+            for label in plans
+        }
+        document = {
+            "auvplan_version": "test", "mission": None, "inputs": {},
+            "start_time": "2026-05-01T08:00:00+00:00", "stage": "full",
+            "terrain": {"name": "test", "origin": {"north": 0.0, "east": 0.0}},
+            "obstacles": [], "current": None,
+            "fleet": {"safety_radius_m": 5.0, "edge_model": "paper",
+                      "deconfliction_method": "astar", "max_current_m_s": 0.0},
+            "solver": {}, "vehicles": vehicles, "wall_time_s": {}, "warnings": [],
+            **outcomes, **(extra or {}),
+        }  # fmt: skip
+        summary = parse_summary(document, source="test summary")
+        summary = summary.model_copy(update={"digest": files_digest(maps, plans)})
+        layers = RunLayers("test", tuple(t.positions for t in tables), tuple({} for _ in tables))
+        folder.mkdir(parents=True, exist_ok=True)
+        write_record(PlanRecord(summary, dict(mission or {}), maps, plans, layers), folder)
+        return folder
+
+    return write

@@ -9,49 +9,44 @@ import numpy as np
 import pytest
 
 from auvplan.cli.main import main
-from auvplan.io.maps_file import write_maps_netcdf
-from auvplan.io.results import write_json, write_trajectories_csv
+from auvplan.record import VehicleTrajectory
 from auvplan.terrain import BathymetryGrid, GridGeometry, compute_terrain_maps
+from auvplan.vehicle import INPUT_NAMES, STATE_NAMES
+from conftest import PlanFolderWriter
 
 FAST = ["--runs", "3", "--particles", "200", "--seed", "1", "--update-period", "2"]
 
 
-def _write_plan(
-    path: Path, time: np.ndarray, east_offsets: tuple[float, ...], wiggle: float
-) -> np.ndarray:
-    """Two northbound vehicles at 1 m/s; returns the power ``(2, n_t)`` written."""
-    n_t = time.size
-    states = np.zeros((2, n_t, 8))
-    for i, east in enumerate(east_offsets):
-        states[i, :, 0] = 20.0 + time
-        states[i, :, 1] = east + wiggle * np.sin(time / 15.0)
-        states[i, :, 3] = 1.0
-    power = 40.0 + 5.0 * np.cos(time / 7.0)[None, :] + np.array([[0.0], [3.0]])
-    write_trajectories_csv(path, ["blue", "green"], time, states, np.zeros((2, n_t - 1, 2)), power)
-    return power
+def _tables(
+    time: np.ndarray, east_offsets: tuple[float, ...], wiggle: float
+) -> tuple[VehicleTrajectory, ...]:
+    """Two northbound MEDUSAs at 1 m/s, each with its own power [W]."""
+    tables = []
+    for i, (name, east) in enumerate(zip(("blue", "green"), east_offsets, strict=True)):
+        states = np.zeros((time.size, 8))
+        states[:, 0] = 20.0 + time
+        states[:, 1] = east + wiggle * np.sin(time / 15.0)
+        states[:, 3] = 1.0
+        power = 40.0 + 5.0 * np.cos(time / 7.0) + 3.0 * i
+        tables.append(VehicleTrajectory(name, STATE_NAMES, INPUT_NAMES, time, states,
+                                        np.zeros((time.size - 1, 2)), power))  # fmt: skip
+    return tuple(tables)
 
 
 @pytest.fixture
-def plan_folder(tmp_path: Path) -> Path:
+def plan_folder(tmp_path: Path, write_plan_folder: PlanFolderWriter) -> Path:
     """A minimal plan output folder written by the project's own writers (150 s mission)."""
-    folder = tmp_path / "out"
-    folder.mkdir()
     geometry = GridGeometry(60, 50, 4.0, 4.0)
     north, east = np.meshgrid(geometry.north, geometry.east, indexing="ij")
     depth = 40.0 + 8.0 * np.sin(north / 17.0) * np.cos(east / 23.0) + 0.05 * east
-    write_maps_netcdf(compute_terrain_maps(BathymetryGrid(depth, geometry)), folder / "maps.nc")
+    maps = compute_terrain_maps(BathymetryGrid(depth, geometry))
     time = np.arange(0.0, 150.5, 0.5)
-    aware = _write_plan(folder / "trajectories.csv", time, (60.0, 120.0), wiggle=15.0)
-    only = _write_plan(folder / "trajectories_energy_only.csv", time, (60.0, 120.0), wiggle=0.0)
-    write_json(
-        {
-            "optimization": {"terrain_weight": 1.0, "plan_status": "CONVERGED"},
-            "energy_only": {"terrain_weight": 0.0, "plan_status": "CONVERGED"},
-            "test_energy_J": [float(np.trapezoid(p, time).sum()) for p in (aware, only)],
-        },
-        folder / "summary.json",
-    )
-    return folder
+    plans = {
+        "terrain_aware": _tables(time, (60.0, 120.0), wiggle=15.0),
+        "energy_only": _tables(time, (60.0, 120.0), wiggle=0.0),
+    }
+    energies = [sum(table.energy for table in tables) for tables in plans.values()]
+    return write_plan_folder(tmp_path / "out", maps, plans, extra={"test_energy_J": energies})
 
 
 def test_evaluate_writes_navigation_json_and_figure(
@@ -101,7 +96,7 @@ def test_same_seed_same_json_and_only_the_plans_present(
     [
         ("no_maps", [], "maps.nc not found"),
         ("no_trajectories", [], "has no trajectories.csv"),
-        ("bad_column", [], "missing column(s) psi"),
+        ("bad_column", [], "no column 'psi' of vehicle 'blue'"),
         ("bad_number", [], "is not a finite number"),
         (None, ["--runs", "0"], "--runs must be >= 1"),
         (None, ["--particles", "1"], "needs >= 2 particles"),

@@ -10,7 +10,8 @@ import pytest
 from auvplan.cli.main import main
 from auvplan.export import FORMATS
 from auvplan.export.plan import ExportPlan
-from auvplan.mission.folder import load_export_plan
+from auvplan.record import export_plan as record_export_plan
+from auvplan.record import read_record
 
 from ._plans import MISSION, synthetic_plan, write_geographic_grid
 
@@ -21,7 +22,7 @@ def export_plan(request: pytest.FixtureRequest) -> ExportPlan:
     a polygon obstacle) and, in the slow suite, the Monterey example's plan read back."""
     if request.param == "synthetic":
         return synthetic_plan()
-    return load_export_plan(request.getfixturevalue("monterey_folder"))
+    return record_export_plan(read_record(request.getfixturevalue("monterey_folder")))
 
 
 @pytest.fixture(scope="session")

@@ -1,4 +1,4 @@
-"""Digests of the trajectory files that :mod:`auvplan.mission.outputs` writes for a plan.
+"""Digests of the trajectory files that :mod:`auvplan.record` writes for a plan.
 
 ``output_digest`` writes ``trajectories.csv`` and ``trajectories.nc`` of a stand-in mission
 result and summarises them: the CSV's SHA-256, and per NetCDF variable its dimensions, type,
@@ -19,9 +19,10 @@ from typing import Any
 import numpy as np
 
 from auvplan import __version__
-from auvplan.io.results import write_trajectories_csv
 from auvplan.io.vehicles import load_vehicle
-from auvplan.mission.outputs import plan_dataset
+from auvplan.mission.outputs import trajectory_tables
+from auvplan.record import trajectories_dataset_of
+from auvplan.record.folder import trajectories_csv_text
 from auvplan.vehicle import VehicleModel, build_vehicle_model
 
 #: Seed and length of the stand-in plan.
@@ -57,15 +58,22 @@ def golden_medusa_result() -> Any:
 
 
 def write_files(result: Any, plan: Any, folder: Path) -> tuple[Path, Path]:
-    """``trajectories.csv`` and ``trajectories.nc`` of the stand-in, as the mission writes them."""
+    """``trajectories.csv`` and ``trajectories.nc`` of the stand-in, as the record writes them."""
+    tables = trajectory_tables(result, plan)
     models = result.deconfliction.layout.models
+    record = SimpleNamespace(
+        plans={"terrain_aware": tables},
+        summary=SimpleNamespace(
+            start=START,
+            vehicles=[SimpleNamespace(type_name=model.vehicle.name) for model in models],
+            outcome=lambda label: SimpleNamespace(terrain_weight=plan.terrain_weight),
+        ),
+        depth=result.config.mission.depth,
+        maps=SimpleNamespace(bathymetry=result.preplan.bathymetry),
+    )
     csv_path, netcdf_path = folder / "trajectories.csv", folder / "trajectories.nc"
-    write_trajectories_csv(
-        csv_path, result.preplan.names, result.deconfliction.time, plan.states, plan.inputs,
-        np.asarray(plan.power), state_names=[model.state_names for model in models],
-        input_names=[model.input_names for model in models],
-    )  # fmt: skip
-    plan_dataset(result, plan).to_netcdf(netcdf_path)
+    csv_path.write_text(trajectories_csv_text(tables), encoding="utf-8", newline="")
+    trajectories_dataset_of(record, "terrain_aware").to_netcdf(netcdf_path)
     return csv_path, netcdf_path
 
 

@@ -100,15 +100,17 @@ def test_evaluate_flies_the_missions_navigation_model(
     tmp_path: Path, transit_mission: TransitMission
 ) -> None:
     """The folder's [navigation] table is the evaluator's model; flags override it."""
-    from auvplan.mission.folder import folder_navigation
+    from auvplan.mission.folder import mission_navigation
+    from auvplan.record import read_record
 
     mission = transit_mission(tmp_path, ridge=False, navigation="drift_percent = 0.5")
     out = tmp_path / "out"
     assert main(["-q", "plan", str(mission), "-o", str(out), "--stage", "preplan"]) == 0
-    table, depth = folder_navigation(out, {})
+    record = read_record(out)
+    table, depth = mission_navigation(record.mission, {}), record.depth
     assert table.drift == 0.5
     assert depth == 0.0
-    assert folder_navigation(out, {"drift_percent": 2.0})[0].drift == 2.0
+    assert mission_navigation(record.mission, {"drift_percent": 2.0}).drift == 2.0
     settings = table.settings(vehicle_depth=depth)
     assert settings.motion.drift_fraction == pytest.approx(0.005)
 

@@ -88,16 +88,17 @@ def _write_plan(
     mission = folder / "mission.toml"
     mission.write_text(f"[fleet]\nsafety_radius_m = {SAFETY_RADIUS}\n{mission_extra}")
     models = [read_reference_model(types[name], propeller_order=3) for name in tracks]
-    write_trajectories_csv(
-        folder / "trajectories.csv",
-        list(tracks),
-        DT * np.arange(N_STEPS + 1),
-        [states for states, _ in tracks.values()],
-        [inputs for _, inputs in tracks.values()],
-        np.full((len(tracks), N_STEPS + 1), 40.0),
-        state_names=[model.state_names for model in models],
-        input_names=[model.input_names for model in models],
-    )
+    with (folder / "trajectories.csv").open("w", newline="", encoding="utf-8") as handle:
+        write_trajectories_csv(
+            handle,
+            list(tracks),
+            DT * np.arange(N_STEPS + 1),
+            [states for states, _ in tracks.values()],
+            [inputs for _, inputs in tracks.values()],
+            [np.full(N_STEPS + 1, 40.0) for _ in tracks],
+            state_names=[model.state_names for model in models],
+            input_names=[model.input_names for model in models],
+        )
     summary = {
         "mission": str(mission),
         "fleet": {"safety_radius_m": SAFETY_RADIUS},

@@ -2,12 +2,11 @@
 
 :func:`write_output_folder` is what ``auvplan plan``/``demo`` and
 :meth:`auvplan.MissionPlan.save` write, all-or-nothing
-(:func:`~auvplan.io.output.staged_output_dir`): the data files of
-:func:`~auvplan.mission.outputs.write_mission_files`, the exports asked for (made from the
-folder, as ``auvplan export`` makes them), the figures of
+(:func:`~auvplan.io.output.staged_output_dir`): the data files of the run's record
+(:func:`~auvplan.record.write_record`), the exports asked for (made from the record, as
+``auvplan export`` makes them from the record it reads), the figures of
 :func:`~auvplan.viz.report.mission_figures` and the self-contained ``report.html``
-(:func:`~auvplan.viz.html.render_report`), which is built from the folder's own
-``summary.json``.
+(:func:`~auvplan.viz.html.render_report`), built from the record's summary.
 """
 
 from __future__ import annotations
@@ -19,25 +18,21 @@ from typing import TYPE_CHECKING
 from auvplan._figures import DEFAULT_DPI
 from auvplan.export import DEFAULT_TOLERANCE_M, write_exports
 from auvplan.io.output import staged_output_dir
-from auvplan.io.text import read_json
-from auvplan.mission.folder import load_export_plan
-from auvplan.mission.outputs import write_mission_files
 from auvplan.mission.pipeline import MissionResult
+from auvplan.record import PlanRecord, export_plan, write_record
+from auvplan.record.files import EXPORT_FOLDER, REPORT_FILE
 from auvplan.viz.html import render_report
 from auvplan.viz.report import RenderedFigure, render_mission_figures
 
 if TYPE_CHECKING:
     from auvplan.api.companion import Companion
 
-#: The report's file name in every output folder.
-REPORT_FILE = "report.html"
-
 
 def write_output_folder(
     result: MissionResult,
+    record: PlanRecord,
     target: Path,
     *,
-    warnings: Sequence[str] = (),
     figures: bool = True,
     figure_format: str = "png",
     dpi: int = DEFAULT_DPI,
@@ -50,11 +45,12 @@ def write_output_folder(
     Parameters
     ----------
     result : MissionResult
-        The run.
+        The run (the figures are drawn from it).
+    record : PlanRecord
+        Its record (:func:`auvplan.mission.outputs.plan_record`): the data files, exports
+        and report.
     target : Path
         The folder; files of the same name are replaced, other files kept.
-    warnings : sequence of str
-        Warnings logged during the run (``summary.json`` and the report list them).
     figures : bool
         Write the figures (the report embeds them).
     figure_format : str
@@ -79,10 +75,10 @@ def write_output_folder(
         draw = render_mission_figures if companion is None else companion.render_figures
         rendered = draw(result, figure_format=figure_format, dpi=dpi)
     with staged_output_dir(target) as staging:
-        written = write_mission_files(result, staging, warnings=warnings)
-        if exports and result.plan is not None:
+        written = write_record(record, staging)
+        if exports and record.has_plan:
             written += write_exports(
-                load_export_plan(staging), staging / "export", exports, tolerance=tolerance
+                export_plan(record), staging / EXPORT_FOLDER, exports, tolerance=tolerance
             )
         for stem, figure in rendered.items():
             path = staging / f"{stem}.{figure.figure_format}"
@@ -90,10 +86,11 @@ def write_output_folder(
             written.append(path)
         report = staging / REPORT_FILE
         names = [path.relative_to(staging).as_posix() for path in [*written, report]]
-        summary = read_json(staging / "summary.json", what="summary file")
-        report.write_text(render_report(summary, rendered, files=names), encoding="utf-8")
+        report.write_text(
+            render_report(record.summary.document(), rendered, files=names), encoding="utf-8"
+        )
         written.append(report)
         return [target / path.relative_to(staging) for path in written]
 
 
-__all__ = ["REPORT_FILE", "write_output_folder"]
+__all__ = ["write_output_folder"]

@@ -7,8 +7,8 @@
 >>> plan.plot().savefig("paths.png")                      # doctest: +SKIP
 >>> plan.save("out/run1"); auvplan.load("out/run1").to_xarray()     # doctest: +SKIP
 
-A :class:`MissionPlan` holds what an output folder holds: the ``summary.json`` document, the
-bathymetry of ``maps.nc`` and the trajectories of ``trajectories.nc``, so a plan made in
+A :class:`MissionPlan` holds what an output folder holds, its :class:`~auvplan.record.PlanRecord`
+(``summary.json``, the maps of ``maps.nc``, each vehicle's trajectories), so a plan made in
 memory (:func:`plan`) and the same plan read back from its folder (:func:`load`) answer alike.
 """
 
@@ -27,16 +27,13 @@ import numpy as np
 from auvplan._figures import DEFAULT_DPI
 from auvplan.errors import InputError
 from auvplan.export import DEFAULT_TOLERANCE_M
-from auvplan.io.maps_file import read_maps_netcdf
 from auvplan.io.output import staged_output_dir
-from auvplan.io.results import json_values
-from auvplan.io.text import read_json
-from auvplan.io.trajectories_file import read_trajectories_netcdf
 from auvplan.mission.config import MissionConfig, load_mission, parse_mission
-from auvplan.mission.outputs import plan_dataset
+from auvplan.mission.outputs import plan_record
 from auvplan.mission.pipeline import MissionResult, Stage, run_mission
 from auvplan.mission.progress import ProgressReporter, no_progress
-from auvplan.mission.summary import mission_summary
+from auvplan.record import PlanRecord, read_record, trajectories_dataset_of
+from auvplan.record.files import MAIN_PLAN
 from auvplan.terrain import BathymetryGrid
 
 if TYPE_CHECKING:
@@ -59,13 +56,8 @@ class MissionPlan:
 
     Parameters
     ----------
-    summary : mapping
-        The ``summary.json`` document (plain JSON values).
-    bathymetry : BathymetryGrid
-        The terrain the mission was planned on (after any window).
-    trajectories : xarray.Dataset or None
-        ``trajectories.nc`` as read (:func:`auvplan.io.trajectories_file.trajectories_dataset`);
-        ``None`` when the run stopped before optimising or the optimiser failed.
+    record : PlanRecord
+        What the output folder holds (:mod:`auvplan.record`).
     result : MissionResult, optional
         The run, when planned in this session.
     folder : Path, optional
@@ -74,25 +66,26 @@ class MissionPlan:
 
     def __init__(
         self,
-        summary: Mapping[str, Any],
-        bathymetry: BathymetryGrid,
-        trajectories: xr.Dataset | None,
+        record: PlanRecord,
         *,
         result: MissionResult | None = None,
         folder: Path | None = None,
     ) -> None:
-        self._summary = dict(summary)
-        self._bathymetry = bathymetry
-        self._trajectories = trajectories
+        self._record = record
+        self._summary = record.summary.document()
+        self._trajectories = trajectories_dataset_of(record, MAIN_PLAN) if record.has_plan else None
         self._result = result
         self._folder = folder
 
     @classmethod
     def from_result(cls, result: MissionResult, *, warnings: Sequence[str] = ()) -> MissionPlan:
         """The plan of a run of :func:`~auvplan.mission.run_mission` (``warnings``: logged)."""
-        summary = json_values(mission_summary(result, warnings=warnings))
-        trajectories = None if result.plan is None else plan_dataset(result, result.plan)
-        return cls(summary, result.preplan.bathymetry, trajectories, result=result)
+        return cls(plan_record(result, warnings=warnings), result=result)
+
+    @property
+    def record(self) -> PlanRecord:
+        """What the output folder holds: summary, mission, maps, each vehicle's trajectories."""
+        return self._record
 
     @property
     def summary(self) -> dict[str, Any]:
@@ -102,7 +95,7 @@ class MissionPlan:
     @property
     def bathymetry(self) -> BathymetryGrid:
         """The terrain the mission was planned on."""
-        return self._bathymetry
+        return self._record.maps.bathymetry
 
     @property
     def result(self) -> MissionResult | None:
@@ -183,10 +176,8 @@ class MissionPlan:
 
         vehicles = self._summary["vehicles"]
         planned = [np.asarray(v["preplan"]["points_north_east_m"], dtype=float) for v in vehicles]
-        tracks = None
-        if self._trajectories is not None:
-            north, east = self._trajectories["north"].values, self._trajectories["east"].values
-            tracks = [np.column_stack([n, e]) for n, e in zip(north, east, strict=True)]
+        tables = self._record.plans.get(MAIN_PLAN)
+        tracks = None if tables is None else [table.positions for table in tables]
         obstacles = self._summary.get("obstacles", [])
         circles = np.array(
             [(o["center"]["north"], o["center"]["east"], o["radius_m"])
@@ -198,7 +189,7 @@ class MissionPlan:
             if o["shape"] == "polygon"
         ]
         return plot_mission_paths(
-            self._bathymetry, self.names, planned, tracks,
+            self.bathymetry, self.names, planned, tracks,
             safety_radius=self._summary["fleet"]["safety_radius_m"],
             circles=circles, polygons=polygons,
         )  # fmt: skip
@@ -235,7 +226,7 @@ class MissionPlan:
         from auvplan.export import parse_formats
 
         return write_output_folder(
-            self._result, target, warnings=self.warnings, figures=figures,
+            self._result, self._record, target, figures=figures,
             figure_format=figure_format, dpi=dpi,
             exports=parse_formats(",".join(exports)) if exports else (), tolerance=tolerance_m,
             companion=companion,
@@ -329,16 +320,11 @@ def load(folder: str | os.PathLike[str]) -> MissionPlan:
     InputError
         If ``folder`` is not an output folder (no ``summary.json``).
     DataFormatError
-        If one of its files is unreadable.
+        If one of its files is unreadable, malformed or stale
+        (:func:`auvplan.record.read_record`).
     """
     path = Path(folder)
-    if not (path / "summary.json").is_file():
-        raise InputError(f"{path} is not an auvplan output folder (no summary.json)")
-    summary = read_json(path / "summary.json", what="summary file")
-    bathymetry = read_maps_netcdf(path / "maps.nc").bathymetry
-    netcdf = path / "trajectories.nc"
-    trajectories = read_trajectories_netcdf(netcdf) if netcdf.is_file() else None
-    return MissionPlan(summary, bathymetry, trajectories, folder=path)
+    return MissionPlan(read_record(path), folder=path)
 
 
 def _mission_config(mission: MissionSource) -> MissionConfig:

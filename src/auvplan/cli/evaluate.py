@@ -1,7 +1,8 @@
 """``auvplan evaluate OUTPUT_DIR``: terrain-aided navigation along the plans of an output folder.
 
-Reads ``maps.nc`` and ``trajectories.csv`` (and ``trajectories_energy_only.csv`` when the plan
-was run with ``--compare-energy-only``) from the folder of ``auvplan plan``/``demo``, runs
+Reads the folder of ``auvplan plan``/``demo`` (:func:`auvplan.record.read_record`: ``maps.nc``
+and ``trajectories.csv``, and ``trajectories_energy_only.csv`` when the plan was run with
+``--compare-energy-only``; stale or malformed files are refused), runs
 Monte-Carlo particle-filter navigation along every vehicle's track and writes
 ``navigation.json`` and ``navigation.png`` (or ``.svg``/``.pdf``: ``--figure-format``) into the
 same folder, all-or-nothing (:func:`auvplan.io.output.staged_output_dir`: the folder's other
@@ -21,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 from auvplan.cli.figure_options import add_figure_options
 
 if TYPE_CHECKING:  # the sweep package (pandas) is imported only when a command runs
+    from auvplan.record import PlanRecord
     from auvplan.sweep.navigation import NavigationOptions
 
 
@@ -92,12 +94,17 @@ def add_navigation_options(parser: argparse.ArgumentParser) -> None:
 
 
 def navigation_options(
-    args: argparse.Namespace, *, seed: int, threads: int | None = None, folder: Path | None = None
+    args: argparse.Namespace,
+    *,
+    seed: int,
+    threads: int | None = None,
+    record: PlanRecord | None = None,
 ) -> NavigationOptions:
     """The :class:`~auvplan.sweep.NavigationOptions` of :func:`add_navigation_options`'s args.
 
-    The model is ``folder``'s ``[navigation]`` table (defaults without a folder) with the
-    flags given on top (:func:`auvplan.mission.folder.folder_navigation`).
+    The model is the ``[navigation]`` table of ``record``'s mission (defaults without a
+    record) with the flags given on top (:func:`auvplan.mission.folder.mission_navigation`),
+    at the plan's depth.
 
     Raises
     ------
@@ -105,7 +112,7 @@ def navigation_options(
         If ``--runs`` is below 1 or a model value is out of its range.
     """
     from auvplan.errors import InputError
-    from auvplan.mission.folder import folder_navigation
+    from auvplan.mission.folder import mission_navigation
     from auvplan.sweep.navigation import NavigationOptions
 
     if args.runs < 1:
@@ -117,9 +124,9 @@ def navigation_options(
         "drift_percent": args.drift,
     }
     overrides = {key: value for key, value in flags.items() if value is not None}
-    table, depth = folder_navigation(folder, overrides)
+    table = mission_navigation({} if record is None else record.mission, overrides)
     settings = table.settings(
-        vehicle_depth=depth,
+        vehicle_depth=0.0 if record is None else record.depth,
         particles=args.particles,
         convergence_updates=args.convergence_updates,
     )
@@ -129,15 +136,16 @@ def navigation_options(
 def run(args: argparse.Namespace) -> int:
     """Evaluate the folder's plans and write the results; returns the exit code."""
     from auvplan.io.output import staged_output_dir
-    from auvplan.io.plan_folder import read_plan_folder
     from auvplan.io.results import write_json
+    from auvplan.record import read_record
+    from auvplan.record.files import NAVIGATION_FILE
     from auvplan.sweep.navigation import evaluate_folder
 
-    folder = read_plan_folder(args.output)
-    options = navigation_options(args, seed=args.seed, folder=args.output)
-    n_tracks = sum(len(vehicles) for vehicles in folder.plans.values())
+    record = read_record(args.output)
+    options = navigation_options(args, seed=args.seed, record=record)
+    n_tracks = sum(len(vehicles) for vehicles in record.plans.values())
     with _progress(n_tracks * args.runs, args.runs, quiet=args.quiet) as progress:
-        navigation = evaluate_folder(folder, options, progress=progress)
+        navigation = evaluate_folder(record, options, progress=progress)
     document = navigation.document
     figure = None
     if not args.no_figure:
@@ -145,13 +153,13 @@ def run(args: argparse.Namespace) -> int:
         from auvplan.viz.report import render_figure
 
         figure = render_figure(
-            plot_navigation(folder.bathymetry, navigation.evaluations),
+            plot_navigation(record.maps.bathymetry, navigation.evaluations),
             figure_format=args.figure_format,
             dpi=args.dpi,
         )
     with staged_output_dir(args.output) as staging:
-        write_json(document, staging / "navigation.json")
-        written = [args.output / "navigation.json"]
+        write_json(document, staging / NAVIGATION_FILE)
+        written = [args.output / NAVIGATION_FILE]
         if figure is not None:
             figure_name = f"navigation.{args.figure_format}"
             (staging / figure_name).write_bytes(figure.data)

@@ -62,11 +62,12 @@ def run_export(args: argparse.Namespace) -> int:
     """Read the folder's plan and write the exports all-or-nothing."""
     from auvplan.export import parse_formats, write_exports
     from auvplan.io.output import staged_output_dir
-    from auvplan.mission.folder import load_export_plan
+    from auvplan.record import export_plan, read_record
+    from auvplan.record.files import EXPORT_FOLDER
 
     formats = parse_formats(args.formats)
-    plan = load_export_plan(args.folder)
-    target = args.output if args.output is not None else args.folder / "export"
+    plan = export_plan(read_record(args.folder))
+    target = args.output if args.output is not None else args.folder / EXPORT_FOLDER
     with staged_output_dir(target) as staging:
         written = write_exports(plan, staging, formats, tolerance=args.tolerance_m)
     if not args.quiet:

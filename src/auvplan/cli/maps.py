@@ -63,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
     from auvplan.io.bathymetry import read_bathymetry
     from auvplan.io.maps_file import write_maps_netcdf
     from auvplan.io.output import staged_output_dir
+    from auvplan.record.files import MAPS_FILE
     from auvplan.terrain import MapParameters, compute_terrain_maps, synthetic_bank
     from auvplan.viz.maps import plot_terrain_maps
     from auvplan.viz.report import render_figure
@@ -96,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
     figure = render_figure(plot_terrain_maps(maps), figure_format=args.figure_format, dpi=args.dpi)
     figure_name = f"maps.{args.figure_format}"
     with staged_output_dir(args.output) as staging:
-        write_maps_netcdf(maps, staging / "maps.nc")
+        write_maps_netcdf(maps, staging / MAPS_FILE)
         (staging / figure_name).write_bytes(figure.data)
     if not args.quiet:
         _print_summary(maps, args.output, figure_name)

@@ -19,7 +19,7 @@ import json
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any, Final
+from typing import Any, Final, TextIO
 
 import numpy as np
 
@@ -113,22 +113,22 @@ def trajectory_columns(
 
 
 def write_trajectories_csv(
-    path: Path,
+    handle: TextIO,
     names: Sequence[str],
     time: FloatArray,
     states: FloatArray | Sequence[FloatArray],
     inputs: FloatArray | Sequence[FloatArray],
-    power: FloatArray,
+    power: Sequence[FloatArray],
     *,
-    state_names: Sequence[Sequence[str]] | None = None,
-    input_names: Sequence[Sequence[str]] | None = None,
+    state_names: Sequence[Sequence[str]],
+    input_names: Sequence[Sequence[str]],
 ) -> None:
-    """Write ``trajectories.csv`` (columns :func:`trajectory_columns`).
+    """Write ``trajectories.csv`` (columns :func:`trajectory_columns`) into a text stream.
 
     Parameters
     ----------
-    path : Path
-        Output file.
+    handle : text stream
+        Where to write (a file opened with ``newline=""``, or a ``StringIO``).
     names : sequence of str
         Vehicle names, length ``n_vehicles``.
     time : ndarray of shape (n_t,)
@@ -137,19 +137,16 @@ def write_trajectories_csv(
         Each vehicle's states named by ``state_names[i]`` (SI units, rev/s, rad).
     inputs : sequence of ndarray of shape (n_t - 1, n_u_i)
         Each vehicle's inputs named by ``input_names[i]``, held over each step.
-    power : ndarray of shape (n_vehicles, n_t)
-        Electrical power [W].
-    state_names, input_names : sequence of sequence of str, optional
-        Per vehicle; default MEDUSA's :data:`~auvplan.vehicle.STATE_NAMES` and
-        :data:`~auvplan.vehicle.INPUT_NAMES` for every vehicle.
+    power : sequence of ndarray of shape (n_t,)
+        Each vehicle's electrical power [W].
+    state_names, input_names : sequence of sequence of str
+        Each vehicle's own state and input names.
 
     Raises
     ------
     InputError
         If an array does not match ``time``, ``names`` or its names.
     """
-    state_names = state_names or [STATE_NAMES] * len(names)
-    input_names = input_names or [INPUT_NAMES] * len(names)
     n_t = time.size
     for index, name in enumerate(names):
         state_shape, input_shape = np.shape(states[index]), np.shape(inputs[index])
@@ -163,21 +160,20 @@ def write_trajectories_csv(
                 f"inputs {input_shape}, power {np.shape(power[index])}"
             )
     columns = trajectory_columns(state_names, input_names)
-    with path.open("w", newline="", encoding="utf-8") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(columns)
-        for index, name in enumerate(names):
-            held = np.vstack([inputs[index], inputs[index][-1:]])
-            series = {
-                "t": time,
-                **dict(zip(state_names[index], np.transpose(states[index]), strict=True)),
-                **dict(zip(input_names[index], held.T, strict=True)),
-                "power": power[index],
-            }
-            for k in range(n_t):
-                writer.writerow(
-                    [name, *(repr(float(series[c][k])) if c in series else "" for c in columns[1:])]
-                )
+    writer = csv.writer(handle)
+    writer.writerow(columns)
+    for index, name in enumerate(names):
+        held = np.vstack([inputs[index], inputs[index][-1:]])
+        series = {
+            "t": time,
+            **dict(zip(state_names[index], np.transpose(states[index]), strict=True)),
+            **dict(zip(input_names[index], held.T, strict=True)),
+            "power": power[index],
+        }
+        for k in range(n_t):
+            writer.writerow(
+                [name, *(repr(float(series[c][k])) if c in series else "" for c in columns[1:])]
+            )
 
 
 def read_trajectories_csv(path: Path) -> dict[str, dict[str, FloatArray]]:
@@ -214,9 +210,9 @@ def read_trajectories_csv(path: Path) -> dict[str, dict[str, FloatArray]]:
 
 
 def write_desired_csv(
-    path: Path, names: Sequence[str], time: FloatArray, poses: FloatArray
+    path: Path, names: Sequence[str], time: FloatArray, poses: Sequence[FloatArray]
 ) -> None:
-    """Write ``desired.csv``; ``poses`` ``(n_vehicles, n_t, 3)`` is north, east [m], psi [rad]."""
+    """Write ``desired.csv``; ``poses[i]`` ``(n_t, 3)`` is north, east [m], psi [rad]."""
     with path.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         writer.writerow(DESIRED_COLUMNS)

@@ -34,8 +34,9 @@ CHECK_REFINEMENT: Final = 10
 class OptimizedPlan:
     """Stage 3 for one weighting: the PRONTO result and the fleet's trajectories.
 
-    ``states`` ``(n_vehicles, n_t, n_x)``, ``inputs`` ``(n_vehicles, n_t - 1, n_u)``, ``power``
-    ``(n_vehicles, n_t)`` [W], ``energy`` ``(n_vehicles,)`` [J] = trapezoidal ∫ power dt,
+    ``states[i]`` ``(n_t, n_x_i)`` and ``inputs[i]`` ``(n_t - 1, n_u_i)`` are vehicle ``i``'s
+    own states and inputs (vehicles may differ in size), ``power`` ``(n_vehicles, n_t)`` [W],
+    ``energy`` ``(n_vehicles,)`` [J] = trapezoidal ∫ power dt,
     ``arrival_error`` ``(n_vehicles,)`` [m], ``terrain_information`` ``(n_vehicles,)`` mean
     information-map value along the trajectory; ``separations[name][other]`` the minimum
     distance [m] to each other vehicle (centre to centre) and obstacle (to its edge; polygons
@@ -50,8 +51,8 @@ class OptimizedPlan:
 
     result: ProntoResult
     terrain_weight: float
-    states: FloatArray
-    inputs: FloatArray
+    states: tuple[FloatArray, ...]
+    inputs: tuple[FloatArray, ...]
     power: FloatArray
     energy: FloatArray
     arrival_error: FloatArray
@@ -80,8 +81,8 @@ def evaluate_plan(
     layout = functions.layout
     models = layout.models
     flat_states, flat_inputs = result.trajectory.states, result.trajectory.inputs
-    states = np.stack(layout.unstack_states(flat_states))
-    inputs = np.stack(layout.unstack_inputs(flat_inputs))
+    states = tuple(np.ascontiguousarray(x) for x in layout.unstack_states(flat_states))
+    inputs = tuple(np.ascontiguousarray(c) for c in layout.unstack_inputs(flat_inputs))
     held = np.vstack([flat_inputs, flat_inputs[-1:]])
     power_map = functions.power.map(time.size, "serial")
     power = np.asarray(power_map(flat_states.T, held.T)).reshape(layout.n_vehicles, time.size)

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from auvplan import __version__
+from auvplan.io.results import json_values
 from auvplan.io.text import file_sha256
 from auvplan.io.vehicles import vehicle_file
 from auvplan.mission.assembly import integration_substeps
@@ -22,7 +23,9 @@ from auvplan.mission.preplan import PreplanStage
 from auvplan.mission.still_water import CurrentComparison
 from auvplan.navigation.prediction import ErrorPrediction
 from auvplan.planning import CircleObstacle, path_length
+from auvplan.record import PlanSummary, parse_summary
 from auvplan.terrain import LocalProjection
+from auvplan.vehicle import positions, top_speed
 
 
 def _record(record: Any) -> Any:
@@ -123,8 +126,32 @@ def _inputs(config: MissionConfig) -> dict[str, Any]:
     }
 
 
-def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> dict[str, Any]:
-    """Build the ``summary.json`` document of a mission run.
+def _max_current(result: MissionResult) -> float:
+    """Largest current speed [m/s] along every optimised plan of ``result`` (0: still water)."""
+    current = result.preplan.current
+    if current is None:
+        return 0.0
+    fastest = 0.0
+    for owner, plan in _plans(result):
+        assert owner.deconfliction is not None  # a plan exists only after stage 2
+        models = owner.deconfliction.layout.models
+        for model, states in zip(models, plan.states, strict=True):
+            north, east = positions(model, states).T
+            v_north, v_east = current.velocity(north, east, owner.deconfliction.time)
+            fastest = max(fastest, float(np.max(np.hypot(v_north, v_east))))
+    return fastest
+
+
+def _plans(result: MissionResult) -> list[tuple[MissionResult, OptimizedPlan]]:
+    """Each optimised plan of ``result`` with the run that made it (the paper's plan: its own)."""
+    plans = [(result, plan) for plan in (result.plan, result.energy_only) if plan is not None]
+    if result.paper is not None and result.paper.plan is not None:
+        plans.append((result.paper, result.paper.plan))
+    return plans
+
+
+def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> PlanSummary:
+    """Build the ``summary.json`` document of a mission run (without its ``digest``).
 
     ``warnings`` are the warnings logged during the run (one line each), kept under
     ``"warnings"``.
@@ -134,6 +161,8 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> d
     settle_s = config.navigation.settle
     maps = preplan.maps
     grid = preplan.bathymetry.geometry
+    stage2 = result.deconfliction
+    method = config.deconfliction.method if stage2 is None else stage2.coordination.method
     summary: dict[str, Any] = {
         "auvplan_version": __version__,
         "mission": None if config.source is None else str(config.source),
@@ -159,7 +188,7 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> d
         "fleet": {
             "safety_radius_m": config.fleet.safety_radius,
             "edge_model": config.planner.edge_model,
-            "deconfliction_method": str(config.deconfliction.method),
+            "deconfliction_method": str(method),
         },
         # the settings by field name, "full" propeller order as null (keys users already read)
         "solver": {**config.solver.model_dump(), "propeller_order": config.solver.harmonics},
@@ -185,11 +214,10 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> d
         if preplan.navigation is not None:
             vehicle["preplan"]["navigation"] = preplan.navigation[i].document()
         summary["vehicles"].append(vehicle)
-    stage2 = result.deconfliction
     if stage2 is not None:
         coordination = stage2.coordination
         n_substeps = integration_substeps(stage2.layout, stage2.dt)
-        summary["fleet"]["deconfliction_method"] = str(coordination.method)
+        summary["fleet"]["max_current_m_s"] = _max_current(result)
         summary["deconfliction"] = {
             "horizon_s": stage2.horizon,
             "integration": {"n_substeps": n_substeps, "substep_s": stage2.dt / n_substeps},
@@ -203,13 +231,20 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> d
             "certified_min_separation_m": coordination.certificate.min_separation,
             "certificate": dataclasses.asdict(coordination.certificate),
         }
-        for i, vehicle in enumerate(summary["vehicles"]):
+        models = stage2.layout.models
+        for i, (vehicle, model) in enumerate(zip(summary["vehicles"], models, strict=True)):
             vehicle["timing"] = {
                 "nominal_speed_m_s": stage2.cruise_speeds[i],
                 "arrival_time_s": coordination.arrival_times[i],
                 "delay_s": coordination.delays[i],
                 "time_law": {"t_s": coordination.time, "progress_m": coordination.progress[i]},
             }
+            vehicle.update(
+                type_name=model.vehicle.name,
+                state_names=model.state_names,
+                input_names=model.input_names,
+                top_speed_m_s=top_speed(model),
+            )
     if result.failure is not None:
         summary["optimization"] = {"plan_status": "FAILED", "verdict": result.failure}
     if result.plan is not None:
@@ -229,7 +264,7 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> d
         summary["current_comparison"] = _comparison_summary(
             result.current_comparison, preplan.names, settle_s
         )
-    return summary
+    return parse_summary(json_values(summary), source="the run's summary")
 
 
 def _comparison_summary(

@@ -17,6 +17,7 @@ import numpy as np
 import tomli_w
 
 from auvplan._typing import FloatArray
+from auvplan.record.files import MISSION_FILE
 from auvplan.scenarios import _terrain
 from auvplan.scenarios._plain import Feature
 from auvplan.terrain import BathymetryGrid
@@ -24,7 +25,6 @@ from auvplan.terrain import BathymetryGrid
 #: ``(largest horizon [s], dt_s)``: the step a user picks for a mission of that length.
 DT_BY_HORIZON: Final = ((900.0, 0.5), (3000.0, 1.0), (math.inf, 2.0))
 VEHICLE_NAMES: Final = ("blue", "green", "orange", "purple", "red", "cyan")
-MISSION_FILE: Final = "mission.toml"
 #: What a transit scenario's terrain holds beside the vehicles' lines (:attr:`Scenario.features`).
 FEATURE_CLASSES: Final = ("flat", "offset", "real")
 

@@ -40,6 +40,7 @@ from auvplan.errors import DataFormatError, InputError
 from auvplan.io.currents import read_current
 from auvplan.io.results import read_trajectories_csv
 from auvplan.ocean import CurrentField, UniformCurrent
+from auvplan.record.files import MAIN_PLAN, MAPS_FILE, PLAN_FILES, SUMMARY_FILE
 from auvplan.scenarios._model import ReferenceModel, step_defects
 from auvplan.scenarios._vehicle_file import read_reference_model
 
@@ -160,7 +161,7 @@ def check(
         No mission file is known.
     """
     output_dir = Path(output_dir)
-    summary = json.loads((output_dir / "summary.json").read_text(encoding="utf-8"))
+    summary = json.loads((output_dir / SUMMARY_FILE).read_text(encoding="utf-8"))
     if "optimization" not in summary:
         raise DataFormatError(f"{output_dir}/summary.json has no optimisation result")
     mission_path = Path(mission) if mission is not None else _recorded_mission(summary)
@@ -173,7 +174,7 @@ def check(
         )
         for name, vehicle in vehicles.items()
     }
-    tracks = read_trajectories(output_dir / "trajectories.csv", models)
+    tracks = read_trajectories(output_dir / PLAN_FILES[MAIN_PLAN].csv, models)
     names = list(tracks)
     failures: list[CheckFailure] = []
 
@@ -279,7 +280,7 @@ def _current(
         return UniformCurrent(float(table.get("north", 0.0)), float(table.get("east", 0.0)))
     from auvplan.io.bathymetry import read_bathymetry
 
-    grid = read_bathymetry(output_dir / "maps.nc")
+    grid = read_bathymetry(output_dir / MAPS_FILE)
     execution = document.get("mission", {})
     start = execution.get("start_time")
     return read_current(
@@ -342,7 +343,7 @@ def _local(position: Mapping[str, float], output_dir: Path) -> tuple[float, floa
         return float(position["north"]), float(position["east"])
     from auvplan.io.bathymetry import read_bathymetry
 
-    projection = read_bathymetry(output_dir / "maps.nc").projection
+    projection = read_bathymetry(output_dir / MAPS_FILE).projection
     if projection is None:
         raise DataFormatError(f"{output_dir}/maps.nc has no projection for a lat/lon obstacle")
     north, east = projection.to_local(np.array([position["lat"]]), np.array([position["lon"]]))

@@ -34,10 +34,10 @@ import numpy as np
 
 from auvplan.errors import InputError
 from auvplan.planning import CircleObstacle, PolygonObstacle
+from auvplan.record.files import MISSION_FILE
 from auvplan.scenarios import _poses, _terrain, transit
 from auvplan.scenarios._scenario import (
     DT_BY_HORIZON,
-    MISSION_FILE,
     VEHICLE_NAMES,
     Scenario,
     position_table,

@@ -1,9 +1,9 @@
 """Terrain-aided navigation of plan output folders: ``auvplan evaluate`` and ``sweep --evaluate``.
 
 :func:`evaluate_folder` flies every vehicle of every plan of an output folder of
-``plan``/``demo`` (or of a sweep's run, as :func:`auvplan.io.plan_folder.read_plan_folder`
-reads it) through the Monte-Carlo TAN simulator (:func:`auvplan.navigation.evaluate_plans`)
-and returns the evaluations with their ``navigation.json`` document.
+``plan``/``demo`` (or of a sweep's run), as :func:`auvplan.record.read_record` reads it,
+through the Monte-Carlo TAN simulator (:func:`auvplan.navigation.evaluate_plans`) and returns
+the evaluations with their ``navigation.json`` document.
 :func:`evaluate_run_folder` does that for one sweep run and writes ``navigation.json``
 (atomically) next to its plan; :func:`is_evaluated` tells whether a folder's
 ``navigation.json`` was made with the same settings, run count and seed, so a resumed sweep
@@ -16,11 +16,10 @@ import json
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Final
+from typing import Any
 
-from auvplan.errors import DataFormatError
+from auvplan.errors import DataFormatError, InputError
 from auvplan.io.output import staged_output_file
-from auvplan.io.plan_folder import TRAJECTORY_FILES, PlanFolder, read_plan_folder
 from auvplan.io.results import write_json
 from auvplan.io.text import read_json
 from auvplan.navigation import (
@@ -33,9 +32,8 @@ from auvplan.navigation import (
     settings_document,
 )
 from auvplan.navigation.evaluation import EvaluationProgress
-
-#: The evaluation's file in an output folder.
-NAVIGATION_FILE: Final = "navigation.json"
+from auvplan.record import PlanRecord, read_record
+from auvplan.record.files import MAIN_PLAN, NAVIGATION_FILE, PLAN_FILES
 
 
 @dataclass(frozen=True)
@@ -68,24 +66,29 @@ class FolderNavigation:
 
 
 def evaluate_folder(
-    folder: PlanFolder, options: NavigationOptions, *, progress: EvaluationProgress | None = None
+    record: PlanRecord, options: NavigationOptions, *, progress: EvaluationProgress | None = None
 ) -> FolderNavigation:
-    """Evaluate every plan of a read output folder (module notes); nothing is written.
+    """Evaluate every plan of an output folder's record (module notes); nothing is written.
 
     Raises
     ------
     InputError
-        If a track cannot be flown (too short, or it starts where the map has no depth).
+        If the record has no optimised plan, or a track cannot be flown (too short, or it
+        starts where the map has no depth).
     """
+    if not record.has_plan:
+        raise InputError(
+            f"the folder has no {PLAN_FILES[MAIN_PLAN].csv} (stage {record.summary.stage}): "
+            "run the plan to the full stage first"
+        )
     plans = {
         label: {
-            name: VehiclePlan(Track(v.time, v.positions, v.heading), v.energy)
-            for name, v in vehicles.items()
+            v.name: VehiclePlan(Track(v.time, v.positions, v.heading), v.energy) for v in vehicles
         }
-        for label, vehicles in folder.plans.items()
+        for label, vehicles in record.plans.items()
     }
     evaluations = evaluate_plans(
-        folder.bathymetry,
+        record.maps.bathymetry,
         plans,
         options.settings,
         n_runs=options.n_runs,
@@ -98,14 +101,20 @@ def evaluate_folder(
         options.settings,
         n_runs=options.n_runs,
         seed=options.seed,
-        plan_records={label: folder.plan_record(label) for label in plans},
+        plan_records={label: _outcome_document(record, label) for label in plans},
     )
     return FolderNavigation(evaluations, document)
 
 
+def _outcome_document(record: PlanRecord, label: str) -> dict[str, Any]:
+    """``summary.json``'s record of plan ``label`` as JSON values (empty without one)."""
+    outcome = record.summary.outcome(label)
+    return {} if outcome is None else outcome.model_dump(mode="json", exclude_unset=True)
+
+
 def has_plan(path: Path) -> bool:
     """Whether ``path`` holds a plan to fly (the optimised ``trajectories.csv``)."""
-    return (path / TRAJECTORY_FILES["terrain_aware"]).is_file()
+    return (path / PLAN_FILES[MAIN_PLAN].csv).is_file()
 
 
 def is_evaluated(path: Path, options: NavigationOptions) -> bool:
@@ -133,7 +142,7 @@ def evaluate_run_folder(path: Path, options: NavigationOptions) -> Path:
     InputError
         If a track cannot be flown (:func:`evaluate_folder`).
     """
-    document = evaluate_folder(read_plan_folder(path), options).document
+    document = evaluate_folder(read_record(path), options).document
     target = path / NAVIGATION_FILE
     with staged_output_file(target) as staging:
         write_json(document, staging)

@@ -205,8 +205,9 @@ def execute_run(run: SweepRun, folder: Path, options: RunOptions) -> RunRecord:
     from auvplan.io.output import staged_output_dir
     from auvplan.io.results import write_json
     from auvplan.mission.config import parse_mission
-    from auvplan.mission.outputs import write_mission_files
+    from auvplan.mission.outputs import plan_record
     from auvplan.mission.pipeline import Stage, run_mission
+    from auvplan.record import write_record
 
     started = time.perf_counter()
     with _collected_warnings(quiet=options.quiet_logs) as messages:
@@ -215,7 +216,7 @@ def execute_run(run: SweepRun, folder: Path, options: RunOptions) -> RunRecord:
             config = parse_mission(run.document, base_dir=run.base_dir, source=run.source)
             result = run_mission(config, stage=Stage(options.stage))
             with staged_output_dir(folder) as staging:
-                write_mission_files(result, staging)
+                write_record(plan_record(result), staging)
                 if options.write_figures is not None:
                     options.write_figures(result, staging)
                 document = run_record_document(

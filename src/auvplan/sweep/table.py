@@ -38,16 +38,16 @@ from typing import Any, Final
 import pandas as pd
 
 from auvplan import __version__
-from auvplan.errors import DataFormatError
+from auvplan.errors import AuvplanError, DataFormatError
 from auvplan.io.output import staged_output_file
 from auvplan.io.results import write_json
 from auvplan.io.text import read_json
-from auvplan.sweep.navigation import NAVIGATION_FILE
+from auvplan.record import PlanSummary, read_summary
+from auvplan.record.files import NAVIGATION_FILE
 from auvplan.sweep.spec import SweepRun
 
 #: The sweep's own record in each run folder.
 RUN_RECORD_FILE: Final = "sweep_run.json"
-SUMMARY_FILE: Final = "summary.json"
 TAN_COLUMN: Final = "tan_rmse_m"
 #: Further columns from ``navigation.json``: column -> key of ``plans.terrain_aware``.
 NAVIGATION_EXTRAS: Final = {
@@ -120,26 +120,27 @@ def run_record_document(
 def read_run_folder(folder: Path, run: SweepRun) -> RunRecord | None:
     """The record of ``run`` if ``folder`` holds it finished, else ``None`` (to be run).
 
-    Finished means ``summary.json`` and ``sweep_run.json`` are readable and the digest
-    matches ``run`` (same mission, values and stage).
+    Finished means ``summary.json`` (:func:`auvplan.record.read_summary`) and
+    ``sweep_run.json`` are readable and the digest matches ``run`` (same mission, values and
+    stage).
     """
     try:
         record = read_json(folder / RUN_RECORD_FILE, what="sweep run record")
-        summary = read_json(folder / SUMMARY_FILE, what="summary file")
-    except DataFormatError:
+        summary = read_summary(folder)
+    except AuvplanError:
         return None
     if not isinstance(record, dict) or record.get("digest") != run.digest:
         return None
     try:
         return _record_from(run, folder, record, summary)
-    except (KeyError, TypeError, ValueError):  # a summary of another layout: run again
+    except (KeyError, TypeError, ValueError):  # a run record of another layout: run again
         return None
 
 
 def _record_from(
-    run: SweepRun, folder: Path, record: dict[str, Any], summary: dict[str, Any]
+    run: SweepRun, folder: Path, record: dict[str, Any], summary: PlanSummary
 ) -> RunRecord:
-    optimization = summary.get("optimization")
+    optimization = summary.optimization
     common = {
         "folder": folder,
         "wall_s": float(record["wall_s"]),
@@ -147,21 +148,25 @@ def _record_from(
         "messages": tuple(record["messages"]),
     }
     if optimization is None:
-        return RunRecord(run.run_id, run.values, run.seed, STAGE_STATUS[summary["stage"]], **common)
-    status = str(optimization["plan_status"])
-    reason = "" if status == "CONVERGED" else " ".join(str(optimization["verdict"]).split())
-    vehicles = optimization.get("vehicles", {})
-    energy = {name: float(vehicle["energy_J"]) for name, vehicle in vehicles.items()}
-    information = [float(vehicle["mean_terrain_information"]) for vehicle in vehicles.values()]
+        return RunRecord(run.run_id, run.values, run.seed, STAGE_STATUS[summary.stage], **common)
+    status = optimization.plan_status
+    reason = "" if status == "CONVERGED" else " ".join(optimization.verdict.split())
+    vehicles = optimization.vehicles or {}
+    energy = {name: vehicle.energy_J for name, vehicle in vehicles.items()}
+    information = [
+        vehicle.mean_terrain_information
+        for vehicle in vehicles.values()
+        if vehicle.mean_terrain_information is not None
+    ]
     return RunRecord(
         run.run_id,
         run.values,
         run.seed,
         status,
         reason,
-        energy=float(optimization["total_energy_J"]) if energy else None,
+        energy=optimization.total_energy_J if energy else None,
         terrain_information=sum(information) / len(information) if information else None,
-        n_iter=optimization.get("n_iter"),
+        n_iter=optimization.n_iter,
         vehicle_energy=energy,
         **common,
     )

@@ -18,7 +18,7 @@ from matplotlib.patches import Circle, Polygon
 
 from auvplan._typing import FloatArray
 from auvplan.terrain.grid import BathymetryGrid
-from auvplan.vehicle import STATE_NAMES, VehicleModel
+from auvplan.vehicle import VehicleModel
 from auvplan.viz.geography import add_geographic_axes
 from auvplan.viz.style import lighter, pair_colors, plain_tick_labels, vehicle_colors
 
@@ -110,23 +110,19 @@ def plot_mission_paths(
 def plot_time_series(
     time: FloatArray,
     names: Sequence[str],
-    states: FloatArray | Sequence[FloatArray],
+    states: Sequence[FloatArray],
     power: FloatArray,
     *,
-    models: Sequence[VehicleModel] | None = None,
+    models: Sequence[VehicleModel],
 ) -> Figure:
     """Surge/sway speed, yaw rate, each vehicle's own actuators and electrical power.
 
-    ``states[i]`` has shape ``(n_t, n_x_i)``, the states of ``models[i]`` (default: MEDUSA's
-    :data:`~auvplan.vehicle.STATE_NAMES` for every vehicle); ``power`` ``(n_vehicles, n_t)``
-    [W]. Each propeller speed ``n_<thruster>`` [rev/s] is drawn and labelled with its
-    thruster's name; a fleet with control surfaces gets a panel of deflections [deg].
+    ``states[i]`` has shape ``(n_t, n_x_i)``, the states of ``models[i]``; ``power``
+    ``(n_vehicles, n_t)`` [W]. Each propeller speed ``n_<thruster>`` [rev/s] is drawn and
+    labelled with its thruster's name; a fleet with control surfaces gets a panel of
+    deflections [deg].
     """
-    layouts: list[tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]]
-    if models is None:
-        layouts = [(STATE_NAMES, STATE_NAMES[6:], ())] * len(names)
-    else:
-        layouts = [(m.state_names, m.thruster_states, m.surface_states) for m in models]
+    layouts = [(m.state_names, m.thruster_states, m.surface_states) for m in models]
     has_surfaces = any(surfaces for _, _, surfaces in layouts)
     panels = 5 if has_surfaces else 4
     figure = Figure(figsize=(9.0, 2.25 * panels), layout="constrained")

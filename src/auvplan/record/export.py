@@ -1,0 +1,83 @@
+"""A record's optimised plan as an :class:`~auvplan.export.plan.ExportPlan`.
+
+``auvplan export``, ``plan --export`` and :meth:`auvplan.MissionPlan.save` export from a
+:class:`~auvplan.record.PlanRecord`: the one read from the folder, or the one just written, so
+an export made later is the same as one made with the plan.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from auvplan.errors import InputError
+from auvplan.export.plan import CircleZone, ExportPlan, PolygonZone, VehicleTrack
+from auvplan.record.files import MAIN_PLAN
+from auvplan.record.folder import PlanRecord
+from auvplan.record.summary import Obstacle, PolygonObstacle
+
+logger = logging.getLogger(__name__)
+
+
+def export_plan(record: PlanRecord) -> ExportPlan:
+    """The optimised plan of ``record``, ready to export.
+
+    Raises
+    ------
+    InputError
+        If the record holds no optimised plan (``--stage`` stopped early or the optimiser
+        failed) or its terrain has no geographic reference (the synthetic bank): exports need
+        lat/lon.
+    """
+    summary = record.summary
+    outcome = summary.optimization
+    if not record.has_plan or outcome is None:
+        reason = f"the optimiser {outcome.plan_status}" if outcome else f"--stage {summary.stage}"
+        raise InputError(f"the record holds no optimised plan ({reason}); nothing to export")
+    projection = record.maps.bathymetry.projection
+    origin = summary.terrain.origin
+    if projection is None or origin.lat is None or origin.lon is None:
+        raise InputError(
+            f"the plan is on terrain without geographic reference ({summary.terrain.name}); "
+            "exports need lat/lon: plan on a georeferenced grid"
+        )
+    if outcome.plan_status != "CONVERGED":
+        logger.warning(
+            "the plan is %s (see summary.json): check it before a vehicle flies it",
+            outcome.plan_status,
+        )
+    tracks = []
+    for table in record.plans[MAIN_PLAN]:
+        north, east = table.state("north"), table.state("east")
+        lat, lon = projection.to_geographic(north, east)
+        tracks.append(VehicleTrack(table.name, table.time, north, east, lat, lon))
+    return ExportPlan(
+        tracks=tuple(tracks),
+        start_time=summary.start,
+        depth=record.depth,
+        origin_lat=origin.lat,
+        origin_lon=origin.lon,
+        capture_radius=summary.fleet.safety_radius_m,
+        zones=tuple(_zone(obstacle) for obstacle in summary.obstacles),
+    )
+
+
+def _zone(obstacle: Obstacle) -> CircleZone | PolygonZone:
+    """A keep-out zone from an obstacle of ``summary.json`` (lat/lon required)."""
+    if isinstance(obstacle, PolygonObstacle):
+        corners = [(v.lat, v.lon) for v in obstacle.vertices]
+        if any(lat is None or lon is None for lat, lon in corners):
+            raise InputError(f"obstacle {obstacle.name!r} has no lat/lon in summary.json")
+        return PolygonZone(
+            obstacle.name,
+            np.array([lat for lat, _ in corners], dtype=np.float64),
+            np.array([lon for _, lon in corners], dtype=np.float64),
+        )
+    center = obstacle.center
+    if center.lat is None or center.lon is None:
+        raise InputError(f"obstacle {obstacle.name!r} has no lat/lon in summary.json")
+    return CircleZone(obstacle.name, center.lat, center.lon, obstacle.radius_m)
+
+
+__all__ = ["export_plan"]
