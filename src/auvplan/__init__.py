@@ -26,9 +26,8 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
+from auvplan._version import __version__
 from auvplan.errors import AuvplanError, DataFormatError, InfeasibleError, InputError, SolverError
-
-__version__ = "0.1.0"
 
 #: Public name -> the module that defines it (imported on first access).
 _LAZY = {
