@@ -148,6 +148,24 @@ def _clash(tmp: Path) -> list[str]:
     return ["maps", "synthetic", "-o", str(tmp / "out")]
 
 
+def _plan_demo(edit: Callable[[str], str]) -> Callable[[Path], list[str]]:
+    """Arguments of ``auvplan plan --stage preplan`` on the demo mission as ``edit`` changes it."""
+
+    def build(tmp: Path) -> list[str]:
+        mission = _write(tmp / "m.toml", edit(DEMO))
+        return ["plan", mission, "-o", str(tmp / "out"), "--stage", "preplan", "--no-figures"]
+
+    return build
+
+
+#: A polygon over blue's start (10, 400) m in the demo mission.
+REEF = """
+[[obstacle]]
+name = "reef"
+polygon = [[0.0, 390.0], [0.0, 410.0], [20.0, 410.0], [20.0, 390.0]]
+"""
+
+
 #: case -> (argv builder, text the one stderr line must contain)
 CASES: dict[str, tuple[Callable[[Path], list[str]], str]] = {
     # 1. text files that are not UTF-8 or not parseable
@@ -204,6 +222,19 @@ CASES: dict[str, tuple[Callable[[Path], list[str]], str]] = {
     "xyz cut to a third": (
         _cut_to_a_third(_maps_on_xyz("cut.xyz", _survey(301))),  # 30-byte lines: cut in line 101
         "cut.xyz: line 101 has 1 column, need 3",
+    ),
+    # 3c. starts and goals
+    "polygon over a start": (
+        _plan_demo(lambda mission: mission + REEF),
+        "auvplan: error: blue: start (10, 400) m is inside obstacle 'reef'",
+    ),
+    "goal == start": (
+        _plan_demo(
+            lambda mission: mission.replace(
+                "goal = { north = 380.0, east = 450.0", "goal = { north = 10.0, east = 440.0"
+            )
+        ),
+        "green: goal (10, 440) m is 0 m from the start (10, 440) m; give a goal at least 1 mm",
     ),
     # 4. vehicle numbers outside their physical range
     "vehicle n_max = 1e-9": (

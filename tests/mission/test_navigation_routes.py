@@ -142,3 +142,19 @@ def test_a_route_around_a_polygon_is_tracked_even_when_it_buys_nothing(
     around = _preplan(mission, tmp_path / "polygon" / "out")
     assert around["budget_m"] is None
     assert around["tracked_by_the_optimiser"] is True
+
+
+def test_a_goal_in_the_start_cell_is_planned(tmp_path: Path) -> None:
+    """Navigation-aware routes of one cell (two points, one predicted error) crashed route_rms."""
+    from importlib import resources
+
+    demo = resources.files("auvplan").joinpath("data", "missions", "demo.toml").read_text()
+    mission = tmp_path / "m.toml"
+    mission.write_text(
+        demo.replace("goal = { north = 380.0, east = 450.0", "goal = { north = 12.0, east = 440.0")
+    )
+    out = tmp_path / "out"
+    assert main(["-q", "plan", str(mission), "-o", str(out), "--stage", "preplan"]) == 0
+    green = json.loads((out / "summary.json").read_text(encoding="utf-8"))["vehicles"][1]
+    assert green["name"] == "green"
+    assert green["preplan"]["navigation"]["route_predicted_rms_m"] > 0.0

@@ -86,14 +86,14 @@ def test_start_and_goal_in_one_cell(grid: GridGeometry, cost: np.ndarray) -> Non
             (50.0, 150.0),
             [CircleObstacle(50.0, 150.0, 3.0)],
             InfeasibleError,
-            "auv7: goal .* inside an obstacle",
+            "auv7: goal .* inside obstacle 'obstacle 0'$",
         ),
         (
             (0.0, 120.0),
             (50.0, 150.0),
             [CircleObstacle(50.0, 155.0, 3.0)],
             InfeasibleError,
-            "auv7: goal .* within the clearance 2 m",
+            "auv7: goal .* within the clearance 2 m of obstacle 'obstacle 0' \\(2 m from it;",
         ),
         (
             (0.0, 120.0),
@@ -117,6 +117,17 @@ def test_errors_name_vehicle_and_reason(
     with pytest.raises(error, match=match) as info:
         plan_route(cost, grid, start, goal, obstacles=obstacles, clearance=2.0, name="auv7")
     assert "\n" not in str(info.value)
+
+
+def test_a_polygon_over_the_start_is_named(grid: GridGeometry, cost: np.ndarray) -> None:
+    """One line naming the vehicle, the obstacle and the start (not the polygon's numpy repr)."""
+    reef = PolygonObstacle(np.array([[-5.0, 110.0], [-5.0, 130.0], [5.0, 130.0], [5.0, 110.0]]))
+    with pytest.raises(InfeasibleError) as info:
+        plan_route(
+            cost, grid, (0.0, 120.0), (50.0, 150.0), obstacles=[reef], obstacle_names=["reef"],
+            name="auv7",
+        )  # fmt: skip
+    assert str(info.value) == "auv7: start (0, 120) m is inside obstacle 'reef'"
 
 
 def test_shape_mismatch(grid: GridGeometry) -> None:

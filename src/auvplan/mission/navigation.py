@@ -220,6 +220,8 @@ def smallest_budget(floor: float) -> float:
 def route_rms(route: Route) -> float:
     """RMS of a route's predicted error [m], weighted by the length flown at each cell."""
     assert route.predicted_error is not None
+    if route.predicted_error.size == 1:  # start and goal in one cell: two points, one cell
+        return float(route.predicted_error[0])
     steps = np.hypot(*np.diff(route.points, axis=0).T)
     weights = np.concatenate([[0.0], steps]) + np.concatenate([steps, [0.0]])
     if not np.any(weights > 0.0):

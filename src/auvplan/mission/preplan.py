@@ -133,6 +133,26 @@ def resolve_obstacles(
     return tuple(obstacles), config.obstacle_names
 
 
+#: A goal closer than this [m] to its vehicle's start is that start: the path between them has
+#: no direction to smooth, to leave the start along or to time (a mission moves every vehicle).
+MIN_TRAVEL: Final = 1e-3
+
+
+def check_goals_leave_starts(names: tuple[str, ...], starts: FloatArray, goals: FloatArray) -> None:
+    """Raise InputError naming a vehicle whose goal lies within :data:`MIN_TRAVEL` of its start.
+
+    ``starts`` and ``goals`` have shape ``(n_vehicles, >= 2)``: north/east [m] first.
+    """
+    for name, start, goal in zip(names, starts, goals, strict=True):
+        distance = float(np.hypot(*(goal[:2] - start[:2])))
+        if distance < MIN_TRAVEL:
+            raise InputError(
+                f"{name}: goal ({goal[0]:g}, {goal[1]:g}) m is {distance:g} m from the start "
+                f"({start[0]:g}, {start[1]:g}) m; give a goal at least {MIN_TRAVEL * 1e3:g} mm "
+                "away from the start"
+            )
+
+
 def check_communication_ranges(
     comms: tuple[CommConfig, ...], names: tuple[str, ...], starts: FloatArray, goals: FloatArray
 ) -> None:
@@ -281,6 +301,7 @@ def plan_routes(
     goals: FloatArray,
     obstacles: tuple[Obstacle, ...],
     *,
+    obstacle_names: tuple[str, ...] = (),
     clearance: float,
     planner: PlannerConfig,
     turning_radii: FloatArray | None = None,
@@ -301,6 +322,7 @@ def plan_routes(
     water (``water_speeds`` [m/s]; :func:`~auvplan.mission.current.current_move_factor`), so
     routes ride favourable water and avoid moves the current bars.
     ``progress`` is told of each vehicle's search (stage ``"A*"``, one unit per vehicle).
+    ``obstacle_names`` label ``obstacles`` in the errors of a start or goal they cover.
     """
     geometry = maps.cost_geometry
     cell = min(geometry.spacing_north, geometry.spacing_east)
@@ -334,6 +356,7 @@ def plan_routes(
                         (float(starts[index, 0]), float(starts[index, 1])),
                         (float(goals[index, 0]), float(goals[index, 1])),
                         obstacles=obstacles + extra,
+                        obstacle_names=obstacle_names,
                         clearance=clearance,
                         edge_model=edge_model,
                         move_factor=factor,
@@ -408,6 +431,7 @@ def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progre
         [(*resolve_position(v.goal, bathymetry, f"vehicle {v.name} goal"), v.goal.psi)
          for v in config.vehicles]
     )  # fmt: skip
+    check_goals_leave_starts(names, starts, goals)
     check_endpoint_clearance(names, starts[:, :2], goals[:, :2], 2.0 * config.fleet.safety_radius)
     check_communication_ranges(config.comms, names, starts, goals)
     obstacles, obstacle_names = resolve_obstacles(config, bathymetry)
@@ -422,7 +446,7 @@ def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progre
             weight=config.weights.navigation,
         )  # fmt: skip
     routes, paths, choices = plan_routes(
-        maps, names, starts, goals, obstacles,
+        maps, names, starts, goals, obstacles, obstacle_names=obstacle_names,
         clearance=config.fleet.safety_radius, planner=config.planner,
         turning_radii=np.array([turning_radius(model) for model in models]),
         start_courses=courses_over_ground(starts, start_speeds, current),

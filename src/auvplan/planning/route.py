@@ -158,6 +158,7 @@ def plan_route(
     goal: tuple[float, float],
     *,
     obstacles: Sequence[CircleObstacle | PolygonObstacle] = (),
+    obstacle_names: Sequence[str] = (),
     clearance: float = 0.0,
     edge_model: EdgeModel = EdgeModel.PAPER,
     move_factor: FloatArray | None = None,
@@ -177,6 +178,9 @@ def plan_route(
         ``(north, east)`` [m] in the grid's world frame.
     obstacles : sequence of CircleObstacle or PolygonObstacle
         Impassable regions; cells within ``clearance`` of them are blocked.
+    obstacle_names : sequence of str
+        Labels of the first obstacles in error messages; the others are ``"obstacle K"``
+        (``K`` their index in ``obstacles``).
     clearance : float
         Distance [m] kept from obstacles, ``>= 0``.
     edge_model : EdgeModel
@@ -221,7 +225,7 @@ def plan_route(
     cells = {}
     for label, point in (("start", start), ("goal", goal)):
         cells[label] = _endpoint_cell(
-            label, point, geometry, blocked_nan, mask, obstacles, clearance, name
+            label, point, geometry, blocked_nan, mask, obstacles, obstacle_names, clearance, name
         )
     try:
         problem = PlanningProblem(
@@ -288,10 +292,14 @@ def _endpoint_cell(
     blocked_nan: BoolArray,
     mask: BoolArray,
     obstacles: Sequence[CircleObstacle | PolygonObstacle],
+    obstacle_names: Sequence[str],
     clearance: float,
     name: str,
 ) -> tuple[int, int]:
-    """Cell of a start/goal point, or a one-line error naming the vehicle and the reason."""
+    """Cell of a start/goal point, or a one-line error naming the vehicle and the reason.
+
+    When obstacles block the point's cell, the error names the nearest of them.
+    """
     north, east = float(point[0]), float(point[1])
     where = f"{name}: {label} ({north:g}, {east:g}) m"
     if not (np.isfinite(north) and np.isfinite(east)):
@@ -308,11 +316,16 @@ def _endpoint_cell(
     if blocked_nan[row, col]:
         raise InfeasibleError(f"{where} is on land or a no-data cell (cell [{row}, {col}])")
     if mask[row, col]:
-        for obstacle in obstacles:
-            if float(distance_to_obstacle(obstacle, np.array(north), np.array(east))) < 0.0:
-                raise InfeasibleError(f"{where} is inside an obstacle ({obstacle})")
+        distances = [
+            float(distance_to_obstacle(obstacle, np.array(north), np.array(east)))
+            for obstacle in obstacles
+        ]
+        nearest = int(np.argmin(distances))
+        label = obstacle_names[nearest] if nearest < len(obstacle_names) else f"obstacle {nearest}"
+        if distances[nearest] < 0.0:
+            raise InfeasibleError(f"{where} is inside obstacle {label!r}")
         raise InfeasibleError(
-            f"{where} is within the clearance {clearance:g} m of an obstacle "
-            f"(cell [{row}, {col}] is blocked)"
+            f"{where} is within the clearance {clearance:g} m of obstacle {label!r} "
+            f"({distances[nearest]:.3g} m from it; cell [{row}, {col}] is blocked)"
         )
     return row, col
