@@ -183,15 +183,33 @@ def test_qgc_plans_for_ardusub(export_plan: ExportPlan) -> None:
             assert sorted(map(tuple, vertices)) == sorted(zip(zone.lat, zone.lon, strict=True))
 
 
+#: Field names of IMC.xml v5.4.31 (LSTS/imc): the header and the messages the export writes.
+IMC_FIELDS = {
+    "PlanSpecification": (
+        *("mgid", "timestamp", "src", "src_ent", "dst", "dst_ent"),  # header, less sync/size
+        *("plan_id", "description", "vnamespace", "variables", "start_man_id", "maneuvers"),
+        *("transitions", "start_actions", "end_actions"),
+    ),
+    "FollowTrajectory": (
+        *("timeout", "lat", "lon", "z", "z_units", "speed", "speed_units", "points", "custom"),
+    ),
+    "TrajectoryPoint": ("x", "y", "z", "t"),
+}
+
+
 def test_imc_follow_trajectory_plans(export_plan: ExportPlan) -> None:
     files = _render(export_plan, "imc")
     stems = file_stems([track.name for track in export_plan.tracks])
     for stem, waypoints in zip(stems, _fleet(export_plan), strict=True):
         document = validate_json(files[f"{stem}.imc.json"], "imc_plan")
         assert document["plan_id"] == waypoints.name
+        assert document["timestamp"] == export_plan.start_time.timestamp()
+        assert set(IMC_FIELDS["PlanSpecification"]) <= set(document)
         (maneuver,) = document["maneuvers"]
         assert maneuver["maneuver_id"] == document["start_man_id"]
         data = maneuver["data"]
+        assert set(data) == {"abbrev", *IMC_FIELDS["FollowTrajectory"]}
+        assert all(set(p) == {"abbrev", *IMC_FIELDS["TrajectoryPoint"]} for p in data["points"])
         lat_0, lon_0 = math.degrees(data["lat"]), math.degrees(data["lon"])
         assert (data["z"], data["z_units"], data["speed_units"]) == (export_plan.depth, 1, 0)
         points = data["points"]

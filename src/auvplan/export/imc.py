@@ -7,6 +7,14 @@ east, ``z`` down offsets [m] from the start point and ``t``, the time [s] after 
 point, so that the vehicle follows the time law, not only the path. The offsets are taken in a
 transverse Mercator tangent at the start point. The JSON layout is the one of LSTS's Neptus
 integration (``abbrev`` names each message).
+
+The top-level message carries IMC's header (``IMC.xml`` v5.4.31 ``<header>``): ``mgid`` 551
+(PlanSpecification), ``timestamp`` (the plan's start, seconds since 1970 UTC) and the
+"unknown" addresses ``src``/``dst`` 0xFFFF and entities ``src_ent``/``dst_ent`` 0xFF, which
+the sending console replaces with its own and the vehicle's. With an IMC library the message is
+serialised as is and sent to a DUNE vehicle in a ``PlanDB`` (``op`` SET) to store it, or a
+``PlanControl`` (``op`` START) to run it; ``sync`` and ``size`` belong to the binary encoding
+and are not written.
 """
 
 from __future__ import annotations
@@ -22,6 +30,11 @@ from auvplan.export.plan import ExportPlan
 from auvplan.export.waypoints import Waypoints, by_file_stem
 from auvplan.terrain.projection import LocalProjection
 
+#: IMC message ids (``IMC.xml``).
+PLAN_SPECIFICATION_ID: Final = 551
+#: IMC's "unknown" system address and entity id: the sender fills in its own.
+UNKNOWN_ADDRESS: Final = 0xFFFF
+UNKNOWN_ENTITY: Final = 0xFF
 Z_UNITS_DEPTH: Final = 1
 SPEED_UNITS_METERS_PS: Final = 0
 #: Manoeuvre timeout as a multiple of the trajectory's duration (IMC field ``timeout``, uint16).
@@ -58,8 +71,16 @@ def plan_specification(plan: ExportPlan, waypoints: Waypoints) -> dict[str, Any]
     }
     return {
         "abbrev": "PlanSpecification",
+        "mgid": PLAN_SPECIFICATION_ID,
+        "timestamp": plan.start_time.timestamp(),
+        "src": UNKNOWN_ADDRESS,
+        "src_ent": UNKNOWN_ENTITY,
+        "dst": UNKNOWN_ADDRESS,
+        "dst_ent": UNKNOWN_ENTITY,
         "plan_id": waypoints.name,
         "description": f"auvplan plan for {waypoints.name}, starting {plan.start_time.isoformat()}",
+        "vnamespace": "",
+        "variables": [],
         "start_man_id": "follow_trajectory",
         "maneuvers": [
             {
