@@ -244,3 +244,20 @@ def test_monterey_example_exports_everything(monterey_folder: Path, tmp_path: Pa
     for vehicle in ("blue", "green"):
         assert {f"{vehicle}.bhv", f"{vehicle}.plan", f"{vehicle}.imc.json"} <= names
     assert {"origin.moos", "trajectories.gpx", "trajectories.kml", "trajectories.geojson"} <= names
+
+
+def test_export_writes_moos_in_the_frame_asked(planned_folder: Path, tmp_path: Path) -> None:
+    """``--moos-frame local`` for LatLong2LocalGrid builds; UTM by default; anything else exit 2."""
+    points = {}
+    for frame in ("utm", "local"):
+        out = tmp_path / frame
+        extra = [] if frame == "utm" else ["--moos-frame", frame]
+        arguments = ["-q", "export", str(planned_folder), "--format", "moos", "-o", str(out)]
+        assert main([*arguments, *extra]) == 0
+        text = (out / "blue.bhv").read_text()
+        assert ("LatLong2LocalUTM" in text) == (frame == "utm")
+        points[frame] = [line for line in text.splitlines() if "points" in line]
+    assert points["utm"] != points["local"]
+    with pytest.raises(SystemExit) as stopped:
+        main(["-q", "export", str(planned_folder), "--format", "moos", "--moos-frame", "grid"])
+    assert stopped.value.code == 2

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from auvplan._figures import DEFAULT_DPI
-from auvplan.export import DEFAULT_TOLERANCE_M, write_exports
+from auvplan.export import DEFAULT_TOLERANCE_M, MoosFrame, write_exports
 from auvplan.io.output import staged_output_dir
 from auvplan.mission.pipeline import MissionResult
 from auvplan.record import PlanRecord, export_plan, write_record
@@ -38,6 +38,7 @@ def write_output_folder(
     dpi: int = DEFAULT_DPI,
     exports: Sequence[str] = (),
     tolerance: float = DEFAULT_TOLERANCE_M,
+    moos_frame: MoosFrame = "utm",
     companion: Companion | None = None,
 ) -> list[Path]:
     """Write the output folder of ``result`` into ``target`` (module notes).
@@ -62,6 +63,8 @@ def write_output_folder(
         ignored without an optimised plan.
     tolerance : float
         Waypoint tolerance of the exports [m].
+    moos_frame : {"utm", "local"}
+        Frame of the MOOS-IvP points (:mod:`auvplan.export.moos`).
     companion : Companion, optional
         Draws half the figures in a second process (:mod:`auvplan.api.companion`).
 
@@ -78,7 +81,11 @@ def write_output_folder(
         written = write_record(record, staging)
         if exports and record.has_plan:
             written += write_exports(
-                export_plan(record), staging / EXPORT_FOLDER, exports, tolerance=tolerance
+                export_plan(record),
+                staging / EXPORT_FOLDER,
+                exports,
+                tolerance=tolerance,
+                moos_frame=moos_frame,
             )
         for stem, figure in rendered.items():
             path = staging / f"{stem}.{figure.figure_format}"

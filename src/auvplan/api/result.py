@@ -26,7 +26,7 @@ import numpy as np
 
 from auvplan._figures import DEFAULT_DPI
 from auvplan.errors import InputError
-from auvplan.export import DEFAULT_TOLERANCE_M
+from auvplan.export import DEFAULT_TOLERANCE_M, MoosFrame
 from auvplan.io.output import staged_output_dir
 from auvplan.mission.config import MissionConfig, load_mission, parse_mission
 from auvplan.mission.outputs import plan_record
@@ -203,6 +203,7 @@ class MissionPlan:
         dpi: int = DEFAULT_DPI,
         exports: Sequence[str] = (),
         tolerance_m: float = DEFAULT_TOLERANCE_M,
+        moos_frame: MoosFrame = "utm",
         companion: Companion | None = None,
     ) -> list[Path]:
         """Write the output folder of ``auvplan plan`` into ``directory``; returns the files.
@@ -210,7 +211,7 @@ class MissionPlan:
         ``summary.json``, ``mission.toml``, ``maps.nc``, the trajectories (CSV and NetCDF),
         the figures in ``figure_format`` (``png``, ``svg`` or ``pdf``) at ``dpi``, the
         exports (``moos``, ``qgc``, ``imc``, ``gpx``, ``kml``, ``geojson``) into
-        ``directory/export`` and ``report.html``; all-or-nothing
+        ``directory/export`` (MOOS-IvP points in ``moos_frame``) and ``report.html``; all-or-nothing
         (:func:`auvplan.api.folder.write_output_folder`). A plan loaded from a folder is
         copied as it is (the options apply to a plan made in this session). A ``companion``
         (:mod:`auvplan.api.companion`) draws half the figures.
@@ -229,7 +230,7 @@ class MissionPlan:
             self._result, self._record, target, figures=figures,
             figure_format=figure_format, dpi=dpi,
             exports=parse_formats(",".join(exports)) if exports else (), tolerance=tolerance_m,
-            companion=companion,
+            moos_frame=moos_frame, companion=companion,
         )  # fmt: skip
 
     def _repr_html_(self) -> str:

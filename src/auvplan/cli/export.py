@@ -1,4 +1,4 @@
-"""``auvplan export OUTPUT_DIR --format FORMAT,... [-o EXPORT_DIR] [--tolerance-m X]``."""
+"""``auvplan export OUTPUT_DIR --format FORMAT,... [-o DIR] [--tolerance-m X] [--moos-frame F]``."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from auvplan.export import DEFAULT_TOLERANCE_M, FORMATS
+from auvplan.export import DEFAULT_TOLERANCE_M, FORMATS, MOOS_FRAMES
 
 
 def tolerance_m(text: str) -> float:
@@ -40,6 +40,13 @@ def add_export_options(parser: argparse.ArgumentParser, *, required: bool) -> No
         help="largest distance between the exported waypoints, flown at their leg speeds, and "
         f"the plan at any time [m] (default {DEFAULT_TOLERANCE_M:g})",
     )
+    parser.add_argument(
+        "--moos-frame",
+        choices=MOOS_FRAMES,
+        default=MOOS_FRAMES[0],
+        help="frame of the MOOS-IvP points: utm (MOOS-IvP's default build, -DUSE_UTM=ON) or "
+        "local (a build with LatLong2LocalGrid) (default utm)",
+    )
 
 
 def register(subparsers: Any) -> None:
@@ -69,7 +76,9 @@ def run_export(args: argparse.Namespace) -> int:
     plan = export_plan(read_record(args.folder))
     target = args.output if args.output is not None else args.folder / EXPORT_FOLDER
     with staged_output_dir(target) as staging:
-        written = write_exports(plan, staging, formats, tolerance=args.tolerance_m)
+        written = write_exports(
+            plan, staging, formats, tolerance=args.tolerance_m, moos_frame=args.moos_frame
+        )
     if not args.quiet:
         print("wrote: " + ", ".join(str(target / path.name) for path in written), file=sys.stdout)
     return 0

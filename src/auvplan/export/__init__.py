@@ -25,17 +25,19 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Final
+from typing import TYPE_CHECKING, Final, Literal, get_args
 
 from auvplan.errors import InputError
 
 if TYPE_CHECKING:
-    from auvplan.export.moos import MoosFrame
     from auvplan.export.plan import ExportPlan
     from auvplan.export.waypoints import Waypoints
 
 #: The export formats, each rendered by the module of the same name in this package.
 FORMATS: Final = ("moos", "qgc", "imc", "gpx", "kml", "geojson")
+#: Frames of the MOOS-IvP points (:mod:`auvplan.export.moos`); the first is the default.
+MoosFrame = Literal["utm", "local"]
+MOOS_FRAMES: Final = get_args(MoosFrame)
 #: Default waypoint tolerance [m] (see :func:`auvplan.export.waypoints.thin_track`).
 DEFAULT_TOLERANCE_M: Final = 1.0
 
@@ -59,6 +61,12 @@ def parse_formats(text: str) -> tuple[str, ...]:
         shown = repr(unknown[0]) if unknown else "none given"
         raise InputError(f"unknown export format {shown} (choose from {', '.join(FORMATS)})")
     return tuple(dict.fromkeys(names))
+
+
+def check_moos_frame(frame: str) -> None:
+    """Raise InputError unless ``frame`` is one of :data:`MOOS_FRAMES`."""
+    if frame not in MOOS_FRAMES:
+        raise InputError(f"MOOS frame {frame!r} is not one of {', '.join(MOOS_FRAMES)}")
 
 
 def render_exports(
@@ -89,8 +97,7 @@ def render_exports(
     from auvplan.export import geojson, gpx, imc, kml, moos, qgc
     from auvplan.export.waypoints import thin_track
 
-    if moos_frame not in moos.MOOS_FRAMES:
-        raise InputError(f"MOOS frame {moos_frame!r} is not one of {', '.join(moos.MOOS_FRAMES)}")
+    check_moos_frame(moos_frame)
     renderers: dict[str, Callable[[ExportPlan, list[Waypoints]], dict[str, str]]] = {
         "moos": functools.partial(moos.render, frame=moos_frame),
         "qgc": qgc.render,
@@ -121,4 +128,13 @@ def write_exports(
     return write_text_files(directory, files)
 
 
-__all__ = ["DEFAULT_TOLERANCE_M", "FORMATS", "parse_formats", "render_exports", "write_exports"]
+__all__ = [
+    "DEFAULT_TOLERANCE_M",
+    "FORMATS",
+    "MOOS_FRAMES",
+    "MoosFrame",
+    "check_moos_frame",
+    "parse_formats",
+    "render_exports",
+    "write_exports",
+]

@@ -29,21 +29,18 @@ The capture radius is the fleet's safety radius ``r_c``, the slip radius three t
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Final, Literal
+from typing import Final
 
 import numpy as np
 from pyproj import CRS, Transformer
 
 from auvplan import __version__
 from auvplan._typing import FloatArray
-from auvplan.errors import InputError
+from auvplan.export import MoosFrame, check_moos_frame
 from auvplan.export.plan import ExportPlan, utc_text
 from auvplan.export.waypoints import Waypoints, by_file_stem
 from auvplan.terrain.projection import GEOGRAPHIC_CRS, LocalProjection
 
-#: The frames of the ``points`` (module notes); the first is the default.
-MOOS_FRAMES: Final = ("utm", "local")
-MoosFrame = Literal["utm", "local"]
 #: Slip radius as a multiple of the capture radius.
 SLIP_FACTOR: Final = 3.0
 #: The helm variable that chains the legs.
@@ -75,8 +72,7 @@ def moos_xy(
     if frame == "local":
         north, east = LocalProjection(plan.origin_lat, plan.origin_lon).to_local(lat, lon)
         return east, north
-    if frame != "utm":
-        raise InputError(f"MOOS frame {frame!r} is not one of {', '.join(MOOS_FRAMES)}")
+    check_moos_frame(frame)
     to_utm = Transformer.from_crs(
         GEOGRAPHIC_CRS, utm_crs(plan.origin_lat, plan.origin_lon), always_xy=True
     )
@@ -201,9 +197,7 @@ def render(
 
 __all__ = [
     "LEG_VARIABLE",
-    "MOOS_FRAMES",
     "SLIP_FACTOR",
-    "MoosFrame",
     "behavior_file",
     "moos_xy",
     "render",
