@@ -27,4 +27,15 @@ class SolverError(AuvplanError):
     """A numerical solver failed in a way the user must know about."""
 
 
-__all__ = ["AuvplanError", "DataFormatError", "InfeasibleError", "InputError", "SolverError"]
+class WriteError(AuvplanError):
+    """A file cannot be written: full disk, file too large, read-only file system (names it)."""
+
+
+__all__ = [
+    "AuvplanError",
+    "DataFormatError",
+    "InfeasibleError",
+    "InputError",
+    "SolverError",
+    "WriteError",
+]

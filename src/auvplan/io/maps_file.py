@@ -30,6 +30,7 @@ import numpy as np
 from auvplan import __version__
 from auvplan.errors import DataFormatError
 from auvplan.io._gridded import grid_mapping_crs
+from auvplan.io.writing import writing
 from auvplan.terrain.grid import BathymetryGrid, GridGeometry
 from auvplan.terrain.maps import MapParameters, TerrainMaps
 from auvplan.terrain.projection import LocalProjection
@@ -138,7 +139,8 @@ def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
         encoding[str(name)]["_FillValue"] = None
     if GRID_MAPPING in dataset.coords:
         encoding[GRID_MAPPING]["dtype"] = "int32"  # CF 1.8 has no 64-bit integers
-    dataset.to_netcdf(path, format="NETCDF4", engine="netcdf4", encoding=encoding)
+    with writing(Path(path)):
+        dataset.to_netcdf(path, format="NETCDF4", engine="netcdf4", encoding=encoding)
     return path
 
 

@@ -25,6 +25,7 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError, InputError
+from auvplan.io.writing import writing
 from auvplan.terrain.projection import LocalProjection
 from auvplan.vehicle import INPUT_NAMES, STATE_NAMES
 
@@ -36,7 +37,8 @@ DESIRED_COLUMNS = ("vehicle", "t", "north", "east", "psi")
 def write_json(data: Mapping[str, Any], path: Path) -> None:
     """Write ``data`` as indented JSON; numpy scalars/arrays become numbers/lists, NaN -> null."""
     text = json.dumps(json_values(data), indent=2, allow_nan=False)
-    path.write_text(text + "\n", encoding="utf-8")
+    with writing(path):
+        path.write_text(text + "\n", encoding="utf-8")
 
 
 def json_values(value: Any) -> Any:
@@ -69,7 +71,8 @@ def write_text_files(directory: Path, files: Mapping[str, str]) -> list[Path]:
     written = []
     for name, text in files.items():
         path = directory / name
-        path.write_text(text, encoding="utf-8")
+        with writing(path):
+            path.write_text(text, encoding="utf-8")
         written.append(path)
     return written
 
@@ -213,7 +216,7 @@ def write_desired_csv(
     path: Path, names: Sequence[str], time: FloatArray, poses: Sequence[FloatArray]
 ) -> None:
     """Write ``desired.csv``; ``poses[i]`` ``(n_t, 3)`` is north, east [m], psi [rad]."""
-    with path.open("w", newline="", encoding="utf-8") as handle:
+    with writing(path), path.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         writer.writerow(DESIRED_COLUMNS)
         for index, name in enumerate(names):

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from auvplan.errors import DataFormatError
+from auvplan.io.writing import writing
 
 
 def read_text(path: Path | Traversable, *, what: str) -> str:
@@ -121,7 +122,8 @@ def write_toml(document: Mapping[str, Any], path: Path, *, header: str = "") -> 
     import tomli_w
 
     comments = "".join(f"# {line}\n" for line in header.splitlines())
-    path.write_text(comments + tomli_w.dumps(document), encoding="utf-8")
+    with writing(path):
+        path.write_text(comments + tomli_w.dumps(document), encoding="utf-8")
 
 
 def file_sha256(path: Path | Traversable) -> str:

@@ -34,6 +34,7 @@ from auvplan.io.results import (
     write_trajectories_csv,
 )
 from auvplan.io.text import read_json, read_toml, write_toml
+from auvplan.io.writing import writing
 from auvplan.record.files import (
     DESIRED_FILE,
     MAIN_PLAN,
@@ -197,8 +198,10 @@ def write_record(record: PlanRecord, directory: Path) -> list[Path]:
     for label, tables in record.plans.items():
         files = PLAN_FILES[label]
         csv_path, netcdf_path = directory / files.csv, directory / files.netcdf
-        csv_path.write_text(trajectories_csv_text(tables), encoding="utf-8", newline="")
-        trajectories_dataset_of(record, label).to_netcdf(netcdf_path)
+        with writing(csv_path):
+            csv_path.write_text(trajectories_csv_text(tables), encoding="utf-8", newline="")
+        with writing(netcdf_path):
+            trajectories_dataset_of(record, label).to_netcdf(netcdf_path)
         written += [csv_path, netcdf_path]
     return written
 

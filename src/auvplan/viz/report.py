@@ -14,6 +14,7 @@ from matplotlib.figure import Figure
 from auvplan._figures import DEFAULT_DPI, FIGURE_FORMATS
 from auvplan.errors import InputError
 from auvplan.interrupts import checkpoint
+from auvplan.io.writing import writing
 from auvplan.mission.evaluation import OptimizedPlan
 from auvplan.mission.navigation import budget_of
 from auvplan.mission.pipeline import MissionResult
@@ -230,6 +231,7 @@ def save_mission_figures(
         result, figure_format=figure_format, dpi=dpi
     ).items():
         path = directory / f"{stem}.{figure_format}"
-        path.write_bytes(rendered.data)
+        with writing(path):
+            path.write_bytes(rendered.data)
         written.append(path)
     return written
