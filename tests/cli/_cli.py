@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import pytest
 
 from auvplan.cli.main import main
@@ -15,6 +18,21 @@ def run_cli(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, s
         code = int(exit_.code or 0)
     captured = capsys.readouterr()
     return code, captured.out, captured.err
+
+
+def run_cli_process(argv: list[str], *, timeout: float) -> tuple[int, str]:
+    """``auvplan argv`` as a process killed after ``timeout`` [s]: ``(exit code, stderr)``.
+
+    For what might hang: ``subprocess.TimeoutExpired`` fails the test in bounded time.
+    """
+    process = subprocess.run(
+        [sys.executable, "-m", "auvplan.cli.main", *argv],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        check=False,
+    )
+    return process.returncode, process.stderr
 
 
 def one_error_line(err: str) -> str:

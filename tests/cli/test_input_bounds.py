@@ -8,14 +8,12 @@ bounded time.
 
 from __future__ import annotations
 
-import subprocess
-import sys
 import time
 from importlib import resources
 from pathlib import Path
 
 import pytest
-from _cli import one_error_line, run_cli
+from _cli import one_error_line, run_cli, run_cli_process
 
 DEMO = resources.files("auvplan").joinpath("data", "missions", "demo.toml").read_text()
 
@@ -26,18 +24,6 @@ def _tree(root: Path) -> dict[str, bytes | None]:
         str(path.relative_to(root)): path.read_bytes() if path.is_file() else None
         for path in sorted(root.rglob("*"))
     }
-
-
-def _auvplan(argv: list[str], *, timeout: float) -> tuple[int, str]:
-    """``auvplan argv`` as a process killed after ``timeout`` [s]: exit code and stderr."""
-    process = subprocess.run(
-        [sys.executable, "-m", "auvplan.cli.main", *argv],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        check=False,
-    )
-    return process.returncode, process.stderr
 
 
 @pytest.fixture(scope="module")
@@ -55,7 +41,7 @@ def plan_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
     )
     folder = root / "out"
     command = ["-q", "plan", str(mission), "-o", str(folder), "--jobs", "1", "--no-figures"]
-    assert _auvplan(command, timeout=300)[0] == 0
+    assert run_cli_process(command, timeout=300)[0] == 0
     return folder
 
 
@@ -102,7 +88,7 @@ def test_evaluate_refuses_what_used_to_hang_in_bounded_time(
 ) -> None:
     """Runs x particles x updates per run are checked from the bounds before any run."""
     before = _tree(plan_folder.parent)
-    code, err = _auvplan(["evaluate", str(plan_folder), "--no-figure", *flags], timeout=60)
+    code, err = run_cli_process(["evaluate", str(plan_folder), "--no-figure", *flags], timeout=60)
     assert code == 2
     assert fragment in one_error_line(err)
     assert _tree(plan_folder.parent) == before

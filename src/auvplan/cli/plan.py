@@ -52,7 +52,7 @@ def _add_common(parser: argparse.ArgumentParser, *, default_output: Path | None)
     parser.add_argument(
         "--jobs",
         type=int,
-        default=_default_jobs(),
+        default=None,
         help="processes: 2 (the default on 2+ cores) compiles the optimiser's kernels on a "
         "first run and draws half the figures in a second process; 1 uses this one only "
         "(default also from $AUVPLAN_JOBS)",
@@ -81,11 +81,22 @@ def _add_common(parser: argparse.ArgumentParser, *, default_output: Path | None)
     add_figure_options(parser)
 
 
-def _default_jobs() -> int:
-    """``$AUVPLAN_JOBS`` when set (checked by :func:`_run`), else 2 with 2+ cores, else 1."""
-    given = os.environ.get("AUVPLAN_JOBS")
-    if given:
-        return int(given) if given.isdigit() else -1
+def _jobs(given: int | None) -> int:
+    """The processes: ``--jobs``, else ``$AUVPLAN_JOBS``, else 2 with 2+ cores, else 1.
+
+    Raises
+    ------
+    InputError
+        If the number given (or the variable's text, quoted) is not 1 or 2.
+    """
+    from auvplan.errors import InputError
+
+    text = os.environ.get("AUVPLAN_JOBS", "") if given is None else str(given)
+    if text in ("1", "2"):
+        return int(text)
+    if text:
+        shown = text if given is not None else repr(text)
+        raise InputError(f"--jobs (or $AUVPLAN_JOBS) must be 1 or 2, got {shown}")
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     return 2 if (cores or 1) >= 2 else 1
 
@@ -125,13 +136,11 @@ def _export_formats(config: Any, args: argparse.Namespace) -> tuple[str, ...]:
 def _run(config: Any, args: argparse.Namespace) -> int:
     from auvplan.api import plan
     from auvplan.api.companion import Companion
-    from auvplan.errors import InputError
     from auvplan.export import DEFAULT_TOLERANCE_M
 
     formats = _export_formats(config, args)
-    if args.jobs not in (1, 2):
-        raise InputError(f"--jobs (or $AUVPLAN_JOBS) must be 1 or 2, got {args.jobs}")
-    with Companion() if args.jobs == 2 else nullcontext() as companion:
+    jobs = _jobs(args.jobs)
+    with Companion() if jobs == 2 else nullcontext() as companion:
         if companion is not None and not args.no_figures:
             companion.start()  # its imports overlap the planning
         mission_plan = plan(

@@ -121,10 +121,13 @@ def run(args: argparse.Namespace) -> int:
     seeds: tuple[int | None, ...] = (None,) if args.seeds is None else parse_seeds(args.seeds)
     base_of, scenario_files = _bases(args, seeds, scenarios=scenarios)
     axes, runs = build_runs(args.vary, seeds, base_of, stage=args.stage)
-    for base, scenario in scenario_files:  # only once every run is valid
-        scenario.write(base.base_dir)
+
+    def write_scenarios() -> None:  # only once every run is valid and the cluster answers
+        for base, scenario in scenario_files:
+            scenario.write(base.base_dir)
+
     started = time.perf_counter()
-    records = _run(args, runs, navigation)
+    records = _run(args, runs, navigation, on_ready=write_scenarios)
     return _finish(args, axes, records, seeds, time.perf_counter() - started, navigation)
 
 
@@ -155,7 +158,11 @@ def _navigation(args: argparse.Namespace) -> NavigationOptions | None:
 
 
 def _run(
-    args: argparse.Namespace, runs: Sequence[SweepRun], navigation: NavigationOptions | None
+    args: argparse.Namespace,
+    runs: Sequence[SweepRun],
+    navigation: NavigationOptions | None,
+    *,
+    on_ready: Callable[[], None],
 ) -> list[RunRecord]:
     from auvplan.sweep import RunOptions, run_sweep
 
@@ -173,7 +180,7 @@ def _run(
     with _progress(len(runs), quiet=args.quiet) as progress:
         return run_sweep(
             runs, args.output, options=options, scheduler=args.scheduler,
-            n_workers=args.workers, progress=progress,
+            n_workers=args.workers, progress=progress, on_ready=on_ready,
         )  # fmt: skip
 
 

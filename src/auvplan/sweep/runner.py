@@ -30,6 +30,8 @@ import importlib.util
 import logging
 import re
 import shutil
+import socket
+import struct
 import threading
 import time
 import traceback
@@ -56,6 +58,8 @@ WORKER_DIED: Final = "worker died"
 WORKER_DIED_REASON: Final = "its worker process died (a crash, or killed for memory)"
 #: Seconds to wait for a ``--scheduler`` to answer.
 CONNECT_TIMEOUT_S: Final = 10.0
+#: Largest first message [bytes] a dask scheduler sends (its handshake: a few hundred bytes).
+MAX_HANDSHAKE_BYTES: Final = 2**20
 INSTALL_HINT: Final = "pip install 'auvplan[sweep]'"
 
 logger = logging.getLogger(__name__)
@@ -112,6 +116,7 @@ def run_sweep(
     scheduler: str | None = None,
     n_workers: int | None = None,
     progress: Callable[[SweepProgress], None] | None = None,
+    on_ready: Callable[[], None] | None = None,
 ) -> list[RunRecord]:
     """Run every unfinished run of ``runs`` on dask; the records in the order of ``runs``.
 
@@ -129,12 +134,17 @@ def run_sweep(
         Worker processes of the LocalCluster (default: the CPU count).
     progress : callable, optional
         Called with a :class:`SweepProgress` at the start and after every run.
+    on_ready : callable, optional
+        Called once the cluster answers (or when no run is left to submit), before any run
+        is submitted: e.g. writing the files the runs read, so that a sweep that cannot reach
+        its cluster writes nothing.
 
     Raises
     ------
     InputError
         If dask.distributed is not installed (the message names the extra), or the scheduler
-        cannot be reached.
+        does not answer as a dask scheduler within ``CONNECT_TIMEOUT_S``
+        (:func:`probe_scheduler`).
     """
     directory = Path(directory).resolve()
     records: dict[str, RunRecord] = {}
@@ -147,13 +157,16 @@ def run_sweep(
                 to_evaluate.add(run.run_id)
     pending = [run for run in runs if run.run_id not in records or run.run_id in to_evaluate]
     report = progress or (lambda _event: None)
+    ready = on_ready or (lambda: None)
     if not pending:
+        ready()
         report(SweepProgress(len(runs), len(records), 0, 0, 0))
         return [records[run.run_id] for run in runs]
-    for run in pending:
-        if run.run_id not in to_evaluate:
-            _remove_stale_staging(run_folder(directory, run))
     with _dask_client(scheduler, n_workers) as (client, as_completed, killed_worker):
+        ready()
+        for run in pending:
+            if run.run_id not in to_evaluate:
+                _remove_stale_staging(run_folder(directory, run))
 
         def event(finished: int, failed: int, record: RunRecord | None = None) -> SweepProgress:
             threads = sum(client.nthreads().values()) or 1
@@ -312,6 +325,7 @@ def _dask_client(scheduler: str | None, n_workers: int | None) -> Iterator[tuple
     as_completed = distributed.as_completed
     killed_worker = distributed.scheduler.KilledWorker
     if scheduler is not None:
+        probe_scheduler(scheduler)
         try:
             client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT_S)
         except (OSError, TimeoutError, ValueError) as error:
@@ -335,6 +349,80 @@ def _dask_client(scheduler: str | None, n_workers: int | None) -> Iterator[tuple
         distributed.Client(cluster) as client,
     ):
         yield client, as_completed, killed_worker
+
+
+def probe_scheduler(address: str, *, timeout: float = CONNECT_TIMEOUT_S) -> None:
+    """Check that a ``tcp://`` ``address`` answers as a dask scheduler within ``timeout`` [s].
+
+    A dask server speaks first: on a new connection it sends its handshake, one framed
+    message (an 8-byte length, then that many bytes of msgpack frames). The probe reads it
+    with the timeout and decodes it with dask's own frame reader, so that an address where
+    something else listens (a web server, which waits for a request, or a server that sends
+    text, whose first bytes read as an exabyte length) is refused in bounded time before
+    :class:`distributed.Client` is given it. Other schemes (``tls://``, ``inproc://``...)
+    are left to the client.
+
+    Raises
+    ------
+    InputError
+        If the address is malformed, cannot be reached, or does not answer as a dask
+        scheduler within ``timeout``.
+    """
+    addressing = importlib.import_module("distributed.comm.addressing")
+    try:
+        scheme, location = addressing.parse_address(address)
+        if scheme != "tcp":
+            return
+        host, port = addressing.parse_host_port(location, 8786)
+    except ValueError as error:
+        raise InputError(f"--scheduler {address}: not an address ({error})") from None
+    deadline = time.monotonic() + timeout
+    try:
+        with socket.create_connection((host, port), timeout=timeout) as connection:
+            (n_bytes,) = struct.unpack("Q", _receive(connection, 8, deadline))
+            if not 0 < n_bytes <= MAX_HANDSHAKE_BYTES:
+                raise ValueError(f"its first message claims {n_bytes} bytes")
+            message = _receive(connection, n_bytes, deadline)
+    except TimeoutError:
+        raise InputError(
+            f"--scheduler {address}: no dask scheduler answered within {timeout:g} s"
+        ) from None
+    except OSError as error:
+        reason = error.strerror or type(error).__name__
+        raise InputError(f"--scheduler {address}: cannot connect ({reason})") from None
+    except ValueError as error:
+        raise InputError(f"--scheduler {address}: not a dask scheduler ({error})") from None
+    if not isinstance(_handshake(message), dict):
+        raise InputError(f"--scheduler {address}: not a dask scheduler (no dask handshake)")
+
+
+def _receive(connection: socket.socket, n_bytes: int, deadline: float) -> bytes:
+    """Exactly ``n_bytes`` from ``connection`` before ``deadline`` (``time.monotonic``).
+
+    Raises ``TimeoutError`` at the deadline and ``ValueError`` if the peer closes first.
+    """
+    received = bytearray()
+    while len(received) < n_bytes:
+        remaining = deadline - time.monotonic()
+        if remaining <= 0.0:
+            raise TimeoutError
+        connection.settimeout(remaining)
+        chunk = connection.recv(n_bytes - len(received))
+        if not chunk:
+            raise ValueError(f"it closed the connection after {len(received)} bytes")
+        received += chunk
+    return bytes(received)
+
+
+def _handshake(message: bytes) -> Any:
+    """The value dask's frame reader decodes from a message, or None if it cannot."""
+    utils = importlib.import_module("distributed.protocol.utils")
+    core = importlib.import_module("distributed.protocol.core")
+    try:
+        frames, missing = utils.unpack_frames(message, partial=True)
+        return None if missing else core.loads(frames, deserialize=False)
+    except Exception:  # noqa: BLE001 (any decoding failure: not a dask peer)
+        return None
 
 
 @contextlib.contextmanager
@@ -404,6 +492,7 @@ __all__ = [
     "SweepProgress",
     "execute_evaluation",
     "execute_run",
+    "probe_scheduler",
     "require_dask",
     "run_folder",
     "run_sweep",

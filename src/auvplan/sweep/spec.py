@@ -31,6 +31,9 @@ from auvplan.mission.config import parse_mission, resolved_document
 
 #: Most runs one sweep may hold.
 MAX_RUNS: Final = 100_000
+#: Deepest nesting of brackets and braces in a ``--vary`` value (an array of obstacle tables
+#: with their polygons nests 4 deep); deeper values are refused before the TOML parser recurses.
+MAX_VALUE_DEPTH: Final = 16
 #: Longest run id kept readable; longer ids are cut and end with a digest.
 MAX_ID_LENGTH: Final = 120
 _SAFE = re.compile(r"[^A-Za-z0-9._-]")
@@ -86,7 +89,8 @@ def parse_vary(text: str) -> tuple[str, list[Any]]:
     Raises
     ------
     InputError
-        If there is no ``=``, no key, an empty value or a malformed key path.
+        If there is no ``=``, no key, an empty value, a malformed key path, or values nested
+        deeper than :data:`MAX_VALUE_DEPTH`.
 
     Examples
     --------
@@ -104,7 +108,12 @@ def parse_vary(text: str) -> tuple[str, list[Any]]:
             f"--vary {text!r}: expected KEY=VALUE,VALUE,... (e.g. weights.terrain=0,1)"
         )
     _key_parts(key)
-    tokens = _split_top_level(listing)
+    tokens, depth = _split_top_level(listing)
+    if depth > MAX_VALUE_DEPTH:
+        raise InputError(
+            f"--vary {key}: values nested {depth} deep, more than {MAX_VALUE_DEPTH} brackets "
+            "or braces"
+        )
     if any(not token.strip() for token in tokens):
         raise InputError(f"--vary {key}: empty value in {listing!r}")
     return key, [_toml_value(token.strip()) for token in tokens]
@@ -116,15 +125,16 @@ def parse_seeds(text: str) -> tuple[int, ...]:
     Raises
     ------
     InputError
-        If a part is not a non-negative integer or range, a range runs backwards, or a seed
-        repeats.
+        If a part is not a non-negative integer or range, a range runs backwards, a seed
+        repeats, or there are more than :data:`MAX_RUNS` seeds (counted from the ranges, in
+        time linear in the number of parts).
 
     Examples
     --------
     >>> parse_seeds("0..3,7")
     (0, 1, 2, 3, 7)
     """
-    seeds: list[int] = []
+    ranges: list[range] = []
     for part in text.split(","):
         match = _SEEDS.match(part.strip())
         if match is None:
@@ -133,11 +143,16 @@ def parse_seeds(text: str) -> tuple[int, ...]:
         high = low if match[2] is None else int(match[2])
         if high < low:
             raise InputError(f"--seeds {text!r}: range {part!r} runs backwards")
-        seeds.extend(range(low, high + 1))
-    repeated = sorted({seed for seed in seeds if seeds.count(seed) > 1})
-    if repeated:
-        raise InputError(f"--seeds {text!r}: seed {repeated[0]} given twice")
-    return tuple(seeds)
+        ranges.append(range(low, high + 1))
+    count = sum(len(seeds) for seeds in ranges)  # counted before any range is expanded
+    if count > MAX_RUNS:
+        raise InputError(f"--seeds {text!r}: {count} seeds, more than {MAX_RUNS} runs")
+    highest = -1  # of the ranges so far in ascending order: an overlap is a repeated seed
+    for seeds in sorted(ranges, key=lambda seeds: seeds.start):
+        if seeds.start <= highest:
+            raise InputError(f"--seeds {text!r}: seed {seeds.start} given twice")
+        highest = max(highest, seeds.stop - 1)
+    return tuple(itertools.chain.from_iterable(ranges))
 
 
 def build_runs(
@@ -251,9 +266,9 @@ def _key_parts(key: str) -> list[tuple[str, int | None]]:
     return parts
 
 
-def _split_top_level(text: str) -> list[str]:
-    """``text`` split at commas outside brackets, braces and quotes."""
-    tokens, depth, quote, start = [], 0, "", 0
+def _split_top_level(text: str) -> tuple[list[str], int]:
+    """``text`` split at commas outside brackets, braces and quotes; and the deepest nesting."""
+    tokens, depth, deepest, quote, start = [], 0, 0, "", 0
     for position, character in enumerate(text):
         if quote:
             quote = "" if character == quote else quote
@@ -261,12 +276,13 @@ def _split_top_level(text: str) -> list[str]:
             quote = character
         elif character in "[{":
             depth += 1
+            deepest = max(deepest, depth)
         elif character in "]}":
             depth -= 1
         elif character == "," and depth == 0:
             tokens.append(text[start:position])
             start = position + 1
-    return [*tokens, text[start:]]
+    return [*tokens, text[start:]], deepest
 
 
 def _toml_value(token: str) -> Any:
