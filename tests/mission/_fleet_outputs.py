@@ -14,14 +14,14 @@ import hashlib
 from datetime import UTC, datetime
 from pathlib import Path
 from types import SimpleNamespace
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
 from auvplan import __version__
 from auvplan.io.vehicles import load_vehicle
 from auvplan.mission.outputs import trajectory_tables
-from auvplan.record import trajectories_dataset_of
+from auvplan.record import PlanRecord, trajectories_dataset_of
 from auvplan.record.folder import trajectories_csv_text
 from auvplan.vehicle import VehicleModel, build_vehicle_model
 
@@ -73,7 +73,8 @@ def write_files(result: Any, plan: Any, folder: Path) -> tuple[Path, Path]:
     )
     csv_path, netcdf_path = folder / "trajectories.csv", folder / "trajectories.nc"
     csv_path.write_text(trajectories_csv_text(tables), encoding="utf-8", newline="")
-    trajectories_dataset_of(record, "terrain_aware").to_netcdf(netcdf_path)
+    stand_in = cast("PlanRecord", record)  # the attributes the dataset reads
+    trajectories_dataset_of(stand_in, "terrain_aware").to_netcdf(netcdf_path)
     return csv_path, netcdf_path
 
 

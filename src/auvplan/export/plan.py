@@ -1,7 +1,7 @@
 """What every export format is written from: the fleet's timed tracks and keep-out zones.
 
 An :class:`ExportPlan` holds the optimised trajectories of a finished plan in geographic and
-local coordinates (read from an output folder by :func:`auvplan.mission.load_export_plan`);
+local coordinates (made from an output folder's record by :func:`auvplan.record.export_plan`);
 the format modules write it after thinning each track to waypoints
 (:mod:`auvplan.export.waypoints`).
 """

@@ -66,7 +66,7 @@ def trajectories_dataset_of(record: PlanRecord, label: str) -> xr.Dataset:
         },
         vehicle_types=None
         if is_medusa_layout
-        else [str(vehicle.type_name) for vehicle in record.summary.vehicles],
+        else [vehicle.type_name or vehicle.type for vehicle in record.summary.vehicles],
     )
 
 

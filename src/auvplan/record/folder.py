@@ -257,25 +257,25 @@ def read_record(folder: Path) -> PlanRecord:
         path = folder / files.csv
         if not path.is_file():
             continue
+        if digest is not None and files.csv not in digest:
+            raise DataFormatError(
+                f"{path} is stale: the run of {folder / SUMMARY_FILE} did not write it (a "
+                "rerun with --stage stopped earlier); plan to the full stage again or remove it"
+            )
         plans[label] = read_trajectory_tables(path, summary.vehicles, max_current=max_current)
-        if digest is not None:
-            _check_digest(path, digest.get(files.csv), folder / SUMMARY_FILE)
+        if digest is not None and _sha256(path) != digest[files.csv]:
+            raise DataFormatError(
+                f"{path} is not the file the run of {folder / SUMMARY_FILE} wrote (its SHA-256 "
+                "differs)"
+            )
     mission_path = folder / MISSION_FILE
     mission = read_toml(mission_path, what="mission file") if mission_path.is_file() else {}
     return PlanRecord(summary, mission, maps, plans)
 
 
-def _check_digest(path: Path, expected: str | None, summary: Path) -> None:
-    """Refuse ``path`` unless its SHA-256 is the one ``summary.json`` recorded for it."""
-    if expected is None:
-        raise DataFormatError(
-            f"{path} is stale: the run of {summary} did not write it (a rerun with --stage "
-            "stopped earlier); plan to the full stage again or remove it"
-        )
-    if hashlib.sha256(path.read_bytes()).hexdigest() != expected:
-        raise DataFormatError(
-            f"{path} is not the file the run of {summary} wrote (its SHA-256 differs)"
-        )
+def _sha256(path: Path) -> str:
+    """SHA-256 of the bytes of ``path``, in hex."""
+    return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
 __all__ = [

@@ -84,15 +84,17 @@ def read_trajectory_tables(
     ``state_names``, ``input_names``, ``power``) and nothing in the others; its time must
     increase over at least 2 rows; its speed through the water ``hypot(u, v)`` must stay
     within :data:`SPEED_MARGIN` times its top speed, and each step within
-    ``SPEED_MARGIN * (top speed + max_current) * dt``.
+    ``SPEED_MARGIN * (top speed + max_current) * dt``. (A summary written before auvplan
+    recorded each vehicle's columns and top speed: its filled cells are its columns, and
+    speeds and steps are not bounded.)
 
     Parameters
     ----------
     path : Path
         The file.
     vehicles : sequence of VehicleSummary
-        The vehicles of ``summary.json`` (with ``state_names``, ``input_names`` and
-        ``top_speed_m_s``).
+        The vehicles of ``summary.json`` (their ``state_names``, ``input_names`` and
+        ``top_speed_m_s`` [m/s]).
     max_current : float
         Largest current speed along the plan [m/s] (0 in still water).
 
@@ -136,17 +138,17 @@ def _vehicle_table(
     max_current: float,
 ) -> VehicleTrajectory:
     """One vehicle's rows as a :class:`VehicleTrajectory`, checked (see the reader)."""
-    where = f"{path} vehicle {vehicle.name!r}"
-    if vehicle.state_names is None or vehicle.input_names is None or vehicle.type_name is None:
-        raise DataFormatError(
-            f"{where}: summary.json has no type_name/state_names/input_names for it"
-        )
-    own = ("t", *vehicle.state_names, *vehicle.input_names, "power")
+    if not rows:
+        raise DataFormatError(f"{path}: no rows of vehicle {vehicle.name!r}")
+    state_names, input_names = _own_columns(vehicle, header, rows[0][1])
+    own = ("t", *state_names, *input_names, "power")
     missing = [name for name in own if name not in header]
     if missing:
         raise DataFormatError(f"{path}: no column {missing[0]!r} of vehicle {vehicle.name!r}")
     if len(rows) < 2:
-        raise DataFormatError(f"{where}: {len(rows)} row(s), a trajectory needs at least 2")
+        raise DataFormatError(
+            f"{path} vehicle {vehicle.name!r}: 1 row, a trajectory needs at least 2"
+        )
     index = {name: header.index(name) for name in own}
     others = [k for k, name in enumerate(header) if k and name not in index]
     table = np.empty((len(rows), len(own)))
@@ -159,11 +161,11 @@ def _vehicle_table(
                 f"{path} line {line}: vehicle {vehicle.name!r} has no state "
                 f"{header[filled]!r}, but the cell holds {row[filled]!r}"
             )
-    n_x = len(vehicle.state_names)
+    n_x = len(state_names)
     trajectory = VehicleTrajectory(
         vehicle.name,
-        vehicle.state_names,
-        vehicle.input_names,
+        state_names,
+        input_names,
         table[:, 0],
         table[:, 1 : 1 + n_x],
         table[:-1, 1 + n_x : -1],
@@ -186,8 +188,8 @@ def _check_motion(
     if (bad := np.flatnonzero(dt <= 0.0)).size:
         line = lines[bad[0] + 1]
         raise DataFormatError(f"{path} line {line}: vehicle {vehicle.name!r}: t does not increase")
-    if vehicle.top_speed_m_s is None:
-        raise DataFormatError(f"{path} vehicle {vehicle.name!r}: summary.json has no top_speed_m_s")
+    if vehicle.top_speed_m_s is None:  # a summary written before auvplan recorded it
+        return
     top = vehicle.top_speed_m_s
     speed = np.hypot(trajectory.state("u"), trajectory.state("v"))
     if (bad := np.flatnonzero(speed > SPEED_MARGIN * top)).size:
@@ -205,6 +207,27 @@ def _check_motion(
             f"{step[k]:.3g} m in {dt[k]:.3g} s is longer than {SPEED_MARGIN:g} x (top speed "
             f"{top:.3g} + current {max_current:.3g} m/s) x dt"
         )
+
+
+def _own_columns(
+    vehicle: VehicleSummary, header: list[str], first_row: list[str]
+) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """The vehicle's state and input names: from ``summary.json``, else from its cells.
+
+    A summary written before auvplan recorded ``state_names``/``input_names`` names no
+    columns; the vehicle's are then those its first row fills, inputs being the ``c_*``.
+    """
+    if vehicle.state_names is not None and vehicle.input_names is not None:
+        return vehicle.state_names, vehicle.input_names
+    filled = [
+        name
+        for name, cell in zip(header[1:], first_row[1:], strict=True)
+        if cell.strip() and name not in ("t", "power")
+    ]
+    return (
+        tuple(name for name in filled if not name.startswith("c_")),
+        tuple(name for name in filled if name.startswith("c_")),
+    )
 
 
 def _number(text: str, where: str, vehicle: str, column: str) -> float:
