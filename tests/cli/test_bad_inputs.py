@@ -8,6 +8,7 @@ was, with no new file or folder. SIGTERM is sent to a real ``auvplan`` process.
 
 from __future__ import annotations
 
+import json
 import logging
 import os
 import signal
@@ -24,6 +25,7 @@ import pytest
 import xarray as xr
 
 from auvplan.cli.main import EXIT_TERMINATED, main
+from conftest import PlanFolderWriter
 
 MEDUSA = resources.files("auvplan").joinpath("data", "vehicles", "medusa.toml").read_text()
 DEMO = resources.files("auvplan").joinpath("data", "missions", "demo.toml").read_text()
@@ -236,6 +238,21 @@ CASES: dict[str, tuple[Callable[[Path], list[str]], str]] = {
         ),
         "green: goal (10, 440) m is 0 m from the start (10, 440) m; give a goal at least 1 mm",
     ),
+    # 3d. mission values the seabed or physics rule out
+    "depth_m below the seabed": (
+        _plan_demo(lambda mission: mission + "\n[mission]\ndepth_m = 5000.0\n"),
+        (
+            "auvplan: error: mission.depth_m = 5000 m is not above the seabed along blue's path "
+            "(seabed 22.5 m deep at north 325 m, east 402 m; the deepest seabed is 43.5 m along "
+            "the paths and 60.0 m over the map): give depth_m < 22.5 m"
+        ),
+    ),
+    "safety_radius_m = 1e-15": (
+        _plan_demo(
+            lambda mission: mission.replace("safety_radius_m = 5.0", "safety_radius_m = 1e-15")
+        ),
+        "fleet.safety_radius_m: Input should be greater than or equal to 0.01, got 1e-15",
+    ),
     # 4. vehicle numbers outside their physical range
     "vehicle n_max = 1e-9": (
         lambda tmp: [
@@ -413,6 +430,45 @@ def test_stray_fix_and_absurd_values_are_warnings_not_errors(
             assert (tmp_path / "out" / "maps.png").is_file()
     assert "stray.xyz: dropped 1 of 300 soundings" in caplog.text
     assert "absurd.nc: 1 of 144 values beyond ±12000 m treated as no data" in caplog.text
+
+
+@pytest.mark.parametrize(("key", "value"), [("lat", float("nan")), ("lat", 95.0), ("lon", 1e400)])
+def test_export_refuses_an_origin_off_the_earth(
+    key: str,
+    value: float,
+    tmp_path: Path,
+    write_plan_folder: PlanFolderWriter,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """summary.json's terrain.origin with a NaN lat was exported (``LatOrigin = nan``)."""
+    from auvplan.record import VehicleTrajectory
+    from auvplan.terrain import BathymetryGrid, GridGeometry, LocalProjection, compute_terrain_maps
+
+    time = np.arange(0.0, 60.5, 0.5)
+    states = np.zeros((time.size, 6))
+    states[:, 0], states[:, 1], states[:, 3] = 20.0 + time, 100.0, 1.0
+    track = VehicleTrajectory(
+        "blue", ("north", "east", "psi", "u", "v", "r"), ("tau_u", "tau_r"), time, states,
+        np.zeros((time.size - 1, 2)), np.full(time.size, 40.0),
+    )  # fmt: skip
+    depth = np.full((40, 60), 40.0) + 0.01 * np.arange(60.0)
+    maps = compute_terrain_maps(
+        BathymetryGrid(depth, GridGeometry(40, 60, 4.0, 4.0), LocalProjection(36.8, -121.81))
+    )
+    origin = {"north": 0.0, "east": 0.0, "lat": 36.8, "lon": -121.81}
+    folder = write_plan_folder(
+        tmp_path / "out", maps, {"terrain_aware": (track,)},
+        extra={"terrain": {"name": "test", "origin": origin}},
+    )  # fmt: skip
+    summary = json.loads((folder / "summary.json").read_text())
+    summary["terrain"]["origin"][key] = value
+    (folder / "summary.json").write_text(json.dumps(summary))
+    _assert_refused(
+        ["export", str(folder), "--format", "moos"],
+        tmp_path,
+        f"summary.json: entry terrain.origin.{key}: input should be",
+        capsys,
+    )
 
 
 # --- SIGTERM on a real process ---------------------------------------------------------------

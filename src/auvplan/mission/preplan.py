@@ -27,6 +27,7 @@ from auvplan.mission.current import cell_currents, current_move_factor, load_cur
 from auvplan.mission.models import vehicle_model
 from auvplan.mission.navigation import NavigationChoice, VehicleNavigation, vehicle_navigation
 from auvplan.mission.progress import ProgressReporter, no_progress
+from auvplan.navigation.depth import depth_at
 from auvplan.ocean import CurrentField
 from auvplan.planning import (
     CircleObstacle,
@@ -151,6 +152,34 @@ def check_goals_leave_starts(names: tuple[str, ...], starts: FloatArray, goals: 
                 f"({start[0]:g}, {start[1]:g}) m; give a goal at least {MIN_TRAVEL * 1e3:g} mm "
                 "away from the start"
             )
+
+
+def check_depth_above_seabed(
+    depth: float, bathymetry: BathymetryGrid, names: tuple[str, ...], paths: tuple[FloatArray, ...]
+) -> None:
+    """Raise InputError unless the plan's constant ``depth`` [m] is above every path's seabed.
+
+    ``paths`` are the smoothed paths, each of shape ``(n_points, 2)``: north/east [m]. The
+    seabed is the bilinear depth of ``bathymetry`` (:func:`~auvplan.navigation.depth.depth_at`)
+    at the path's points; the message names the vehicle and place of the shallowest seabed
+    along the paths, the deepest along them and over the map, and the largest usable depth.
+    """
+    if depth <= 0.0:
+        return  # at the surface: above every water cell
+    seabeds = [depth_at(bathymetry, path[:, 0], path[:, 1]) for path in paths]
+    shallowest = [float(np.nanmin(seabed)) for seabed in seabeds]
+    index = int(np.argmin(shallowest))
+    if shallowest[index] > depth:
+        return
+    point = paths[index][int(np.nanargmin(seabeds[index]))]
+    deepest = max(float(np.nanmax(seabed)) for seabed in seabeds)
+    raise InputError(
+        f"mission.depth_m = {depth:g} m is not above the seabed along {names[index]}'s path "
+        f"(seabed {shallowest[index]:.1f} m deep at north {point[0]:.0f} m, east "
+        f"{point[1]:.0f} m; the deepest seabed is {deepest:.1f} m along the paths and "
+        f"{float(np.nanmax(bathymetry.depth)):.1f} m over the map): give depth_m < "
+        f"{math.floor(10.0 * shallowest[index]) / 10.0:g} m"
+    )
 
 
 def check_communication_ranges(
@@ -458,6 +487,7 @@ def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progre
         ),
         progress=progress,
     )  # fmt: skip
+    check_depth_above_seabed(config.mission.depth, bathymetry, names, paths)
     return PreplanStage(
         bathymetry=bathymetry,
         maps=maps,

@@ -33,6 +33,10 @@ BlockSize = Annotated[int, Strict(), Field(ge=1, le=256)]
 FORBIDDEN_NAME_CHARACTERS: Final = ",\n\"'"
 
 _SOLVER_DEFAULTS: Final = ProntoOptions()
+#: Smallest safety radius r_c [m]: two vehicles kept 2 cm apart would already touch (no hull
+#: is that small), and the deconfliction's time step, which must move a vehicle less than
+#: 2 r_c, would shrink towards nothing.
+MIN_SAFETY_RADIUS: Final = 0.01
 #: Years a start time may fall in (timestamps stay within numpy's datetime64[ns] range).
 START_YEARS: Final = (1900, 2200)
 
@@ -116,7 +120,7 @@ class FleetConfig(TableModel):
         json_schema_extra=_unit("m/s"),
     )  # fmt: skip
     safety_radius: Number = Field(
-        alias="safety_radius_m", gt=0.0, le=1000.0,
+        alias="safety_radius_m", ge=MIN_SAFETY_RADIUS, le=1000.0,
         description="r_c; every pair keeps >= 2 r_c", json_schema_extra=_unit("m"),
     )  # fmt: skip
 

@@ -31,12 +31,18 @@ def _iso_time(text: str) -> str:
 
 
 class Place(_Entry):
-    """A point of the local frame [m], with WGS 84 ``lat``/``lon`` [deg] when georeferenced."""
+    """A point of the local frame [m], with WGS 84 ``lat``/``lon`` [deg] when georeferenced.
+
+    Every coordinate is finite, and ``lat``/``lon`` are on the Earth: a NaN origin would
+    otherwise reach the exports (``LatOrigin = nan``) or pyproj (a CRSError).
+    """
+
+    model_config = ConfigDict(allow_inf_nan=False)
 
     north: float
     east: float
-    lat: float | None = None
-    lon: float | None = None
+    lat: float | None = Field(default=None, ge=-90.0, le=90.0)
+    lon: float | None = Field(default=None, ge=-180.0, le=360.0)
 
 
 class Pose(_Entry):
