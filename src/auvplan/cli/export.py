@@ -3,22 +3,23 @@
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 from typing import Any
 
-from auvplan.export import DEFAULT_TOLERANCE_M, FORMATS, MOOS_FRAMES
+from auvplan.errors import InputError
+from auvplan.export import DEFAULT_TOLERANCE_M, FORMATS, MOOS_FRAMES, check_tolerance
 
 
 def tolerance_m(text: str) -> float:
-    """A finite, non-negative waypoint tolerance [m] (argparse type)."""
+    """A waypoint tolerance [m] within :func:`auvplan.export.check_tolerance` (argparse type)."""
     try:
         value = float(text)
+        check_tolerance(value)
+    except InputError as error:  # a ValueError too: first
+        raise argparse.ArgumentTypeError(str(error)) from None
     except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value >= 0.0):
-        raise argparse.ArgumentTypeError(f"expected a distance >= 0 m, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected a distance in m, got {text!r}") from None
     return value
 
 

@@ -40,6 +40,9 @@ MoosFrame = Literal["utm", "local"]
 MOOS_FRAMES: Final = get_args(MoosFrame)
 #: Default waypoint tolerance [m] (see :func:`auvplan.export.waypoints.thin_track`).
 DEFAULT_TOLERANCE_M: Final = 1.0
+#: Largest waypoint tolerance [m]: half the Earth's circumference, farther than any two
+#: points of a plan are apart (any larger tolerance thins the same way).
+MAX_TOLERANCE_M: Final = 2.0e7
 
 
 def parse_formats(text: str) -> tuple[str, ...]:
@@ -69,6 +72,22 @@ def check_moos_frame(frame: str) -> None:
         raise InputError(f"MOOS frame {frame!r} is not one of {', '.join(MOOS_FRAMES)}")
 
 
+def check_tolerance(tolerance: float) -> None:
+    """Raise InputError unless ``tolerance`` [m] is a number from 0 to :data:`MAX_TOLERANCE_M`.
+
+    Examples
+    --------
+    >>> check_tolerance(1e300)
+    Traceback (most recent call last):
+    ...
+    auvplan.errors.InputError: waypoint tolerance must be >= 0 and <= 2e+07 m, got 1e+300
+    """
+    if not 0.0 <= tolerance <= MAX_TOLERANCE_M:  # False for NaN
+        raise InputError(
+            f"waypoint tolerance must be >= 0 and <= {MAX_TOLERANCE_M:g} m, got {tolerance:g}"
+        )
+
+
 def render_exports(
     plan: ExportPlan,
     formats: Sequence[str],
@@ -93,11 +112,17 @@ def render_exports(
     -------
     dict of str to str
         File name (no folder) to its text.
+
+    Raises
+    ------
+    InputError
+        If ``moos_frame`` or ``tolerance`` is out of its range, or a format is unknown.
     """
     from auvplan.export import geojson, gpx, imc, kml, moos, qgc
     from auvplan.export.waypoints import thin_track
 
     check_moos_frame(moos_frame)
+    check_tolerance(tolerance)
     renderers: dict[str, Callable[[ExportPlan, list[Waypoints]], dict[str, str]]] = {
         "moos": functools.partial(moos.render, frame=moos_frame),
         "qgc": qgc.render,
@@ -131,9 +156,11 @@ def write_exports(
 __all__ = [
     "DEFAULT_TOLERANCE_M",
     "FORMATS",
+    "MAX_TOLERANCE_M",
     "MOOS_FRAMES",
     "MoosFrame",
     "check_moos_frame",
+    "check_tolerance",
     "parse_formats",
     "render_exports",
     "write_exports",
