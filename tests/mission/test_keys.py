@@ -49,7 +49,7 @@ def test_keys_verb_prints_a_markdown_table(capsys: pytest.CaptureFixture[str]) -
     assert main(["keys"]) == 0
     out = capsys.readouterr().out
     assert out.startswith("| key | type | default | range | unit | meaning |")
-    assert "| `solver.dt_s` | number | 0.5 | >= 0.01, <= 10 | s |" in out
+    assert "| `solver.dt_s` | number | 0.5 | >= 0.01, <= 10.0 | s |" in out
 
 
 def test_defaults_and_ranges_are_written_as_toml() -> None:

@@ -64,13 +64,14 @@ def toml_value(value: Any) -> str:
 
     Examples
     --------
-    >>> [toml_value(v) for v in (True, (2, 2), "paper", 4294967295, 1e-7, PurePath("a.nc"))]
-    ['true', '[2, 2]', '"paper"', '4294967295', '1e-07', '"a.nc"']
+    >>> [toml_value(v) for v in (True, (2, 2), "paper", 4294967295, 0.0, 1e-7, PurePath("a"))]
+    ['true', '[2, 2]', '"paper"', '4294967295', '0.0', '1e-07', '"a"']
     """
     if isinstance(value, tuple | list):
         return "[" + ", ".join(toml_value(item) for item in value) + "]"
     if isinstance(value, float):
-        return f"{value:.12g}"
+        text = f"{value:.12g}"
+        return text if any(mark in text for mark in ".ein") else f"{text}.0"  # a TOML float
     if isinstance(value, PurePath):
         value = str(value)
     return tomli_w.dumps({"v": value}).removeprefix("v = ").strip()
