@@ -168,6 +168,29 @@ polygon = [[0.0, 390.0], [0.0, 410.0], [20.0, 410.0], [20.0, 390.0]]
 """
 
 
+def _current_file(path: Path, nan_rows: slice, nan_cols: slice) -> None:
+    """A still current on local north/east axes [m] around the demo's map (0 … 400 m north,
+    0 … 800 m east, nodes every 50 m), NaN at the nodes ``[nan_rows, nan_cols]``."""
+    north, east = np.arange(-100.0, 501.0, 50.0), np.arange(-100.0, 901.0, 50.0)
+    velocity = np.full((north.size, east.size), 0.1)
+    velocity[nan_rows, nan_cols] = np.nan
+    attrs = {"units": "m s-1"}
+    xr.Dataset(
+        {"u": (("north", "east"), velocity, attrs), "v": (("north", "east"), velocity, attrs)},
+        coords={"north": north, "east": east},
+    ).to_netcdf(path)
+
+
+def _plan_in_current(nan_rows: slice, nan_cols: slice) -> Callable[[Path], list[str]]:
+    """The demo mission (preplan) in a current file with NaN at the nodes given."""
+
+    def build(tmp: Path) -> list[str]:
+        _current_file(tmp / "cur.nc", nan_rows, nan_cols)
+        return _plan_demo(lambda mission: mission + '\n[current]\nfile = "cur.nc"\n')(tmp)
+
+    return build
+
+
 #: case -> (argv builder, text the one stderr line must contain)
 CASES: dict[str, tuple[Callable[[Path], list[str]], str]] = {
     # 1. text files that are not UTF-8 or not parseable
@@ -252,6 +275,13 @@ CASES: dict[str, tuple[Callable[[Path], list[str]], str]] = {
             lambda mission: mission.replace("safety_radius_m = 5.0", "safety_radius_m = 1e-15")
         ),
         "fleet.safety_radius_m: Input should be greater than or equal to 0.01, got 1e-15",
+    ),
+    "current file with a NaN block over the map's water": (
+        _plan_in_current(slice(4, 7), slice(6, 10)),  # north 100 … 200 m, east 200 … 350 m
+        (
+            "current file cur.nc: v is NaN over the map's water: at 1900 of its 20301 water "
+            "cells, first north 76 m, east 176 m (NaN is read as still water only over land"
+        ),
     ),
     # 4. vehicle numbers outside their physical range
     "vehicle n_max = 1e-9": (
@@ -430,6 +460,15 @@ def test_stray_fix_and_absurd_values_are_warnings_not_errors(
             assert (tmp_path / "out" / "maps.png").is_file()
     assert "stray.xyz: dropped 1 of 300 soundings" in caplog.text
     assert "absurd.nc: 1 of 144 values beyond ±12000 m treated as no data" in caplog.text
+
+
+def test_current_nan_off_the_maps_water_is_still_water(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """NaN at nodes nearest no water cell of the map (as ocean models leave land) plans."""
+    argv = _plan_in_current(slice(0, 2), slice(None))(tmp_path)  # the rows south of the map
+    code, _, err = _run([*argv, "-q"], capsys)
+    assert (code, err) == (0, "")
 
 
 @pytest.mark.parametrize(("key", "value"), [("lat", float("nan")), ("lat", 95.0), ("lon", 1e400)])

@@ -55,6 +55,7 @@ def read_current(
     extent: tuple[tuple[float, float], tuple[float, float]],
     start_time: datetime | None,
     depth: float,
+    water: tuple[FloatArray, FloatArray] | None = None,
 ) -> GriddedCurrent:
     """Read a current file onto the mission's local frame (module notes).
 
@@ -71,6 +72,11 @@ def read_current(
         UTC time of mission time 0 (None: the file's first time).
     depth : float
         Depth of the plan [m]; the level nearest it is taken.
+    water : (ndarray, ndarray), optional
+        ``north, east`` [m] of the map's water cells. The file's nodes nearest to them must
+        hold values at every time: ocean models leave land NaN, which is read as still water
+        (there is no vehicle there), but NaN over the map's water would plan a current that
+        is not known as still water.
 
     Returns
     -------
@@ -79,7 +85,8 @@ def read_current(
     Raises
     ------
     DataFormatError
-        Unreadable file, no current variables, unknown units, irregular axes, no valid values.
+        Unreadable file, no current variables, unknown units, irregular axes, no valid values,
+        NaN over the map's water (naming the variable, the count and the first place).
     InputError
         The file does not cover the map or the mission's start time, or is georeferenced
         while the terrain is not.
@@ -94,7 +101,7 @@ def read_current(
         raise DataFormatError(f"current file {path}: unreadable ({first_line(error)})") from None
     try:
         with dataset:
-            return _convert(dataset, projection, extent, start_time, depth)
+            return _convert(dataset, projection, extent, start_time, depth, water)
     except AuvplanError as error:
         raise type(error)(f"current file {path.name}: {error}") from None
     except (ValueError, KeyError, TypeError, IndexError) as error:
@@ -136,6 +143,7 @@ def _convert(
     extent: tuple[tuple[float, float], tuple[float, float]],
     start_time: datetime | None,
     depth: float,
+    water: tuple[FloatArray, FloatArray] | None,
 ) -> GriddedCurrent:
     import cf_xarray  # noqa: F401  (registers the .cf accessor)
 
@@ -170,6 +178,9 @@ def _convert(
     geometry, slices = _lattice(rows, cols, slices)
     to_axes = _affine(dataset, data, projection, extent, is_latlon, rows, cols, row_name)
     _check_coverage(to_axes, geometry, extent)
+    if water is not None:
+        for name, values in ((north_name, slices[0]), (east_name, slices[1])):
+            _check_water_values(name, values, geometry, to_axes, water)
     return GriddedCurrent(
         north_component=tuple(SplineSurface.fit(geometry, s) for s in slices[0]),
         east_component=tuple(SplineSurface.fit(geometry, s) for s in slices[1]),
@@ -254,6 +265,34 @@ def _affine(
     jacobian = np.array([[y[2] - y[0], y[1] - y[0]], [x[2] - x[0], x[1] - x[0]]]) / _JACOBIAN_STEP_M
     origin = np.array([y[0], x[0]]) - jacobian @ np.array([north[0], east[0]])
     return np.column_stack([jacobian, origin])
+
+
+def _check_water_values(
+    name: str,
+    values: FloatArray,
+    geometry: GridGeometry,
+    to_axes: FloatArray,
+    water: tuple[FloatArray, FloatArray],
+) -> None:
+    """Raise DataFormatError if the node nearest a water point is NaN at some time.
+
+    ``values`` has shape ``(n_times, n_rows, n_cols)`` on ``geometry`` (the file's axes);
+    ``to_axes`` maps local ``(north, east, 1)`` [m] to them; ``water`` is ``(north, east)`` [m].
+    """
+    north, east = (np.ravel(axis) for axis in water)
+    rows, cols = geometry.to_index(*(to_axes @ np.vstack([north, east, np.ones_like(north)])))
+    rows, cols = np.clip(rows, 0, geometry.n_rows - 1), np.clip(cols, 0, geometry.n_cols - 1)
+    is_nan = np.isnan(values[:, rows, cols])  # (n_times, n_water)
+    if not is_nan.any():
+        return
+    time, first = (int(i[0]) for i in np.nonzero(is_nan))
+    n_cells = int(np.count_nonzero(is_nan.any(axis=0)))
+    when = f" in time slice {time} of {values.shape[0]}" if values.shape[0] > 1 else ""
+    raise DataFormatError(
+        f"{name} is NaN over the map's water: at {n_cells} of its {north.size} water cells, "
+        f"first north {north[first]:.0f} m, east {east[first]:.0f} m{when} (NaN is read as "
+        "still water only over land; fill the gaps over water)"
+    )
 
 
 def _check_coverage(
