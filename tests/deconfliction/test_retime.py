@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 import pytest
 from _deconfliction_oracles import dense_min_separation, law_at
@@ -126,7 +128,7 @@ def test_retimed_law_between_samples_is_the_integrated_speed() -> None:
 
 
 def test_coarse_resampling_falls_back_to_the_certified_replay(
-    monkeypatch: pytest.MonkeyPatch,
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
 ) -> None:
     from auvplan.deconfliction import retime
 
@@ -138,7 +140,12 @@ def test_coarse_resampling_falls_back_to_the_certified_replay(
     )
     schedule = deconflict(problem)
     monkeypatch.setattr(retime, "MAX_SAMPLES", 5)  # a grid too coarse to certify the crossing
-    result = retime_for_arrival(schedule, problem, 80.0)
+    with caplog.at_level(logging.DEBUG, logger="auvplan"):
+        result = retime_for_arrival(schedule, problem, 80.0)
+    # a degradation the run reports in its result (summary.json), not on the console
+    assert "the schedule is replayed at a common pace" in result.message
+    assert "not certified on the resampled grid" in result.message
+    assert max(record.levelno for record in caplog.records) == logging.DEBUG
     assert result.certificate.holds
     assert result.min_separation >= 2 * problem.safety_radius
     np.testing.assert_allclose(result.time, schedule.time * 80.0 / schedule.time[-1])

@@ -33,6 +33,10 @@ between 0 and ``v_i``. :func:`retime_for_arrival` turns it into time laws a vehi
 4. **Certificate.** Each vehicle's new law is re-certified against all the others; should it
    fail (a sample where the replayed schedule itself is closer than :math:`R_{ij}`, possible
    after coarsening), the vehicle keeps its replayed law.
+5. **Fallback.** Should the laws together fail the certificate on a resampled grid (a schedule
+   of more than :data:`MAX_SAMPLES` samples), the schedule itself is replayed at the common
+   pace on its own grid (certified, stops included). This is a degradation the run reports:
+   the result's message says it (``summary.json``: ``deconfliction.message``).
 """
 
 from __future__ import annotations
@@ -91,7 +95,9 @@ def retime_for_arrival(
         (the input's samples, at most :data:`MAX_SAMPLES`), ``progress`` and ``speeds`` (the
         law is quadratic between samples, module notes), ``arrival_times`` (all
         ``final_time``), ``delays``, the recomputed certificate, and ``within_limits``: per
-        vehicle, whether its law keeps the acceleration bound everywhere.
+        vehicle, whether its law keeps the acceleration bound everywhere. ``message`` names
+        the vehicles that keep their replayed law and says when the schedule is replayed
+        (module notes, steps 4 and 5).
 
     Raises
     ------
@@ -130,21 +136,23 @@ def retime_for_arrival(
     within = [False] * problem.n_vehicles
     for i in np.argsort(-result.delays, kind="stable"):  # the longest waits first
         law = _smooth_law(problem, int(i), time, progress, pace)
-        if law is None:
-            logger.warning("retime: vehicle %s keeps its replayed law", problem.label(int(i)))
+        if law is None:  # (the result's message names it)
+            logger.debug("retime: vehicle %s keeps its replayed law", problem.label(int(i)))
             progress[i] = _late_arrival(problem, int(i), progress)
             continue
         progress[i], speeds[i], within[i] = law
     certificate = certify_separation(problem, time, progress)
+    fallback = ""
     if not certificate.holds:
         # the resampled corridor missed a close pass: replay the schedule itself on its own
         # grid at the common pace, which keeps its configurations and hence its certificate
         i, j = certificate.pair
-        logger.warning(
-            "retime: %s and %s not certified on the resampled grid (%.3g m); replaying the "
-            "schedule at a common pace", problem.label(i), problem.label(j),
-            certificate.min_separation,
-        )  # fmt: skip
+        fallback = (
+            f"the smooth laws of {problem.label(i)} and {problem.label(j)} were not certified "
+            f"on the resampled grid ({certificate.min_separation:.3g} m): the schedule is "
+            "replayed at a common pace, stops included"
+        )
+        logger.debug("retime: %s", fallback)  # (a degradation: the result's message says it)
         time = result.time * (final_time / makespan)
         progress = np.array(result.progress, dtype=np.float64)
         speeds = np.full_like(progress, np.nan)
@@ -160,6 +168,8 @@ def retime_for_arrival(
     arrivals = arrival_times_of(problem, time, progress)
     delays = arrivals - problem.nominal_arrival_times
     message = f"{result.message}; retimed to arrive at {final_time:.6g} s"
+    if fallback:
+        message += f" ({fallback})"
     kept = [problem.label(i) for i in range(problem.n_vehicles) if np.isnan(speeds[i, 0])]
     if kept:
         message += f" (vehicles {kept} keep their replayed law and may arrive early)"

@@ -20,6 +20,7 @@ from auvplan.mission.navigation import budget_of
 from auvplan.mission.pipeline import MissionResult
 from auvplan.planning import CircleObstacle, PolygonObstacle
 from auvplan.vehicle import positions
+from auvplan.viz._notices import notices_as_debug
 from auvplan.viz.coordination import plot_coordination_space
 from auvplan.viz.current import add_current_arrows
 from auvplan.viz.maps import plot_terrain_maps
@@ -81,7 +82,8 @@ def render_figure(
     def render(file_format: str) -> bytes:
         buffer = io.BytesIO()
         metadata = {"Date": None} if file_format == "svg" else {}  # reproducible files
-        figure.savefig(buffer, format=file_format, dpi=dpi, metadata=metadata)
+        with notices_as_debug():  # missing glyphs (a vehicle named in CJK), collapsed layouts
+            figure.savefig(buffer, format=file_format, dpi=dpi, metadata=metadata)
         return buffer.getvalue()
 
     checkpoint()  # a stop request (SIGINT/SIGTERM) between figures
