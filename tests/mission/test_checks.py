@@ -10,6 +10,7 @@ import numpy as np
 
 from auvplan.mission.checks import ARRIVAL_TOLERANCE, PlanStatus, judge_plan
 from auvplan.mission.config import parse_mission
+from auvplan.record.labels import Pair
 
 MISSION = """
 [terrain]
@@ -43,17 +44,17 @@ def _result(success: bool = True) -> Any:
     )  # fmt: skip
 
 
-def _distances(**overrides: np.ndarray) -> dict[str, np.ndarray]:
+def _distances(**overrides: np.ndarray) -> dict[Pair, np.ndarray]:
     distances = {
-        "a / b": np.full(TIME.size, 30.0),
-        "a / rock": np.full(TIME.size, 12.0),
-        "b / rock": np.full(TIME.size, 12.0),
+        Pair("a", "b"): np.full(TIME.size, 30.0),
+        Pair("a", "rock"): np.full(TIME.size, 12.0),
+        Pair("b", "rock"): np.full(TIME.size, 12.0),
     }
-    distances.update({key.replace("_", " / "): value for key, value in overrides.items()})
+    distances.update({Pair(*key.split("_")): value for key, value in overrides.items()})
     return distances
 
 
-def _judge(distances: dict[str, np.ndarray], arrival: float = 0.1, success: bool = True) -> Any:
+def _judge(distances: dict[Pair, np.ndarray], arrival: float = 0.1, success: bool = True) -> Any:
     config = parse_mission(tomllib.loads(MISSION))
     return judge_plan(
         config, ("a", "b"), _result(success), TIME, distances, np.array([arrival, 0.0])

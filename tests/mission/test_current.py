@@ -170,7 +170,7 @@ def test_downstream_leg_costs_less_than_upstream() -> None:
     assert upstream.plan.verdict.success
     assert downstream.plan.energy[0] < 0.9 * upstream.plan.energy[0]
     # the surge through the water is lower downstream, higher upstream than the ground speed
-    u = downstream.plan.states[0, :, 3], upstream.plan.states[0, :, 3]
+    u = downstream.plan.states[0][:, 3], upstream.plan.states[0][:, 3]
     assert np.mean(u[0]) < 0.5 < np.mean(u[1])
 
 

@@ -24,6 +24,7 @@ from auvplan.mission.config import MissionConfig
 from auvplan.mission.navigation import NavigationChoice, budget_of, smallest_budget
 from auvplan.navigation.prediction import ErrorPrediction
 from auvplan.optimization import ProntoResult
+from auvplan.record.labels import Pair
 
 #: Slack [m] allowed on distance limits for round-off between the plan and its replay.
 DISTANCE_TOLERANCE: Final = 1e-3
@@ -92,14 +93,15 @@ def judge_plan(
     names: tuple[str, ...],
     result: ProntoResult,
     fine_time: FloatArray,
-    fine_distances: dict[str, FloatArray],
+    fine_distances: dict[Pair, FloatArray],
     arrival_error: FloatArray,
     predicted: tuple[ErrorPrediction, ...] = (),
     routes: tuple[NavigationChoice, ...] | None = None,
 ) -> PlanVerdict:
     """Check a plan's constraints on the fine replay and give its verdict.
 
-    ``fine_distances`` are labelled ``"a / b"`` (vehicles or a vehicle and an obstacle label);
+    ``fine_distances`` are by :class:`~auvplan.record.labels.Pair` (two vehicles, or a vehicle
+    and an obstacle);
     ``arrival_error`` ``(n_vehicles,)`` [m]; ``predicted`` the predicted TAN error of each
     vehicle along its replayed track, ``routes`` how each route was chosen (the smallest
     feasible budget, when the mission's cannot be met).
@@ -107,22 +109,19 @@ def judge_plan(
     radius = config.fleet.safety_radius
     obstacles = set(config.obstacle_names)
     violations: list[Violation] = []
-    for label, distance in fine_distances.items():
-        first, second = label.split(" / ")
-        limit = radius if second in obstacles else 2.0 * radius
+    for pair, distance in fine_distances.items():
+        limit = radius if pair.second in obstacles else 2.0 * radius
         value, when = _worst(distance, fine_time, largest=False)
         if value < limit - DISTANCE_TOLERANCE:
-            kind = "obstacle clearance" if second in obstacles else "separation"
-            violations.append(
-                Violation(kind, f"{first} / {second}", value, limit, when, _TIMING_ADVICE)
-            )
+            kind = "obstacle clearance" if pair.second in obstacles else "separation"
+            violations.append(Violation(kind, str(pair), value, limit, when, _TIMING_ADVICE))
     for comm in config.comms:
-        label = " / ".join(sorted(comm.pair, key=names.index))
-        value, when = _worst(fine_distances[label], fine_time, largest=True)
+        pair = Pair.of_vehicles(names, *comm.pair)
+        value, when = _worst(fine_distances[pair], fine_time, largest=True)
         if value > comm.max_range + DISTANCE_TOLERANCE:
             advice = "move the goals closer together or raise max_range_m"
             violations.append(
-                Violation("communication", label, value, comm.max_range, when, advice)
+                Violation("communication", str(pair), value, comm.max_range, when, advice)
             )
     for i, error in enumerate(arrival_error):
         if error > ARRIVAL_TOLERANCE:

@@ -16,13 +16,15 @@ from scipy.interpolate import RegularGridInterpolator
 from auvplan._typing import FloatArray
 from auvplan.mission.checks import PlanVerdict, judge_plan
 from auvplan.mission.config import MissionConfig
+from auvplan.mission.costs import CostBreakdown, constraint_slack, cost_breakdown
 from auvplan.mission.fleet import FleetProblemFunctions
 from auvplan.mission.navigation import predict_tracks
 from auvplan.mission.preplan import PreplanStage
 from auvplan.mission.verify import replay_closed_loop
 from auvplan.navigation.prediction import ErrorPrediction
-from auvplan.optimization import ProntoResult
+from auvplan.optimization import ProntoResult, TrajectoryProblem
 from auvplan.planning import distance_to_obstacle
+from auvplan.record.labels import Pair
 from auvplan.terrain import TerrainMaps
 from auvplan.vehicle import headings, positions
 
@@ -42,11 +44,14 @@ class OptimizedPlan:
     distance [m] to each other vehicle (centre to centre) and obstacle (to its edge; polygons
     are enforced by the pre-planner and only checked here) when the plan is flown with its
     tracking regulator on a grid ``CHECK_REFINEMENT`` times finer than the solver's, whose
-    time series are ``fine_distances`` (labels ``"a / b"``) on ``fine_time``;
+    time series are ``fine_distances`` (by :class:`~auvplan.record.labels.Pair`) on
+    ``fine_time``;
     ``tracking_error`` ``(n_vehicles,)`` is that replay's largest distance [m] from the plan at
     the solver nodes. ``predicted_navigation`` is the predicted TAN error along each replayed
     track (:func:`auvplan.mission.navigation.predict_tracks`). ``verdict`` says whether every
-    constraint holds between samples (:func:`auvplan.mission.checks.judge_plan`).
+    constraint holds between samples (:func:`auvplan.mission.checks.judge_plan`). ``costs`` is
+    the objective by named term and ``constraint_slack[block][pair]`` the smallest value of
+    each constraint row at the solver nodes (:mod:`auvplan.mission.costs`).
     """
 
     result: ProntoResult
@@ -59,10 +64,12 @@ class OptimizedPlan:
     terrain_information: FloatArray
     separations: dict[str, dict[str, float]]
     fine_time: FloatArray
-    fine_distances: dict[str, FloatArray]
+    fine_distances: dict[Pair, FloatArray]
     tracking_error: FloatArray
     predicted_navigation: tuple[ErrorPrediction, ...]
     verdict: PlanVerdict
+    costs: CostBreakdown
+    constraint_slack: dict[str, dict[str, float]]
 
 
 def evaluate_plan(
@@ -70,13 +77,15 @@ def evaluate_plan(
     preplan: PreplanStage,
     time: FloatArray,
     dt: float,
+    problem: TrajectoryProblem,
     functions: FleetProblemFunctions,
     result: ProntoResult,
     terrain_weight: float,
 ) -> OptimizedPlan:
     """Energy, information, arrival error and sampled-and-between separations of a result.
 
-    ``time`` is the solver grid of control interval ``dt`` [s].
+    ``time`` is the solver grid of control interval ``dt`` [s]; ``problem`` and ``functions``
+    the solved fleet problem (for the cost terms and constraint slacks).
     """
     layout = functions.layout
     models = layout.models
@@ -126,6 +135,8 @@ def evaluate_plan(
         fine_distances=fine_distances,
         tracking_error=tracking_error,
         predicted_navigation=predicted,
+        costs=cost_breakdown(problem, functions, result.trajectory),
+        constraint_slack=constraint_slack(problem, functions, result.trajectory),
         verdict=judge_plan(
             config,
             preplan.names,
@@ -141,23 +152,23 @@ def evaluate_plan(
 
 def pairwise_distances(
     preplan: PreplanStage, tracks: FloatArray
-) -> tuple[dict[str, FloatArray], dict[str, dict[str, float]]]:
+) -> tuple[dict[Pair, FloatArray], dict[str, dict[str, float]]]:
     """Distance series between every pair and to every obstacle, and their minima.
 
-    ``tracks`` ``(n_vehicles, n_t, 2)`` north/east [m]. Returns the series labelled
-    ``"a / b"`` and ``minima[a][b]`` (symmetric between vehicles) [m].
+    ``tracks`` ``(n_vehicles, n_t, 2)`` north/east [m]. Returns the series by
+    :class:`~auvplan.record.labels.Pair` and ``minima[a][b]`` (symmetric between vehicles) [m].
     """
     names = preplan.names
-    series: dict[str, FloatArray] = {}
+    series: dict[Pair, FloatArray] = {}
     minima: dict[str, dict[str, float]] = {name: {} for name in names}
     for i, name in enumerate(names):
         for j in range(i + 1, len(names)):
             distance = np.hypot(*(tracks[i] - tracks[j]).T)
-            series[f"{name} / {names[j]}"] = distance
+            series[Pair(name, names[j])] = distance
             minima[name][names[j]] = minima[names[j]][name] = float(np.min(distance))
         for obstacle, label in zip(preplan.obstacles, preplan.obstacle_names, strict=True):
             distance = distance_to_obstacle(obstacle, *tracks[i].T)
-            series[f"{name} / {label}"] = distance
+            series[Pair(name, label)] = distance
             minima[name][label] = float(np.min(distance))
     return series, minima
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Final, Literal
+from typing import Any, Final, Literal
 
 import casadi as ca
 import numpy as np
@@ -33,6 +33,7 @@ import numpy as np
 from auvplan._typing import FloatArray
 from auvplan.ocean import CurrentField
 from auvplan.optimization import StageBlock, stack_blocks
+from auvplan.record.labels import Pair
 from auvplan.vehicle import VehicleModel
 
 #: Desired-state weights Q of the tracking term per unit of ``terrain`` weight, by state name:
@@ -75,24 +76,89 @@ TERMINAL_HEADING_WEIGHT: Final = 2e3
 N_CURRENT_PARAMETERS: Final = 6
 
 
+#: The running-cost terms of a vehicle, in the order of :func:`vehicle_cost_terms`' output.
+RUNNING_TERMS: Final = ("energy", "tracking", "input")
+#: Every named term of the fleet's cost: the running terms, the information reward (a
+#: :class:`~auvplan.optimization.NodeCost`, negative) and the terminal cost.
+COST_TERMS: Final = (*RUNNING_TERMS, "information", "terminal")
+
+
+@dataclass(frozen=True)
+class StageWeights:
+    """The runtime weights ``w`` of one vehicle's cost rate, by name.
+
+    The one owner of their order in ``w = (w_E, w_T, r, q_1, …, q_{n_x})``: :meth:`vector` packs
+    numbers, :meth:`of` names the entries of a symbol, so no index is spelt elsewhere.
+
+    Attributes
+    ----------
+    energy : float
+        ``w_E``, multiplier of the propulsive power [-].
+    tracking : float
+        ``w_T``, multiplier of the desired-state tracking (the terrain weight; 0 for a vehicle
+        whose route is not tracked) [-].
+    input : float
+        ``r``, input regularisation [W per unit c²].
+    per_state : tuple of float
+        ``q_s``, tracking weight of each state [W per unit state²] (:func:`tracking_weights`).
+    """
+
+    energy: Any
+    tracking: Any
+    input: Any
+    per_state: Any
+
+    @staticmethod
+    def size(n_x: int) -> int:
+        """Length of ``w`` for a model of ``n_x`` states."""
+        return 3 + n_x
+
+    @classmethod
+    def of(cls, w: ca.SX) -> StageWeights:
+        """The named entries of a symbol ``w`` of :meth:`size`."""
+        return cls(energy=w[0], tracking=w[1], input=w[2], per_state=w[3:])
+
+    def vector(self) -> FloatArray:
+        """``w`` as numbers."""
+        return np.array([self.energy, self.tracking, self.input, *self.per_state], dtype=float)
+
+
+def vehicle_cost_terms(model: VehicleModel, *, has_current: bool = False) -> ca.Function:
+    r"""The running-cost terms of one vehicle: ``terms(x, c, p, w) -> (3,)`` rates [W].
+
+    ``(w_E P(x, c), ½ w_T Σ_s q_s (x_s − x_{d,s})², ½ r ‖c‖²)`` named by
+    :data:`RUNNING_TERMS`, with ``w`` as :class:`StageWeights` and ``p`` as in
+    :func:`vehicle_stage_functions`.
+    """
+    x, c = ca.SX.sym("x", model.n_x), ca.SX.sym("c", model.n_u)
+    n_p = model.n_x + (N_CURRENT_PARAMETERS if has_current else 0)
+    p, w = ca.SX.sym("p", n_p), ca.SX.sym("w", StageWeights.size(model.n_x))
+    weights = StageWeights.of(w)
+    error = x - p[: model.n_x]
+    terms = ca.vertcat(
+        weights.energy * model.power(x, c),
+        0.5 * weights.tracking * ca.dot(weights.per_state * error, error),
+        0.5 * weights.input * ca.dot(c, c),
+    )
+    return ca.Function("vehicle_terms", [x, c, p, w], [terms])
+
+
 def vehicle_stage_functions(
     model: VehicleModel, *, has_current: bool = False
 ) -> tuple[ca.Function, ca.Function]:
     r"""One vehicle's block of the fleet problem: ``f(x, c, p)`` and cost rate ``l(x, c, p, w)``.
 
-    ``p`` is the vehicle's desired state ``x_d`` and ``w = (w_E, w_T, r, q_1, …, q_{n_x})`` the
-    runtime weights: ``l = w_E P(x, c) + ½ w_T Σ_s q_s (x_s − x_{d,s})² + ½ r ‖c‖²`` [W].
-    With ``has_current``, ``p = (x_d, v_c,k, vec(G_k))`` (:data:`N_CURRENT_PARAMETERS` more,
-    ``G_k`` row-major) and the dynamics are
+    ``l`` is the sum of :func:`vehicle_cost_terms`:
+    ``l = w_E P(x, c) + ½ w_T Σ_s q_s (x_s − x_{d,s})² + ½ r ‖c‖²`` [W], ``w`` as
+    :class:`StageWeights`. With ``has_current``, ``p = (x_d, v_c,k, vec(G_k))``
+    (:data:`N_CURRENT_PARAMETERS` more, ``G_k`` row-major) and the dynamics are
     :attr:`~auvplan.vehicle.VehicleModel.dynamics_in_current` with the current linearised
     about the desired position ``p_d``: ``v_c(p) ≈ v_c,k + G_k (p − p_d)``.
     """
     x, c = ca.SX.sym("x", model.n_x), ca.SX.sym("c", model.n_u)
     n_p = model.n_x + (N_CURRENT_PARAMETERS if has_current else 0)
-    p, w = ca.SX.sym("p", n_p), ca.SX.sym("w", 3 + model.n_x)
-    error = x - p[: model.n_x]
-    rate = w[0] * model.power(x, c) + 0.5 * w[1] * ca.dot(w[3:] * error, error)
-    rate += 0.5 * w[2] * ca.dot(c, c)
+    p, w = ca.SX.sym("p", n_p), ca.SX.sym("w", StageWeights.size(model.n_x))
+    rate = ca.sum1(vehicle_cost_terms(model, has_current=has_current)(x, c, p, w))
     if has_current:
         rows = [model.index("north"), model.index("east")]
         offset = p[model.n_x : model.n_x + 2]
@@ -195,13 +261,14 @@ class FleetConstraint:
     """One block of path constraints ``c(x, u, p) >= 0`` of the stacked fleet system.
 
     ``kind`` is ``"hockey"`` (non-convex, barrier composed with the hockey stick) or
-    ``"plain"``; ``labels`` name each row (``"blue-green"``, ``"blue-obstacle 0"``, …).
+    ``"plain"``; ``labels`` name each row by its :class:`~auvplan.record.labels.Pair`
+    (two vehicles, a vehicle and an obstacle, a vehicle and a limited state).
     """
 
     name: str
     function: ca.Function
     kind: Literal["plain", "hockey"]
-    labels: tuple[str, ...]
+    labels: tuple[Pair, ...]
 
 
 @dataclass(frozen=True)
@@ -233,6 +300,16 @@ class FleetWeights:
     def terrain_of(self, index: int) -> float:
         """The tracking weight of vehicle ``index``."""
         return self.terrain if not self.tracked or self.tracked[index] else 0.0
+
+    def stage_weights(self, index: int, model: VehicleModel) -> StageWeights:
+        """The :class:`StageWeights` of vehicle ``index`` of type ``model``."""
+        per_state = tracking_weights(model)
+        return StageWeights(
+            energy=self.energy,
+            tracking=self.terrain_of(index),
+            input=INPUT_WEIGHT,
+            per_state=tuple(per_state.get(name, 0.0) for name in model.state_names),
+        )
 
 
 @dataclass(frozen=True)
@@ -283,15 +360,10 @@ def build_fleet_functions(
     cs = [c[layout.input_slice(i)] for i in range(layout.n_vehicles)]
     models = layout.models
 
-    def tracking(model: VehicleModel) -> list[float]:
-        return [tracking_weights(model).get(name, 0.0) for name in model.state_names]
-
     blocks = tuple(
         StageBlock(
             *vehicle_stage_functions(model, has_current=has_current),
-            weights=np.array(
-                [weights.energy, weights.terrain_of(i), INPUT_WEIGHT, *tracking(model)]
-            ),
+            weights=weights.stage_weights(i, model).vector(),
             states=layout.state_slice(i),
             inputs=layout.input_slice(i),
             parameters=layout.parameter_slice(i, has_current=has_current),
@@ -334,7 +406,7 @@ def _constraints(
     blocks: list[FleetConstraint] = []
 
     def add(
-        name: str, rows: list[ca.SX], labels: list[str], kind: Literal["plain", "hockey"]
+        name: str, rows: list[ca.SX], labels: list[Pair], kind: Literal["plain", "hockey"]
     ) -> None:
         if rows:
             function = ca.Function(name, list(arguments), [ca.vertcat(*rows)])
@@ -352,7 +424,7 @@ def _constraints(
     add(
         "collision",
         [squared_distance(i, *position(j)) / separation**2 - 1 for i, j in pairs],
-        [f"{names[i]}-{names[j]}" for i, j in pairs],
+        [Pair(names[i], names[j]) for i, j in pairs],
         "hockey",
     )
     circles = np.asarray(limits.obstacles).reshape(-1, 3)
@@ -365,7 +437,7 @@ def _constraints(
             for north, east, radius in circles
         ],
         [
-            f"{names[i]}-{label}"
+            Pair(names[i], label)
             for i in range(layout.n_vehicles)
             for label in limits.obstacle_names
         ],
@@ -374,7 +446,7 @@ def _constraints(
     add(
         "communication",
         [1 - squared_distance(i, *position(j)) / d_max**2 for i, j, d_max in limits.comm_pairs],
-        [f"{names[i]}-{names[j]}" for i, j, _ in limits.comm_pairs],
+        [Pair(names[i], names[j]) for i, j, _ in limits.comm_pairs],
         "plain",
     )
     add(
@@ -385,7 +457,7 @@ def _constraints(
             for state, limit in model.state_limits
         ],
         [
-            f"{names[i]}-{state}"
+            Pair(names[i], state)
             for i, model in enumerate(models)
             for state, _ in model.state_limits
         ],

@@ -243,6 +243,7 @@ def run_optimization(
         preplan,
         deconfliction.time,
         deconfliction.dt,
+        assembled.problem,
         assembled.functions,
         result,
         terrain_weight,

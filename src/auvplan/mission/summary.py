@@ -67,10 +67,15 @@ def _plan_summary(plan: OptimizedPlan, names: tuple[str, ...], settle_s: float) 
                 "tracking_error_m": float(plan.tracking_error[i]),
                 "min_separation_m": plan.separations[name],
                 "predicted_navigation_error": _predicted(plan.predicted_navigation[i], settle_s),
+                "cost_terms_J": {
+                    term: float(values[i]) for term, values in plan.costs.running.items()
+                },
             }
             for i, name in enumerate(names)
         },
         "total_energy_J": float(np.sum(plan.energy)),
+        "cost_terms_J": plan.costs.totals(),
+        "constraint_slack": plan.constraint_slack,
     }
 
 

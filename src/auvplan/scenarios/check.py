@@ -41,6 +41,7 @@ from auvplan.io.currents import read_current
 from auvplan.io.results import read_trajectories_csv
 from auvplan.ocean import CurrentField, UniformCurrent
 from auvplan.record.files import MAIN_PLAN, MAPS_FILE, PLAN_FILES, SUMMARY_FILE
+from auvplan.record.labels import Pair
 from auvplan.scenarios._model import ReferenceModel, step_defects
 from auvplan.scenarios._vehicle_file import read_reference_model
 
@@ -204,7 +205,7 @@ def check(
             )
     comm_distances = {}
     for comm in document.get("comm", []):
-        pair = f"{comm['pair'][0]} / {comm['pair'][1]}"
+        pair = str(Pair(*comm["pair"]))
         farthest = float(np.max(np.hypot(*(fine[comm["pair"][0]] - fine[comm["pair"][1]]).T)))
         comm_distances[pair] = farthest
         if farthest > float(comm["max_range_m"]) + GEOMETRY_SLACK_M:
@@ -312,7 +313,7 @@ def _recorded_mission(summary: Mapping[str, Any]) -> Path:
 
 def _pair_distances(fine: Mapping[str, FloatArray], names: list[str]) -> dict[str, FloatArray]:
     return {
-        f"{a} / {b}": np.hypot(*(fine[a] - fine[b]).T)
+        str(Pair(a, b)): np.hypot(*(fine[a] - fine[b]).T)
         for i, a in enumerate(names)
         for b in names[i + 1 :]
     }

@@ -159,7 +159,9 @@ def figure_builders(result: MissionResult) -> dict[str, Callable[[], Figure]]:
         )
         if plan.fine_distances:
             builders["separation"] = lambda: plot_separation(
-                plan.fine_time, plan.fine_distances, 2 * radius
+                plan.fine_time,
+                {str(pair): distance for pair, distance in plan.fine_distances.items()},
+                2 * radius,
             )
     return builders
 
