@@ -7,8 +7,10 @@ the healing cache file, and a damaged index or data file is a cache miss with on
 
 from __future__ import annotations
 
+import errno
 import importlib
 import logging
+import os
 import pickle
 from pathlib import Path
 from typing import Any
@@ -18,6 +20,7 @@ from numba.core import caching
 from numba.core.dispatcher import Dispatcher
 
 import auvplan
+from auvplan import _numba_cache
 from auvplan._numba_cache import HealingCacheFile
 
 SOURCE_ROOT = Path(auvplan.__file__).parent
@@ -69,3 +72,20 @@ def test_a_damaged_index_or_data_file_is_a_miss_with_one_warning(
         f"numba cache file {data}",
         f"numba cache file {index}",
     ]
+
+
+def test_a_kernel_the_file_system_refuses_stays_unsaved_with_one_warning(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    def full_disk(self: HealingCacheFile, name: str, data: object) -> None:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(HealingCacheFile, "_save_data", full_disk)
+    monkeypatch.setattr(_numba_cache, "_UNSAVED", set())
+    cache_file: Any = caching.IndexDataCacheFile(tmp_path, "kernel-1.py311", "stamp")
+    with caplog.at_level(logging.WARNING, logger="auvplan._numba_cache"):
+        for key in ("one signature", "another signature"):
+            cache_file.save(key, ("machine", "code"))  # (numba raised: the run failed)
+            assert cache_file.load(key) is None  # compiled again by the next run
+    expected = f"numba cache {tmp_path}: No space left on device; kernels are compiled again"
+    assert [record.getMessage() for record in caplog.records] == [f"{expected} by the next run"]

@@ -11,7 +11,9 @@ way (numba issue 10434; the fix in pull request 10656 is not released).
 
 Importing this module replaces numba's ``IndexDataCacheFile`` with :class:`HealingCacheFile`,
 which treats a file that cannot be read back as missing: it logs one warning naming the
-file, deletes it, and numba compiles the kernel again and writes a new file. The package of
+file, deletes it, and numba compiles the kernel again and writes a new file. A kernel the
+file system refuses to save (full disk, read-only, file too large) stays unsaved, with one
+warning per cache folder, instead of failing the run (numba raises the ``OSError``). The package of
 every auvplan kernel module imports this module before defining its kernels (numba creates a
 kernel's cache file object when it decorates the kernel). Files numba can read are
 untouched, so a healthy cache behaves exactly as before.
@@ -28,6 +30,8 @@ from numba.core import caching
 __all__ = ["HealingCacheFile"]
 
 logger = logging.getLogger(__name__)
+#: Cache folders where saving a kernel failed (warned once).
+_UNSAVED: set[Path] = set()
 
 
 class HealingCacheFile(caching.IndexDataCacheFile):
@@ -53,6 +57,20 @@ class HealingCacheFile(caching.IndexDataCacheFile):
         except Exception as error:  # noqa: BLE001 (garbage unpickles to almost any error)
             _discard(Path(self._data_path(name)), error)  # type: ignore[no-untyped-call]
             return None
+
+    def save(self, key: Any, data: Any) -> None:
+        """Save a compiled kernel; one the file system refuses (full, read-only) stays unsaved."""
+        try:
+            super().save(key, data)  # type: ignore[no-untyped-call]
+        except OSError as error:  # (numba deletes its temporary file)
+            folder = Path(self._cache_path)
+            if folder not in _UNSAVED:  # one line per folder, not one per kernel
+                _UNSAVED.add(folder)
+                logger.warning(
+                    "numba cache %s: %s; kernels are compiled again by the next run",
+                    folder,
+                    error.strerror or error,
+                )
 
 
 def _discard(path: Path, error: Exception) -> None:

@@ -33,10 +33,11 @@ between 0 and ``v_i``. :func:`retime_for_arrival` turns it into time laws a vehi
 4. **Certificate.** Each vehicle's new law is re-certified against all the others; should it
    fail (a sample where the replayed schedule itself is closer than :math:`R_{ij}`, possible
    after coarsening), the vehicle keeps its replayed law.
-5. **Fallback.** Should the laws together fail the certificate on a resampled grid (a schedule
-   of more than :data:`MAX_SAMPLES` samples), the schedule itself is replayed at the common
-   pace on its own grid (certified, stops included). This is a degradation the run reports:
-   the result's message says it (``summary.json``: ``deconfliction.message``).
+5. **Fallback.** Should the laws together fail the certificate on their grid (uniform, at most
+   :data:`MAX_SAMPLES` samples: coarser than the schedule's), the schedule itself is replayed
+   at the common pace on its own grid (certified, stops included). This is a degradation
+   the run reports: the result's message says it (``summary.json``:
+   ``deconfliction.message``).
 """
 
 from __future__ import annotations
