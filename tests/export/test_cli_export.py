@@ -258,6 +258,8 @@ def test_export_writes_moos_in_the_frame_asked(planned_folder: Path, tmp_path: P
         assert ("LatLong2LocalUTM" in text) == (frame == "utm")
         points[frame] = [line for line in text.splitlines() if "points" in line]
     assert points["utm"] != points["local"]
+    # plan --export takes the same flag (the session's folder was planned with the default)
+    assert "LatLong2LocalUTM" in (planned_folder / "export" / "blue.bhv").read_text()
     with pytest.raises(SystemExit) as stopped:
         main(["-q", "export", str(planned_folder), "--format", "moos", "--moos-frame", "grid"])
     assert stopped.value.code == 2

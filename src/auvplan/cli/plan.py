@@ -159,6 +159,7 @@ def _run(config: Any, args: argparse.Namespace) -> int:
             dpi=args.dpi,
             exports=formats,
             tolerance_m=getattr(args, "tolerance_m", DEFAULT_TOLERANCE_M),  # demo: no --export
+            moos_frame=getattr(args, "moos_frame", "utm"),
             companion=companion,
         )
     result = mission_plan.result
