@@ -11,6 +11,12 @@ from __future__ import annotations
 import errno
 import io
 import os
+import re
+import resource
+import signal
+import subprocess
+import sys
+from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any, Self
@@ -142,4 +148,37 @@ def test_a_full_disk_while_plan_writes_maps_nc_is_one_line(
     assert captured.err.splitlines() == [
         f"auvplan: error: {_expected(out, 'maps.nc', errno.ENOSPC)}"
     ]
+    _assert_nothing_left(out)
+
+
+def _file_size_limit(limit: int) -> Callable[[], None]:
+    """A child process's start: writes past ``limit`` bytes fail with EFBIG (no signal)."""
+
+    def limit_writes() -> None:
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    return limit_writes
+
+
+def test_a_real_file_size_limit_is_one_line_naming_the_file(
+    mission_file: Path, tmp_path: Path
+) -> None:
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "auvplan", "-q", "plan", str(mission_file), "-o", str(out)]
+    completed = subprocess.run(
+        [*command, "--stage", "preplan", "--no-figures"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        preexec_fn=_file_size_limit(32 * 1024),  # maps.nc is larger; the kernels are cached
+        check=False,
+    )
+    assert completed.returncode == 2
+    lines = completed.stderr.splitlines()
+    assert len(lines) == 1, completed.stderr
+    assert re.fullmatch(
+        rf"auvplan: error: cannot write {re.escape(str(out.resolve()))}/\S+: File too large.*",
+        lines[0],
+    )
     _assert_nothing_left(out)
