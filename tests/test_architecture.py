@@ -117,3 +117,30 @@ def test_dependency_direction(package: str) -> None:
         if (bad := _imported_subpackages(path) & FORBIDDEN[package])
     }
     assert not offenders, f"{package} imports forbidden subpackages: {offenders}"
+
+
+def _names_taken_from_the_package_face(path: Path) -> set[str]:
+    """Names a module imports from ``auvplan`` itself that are not modules of their own.
+
+    ``from auvplan import X`` where ``X`` is defined in ``auvplan/__init__.py`` (the public
+    face, which imports the layers lazily) points up from every layer; a top-level module
+    (``auvplan/errors.py``, ``auvplan/_version.py`` ...) is a layer below all of them.
+    """
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    return {
+        alias.name
+        for node in ast.walk(tree)
+        if isinstance(node, ast.ImportFrom) and node.module == "auvplan" and node.level == 0
+        for alias in node.names
+        if not (SRC / f"{alias.name}.py").is_file()
+    }
+
+
+def test_no_module_imports_the_package_face() -> None:
+    """No upward arrow: nothing below the face takes a name from ``auvplan/__init__.py``."""
+    offenders = {
+        str(path.relative_to(SRC)): names
+        for path in sorted(SRC.rglob("*.py"))
+        if path != SRC / "__init__.py" and (names := _names_taken_from_the_package_face(path))
+    }
+    assert not offenders, f"upward imports from the package face: {offenders}"

@@ -29,7 +29,8 @@ import sys
 from collections.abc import Sequence
 from typing import Any, NoReturn
 
-from auvplan import __version__, interrupts
+from auvplan import interrupts
+from auvplan._version import __version__
 from auvplan.errors import AuvplanError
 
 #: Modules of :mod:`auvplan.cli` that provide a verb, in help order.

@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from typing import Final
 from xml.etree import ElementTree
 
-from auvplan import __version__
+from auvplan._version import __version__
 from auvplan.export.plan import ExportPlan, utc_text
 from auvplan.export.waypoints import Waypoints
 

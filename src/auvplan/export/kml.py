@@ -19,7 +19,7 @@ from typing import Final
 import numpy as np
 from lxml import etree
 
-from auvplan import __version__
+from auvplan._version import __version__
 from auvplan.export.plan import CircleZone, ExportPlan, PolygonZone, utc_text
 from auvplan.export.waypoints import Waypoints
 from auvplan.terrain.projection import LocalProjection

@@ -34,8 +34,8 @@ from typing import Final
 import numpy as np
 from pyproj import CRS, Transformer
 
-from auvplan import __version__
 from auvplan._typing import FloatArray
+from auvplan._version import __version__
 from auvplan.export import MoosFrame, check_moos_frame
 from auvplan.export.plan import ExportPlan, utc_text
 from auvplan.export.waypoints import Waypoints, by_file_stem

@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Final
 
 import numpy as np
 
-from auvplan import __version__
+from auvplan._version import __version__
 from auvplan.errors import DataFormatError
 from auvplan.io._gridded import grid_mapping_crs
 from auvplan.io.writing import writing

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from auvplan import __version__
+from auvplan._version import __version__
 from auvplan.mission.config import resolved_document
 from auvplan.mission.evaluation import OptimizedPlan
 from auvplan.mission.pipeline import MissionResult

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from auvplan import __version__
+from auvplan._version import __version__
 from auvplan.io.results import json_values
 from auvplan.io.text import file_sha256
 from auvplan.io.vehicles import vehicle_file

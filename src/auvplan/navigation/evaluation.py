@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from auvplan import __version__
 from auvplan._typing import FloatArray
+from auvplan._version import __version__
 from auvplan.navigation.metrics import (
     CONVERGENCE_SIGMA_M,
     DIVERGENCE_SIGMAS,

@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from auvplan import __version__
 from auvplan._typing import FloatArray
+from auvplan._version import __version__
 from auvplan.errors import DataFormatError
 from auvplan.io.results import union_names
 from auvplan.io.trajectories_file import SERIES, trajectories_dataset

@@ -37,7 +37,7 @@ from typing import Any, Final
 
 import pandas as pd
 
-from auvplan import __version__
+from auvplan._version import __version__
 from auvplan.errors import AuvplanError, DataFormatError
 from auvplan.io.output import staged_output_file
 from auvplan.io.results import write_json
