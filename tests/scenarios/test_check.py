@@ -255,8 +255,11 @@ def test_real_plan_of_a_generated_scenario_passes(tmp_path: Path) -> None:
     assert report.success, report.failures
 
 
-def test_scenarios_verb_writes_one_folder_per_seed(tmp_path: Path) -> None:
-    code = main(["-q", "scenarios", "3", "5", "-o", str(tmp_path), "--data-dir", str(tmp_path)])
+def test_scenarios_verb_writes_one_folder_per_seed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("AUVPLAN_SHARED_DATA", str(tmp_path))  # empty: no real grids
+    code = main(["-q", "scenarios", "3", "5", "-o", str(tmp_path)])
     assert code == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["seed_0003", "seed_0005"]
     expected = generate(5, data_dir=tmp_path).toml(tmp_path / "seed_0005")

@@ -14,11 +14,13 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from auvplan.cli.main import main
+from auvplan.errors import InputError
 from auvplan.io.bathymetry import read_bathymetry
 from auvplan.mission.config import load_mission
 from auvplan.mission.pipeline import run_preplan
 from auvplan.planning import distance_to_obstacle
-from auvplan.scenarios import generate
+from auvplan.scenarios import check_data_dir, generate
+from auvplan.scenarios._terrain import REAL_GRIDS
 from auvplan.scenarios.family import DT_BY_HORIZON, FLEET_SIZES, HORIZON_RANGE_S
 
 #: Seeds whose pre-planning takes a second or less: synthetic, bank, Lisbon, Monterey terrain.
@@ -115,6 +117,49 @@ def test_without_real_grids_only_synthetic_terrain(tmp_path: Path) -> None:
     assert kinds <= {"bank", "synthetic"}
     mission = generate(0, data_dir=tmp_path).write(tmp_path / "scenario")
     assert _preplan_exit_code(mission, tmp_path / "out")[0] == 0
+
+
+def test_check_data_dir_needs_a_folder_with_a_real_grid(tmp_path: Path) -> None:
+    lacks = f"lacks {', '.join(REAL_GRIDS.values())}"
+    with pytest.raises(InputError, match=f"data folder {tmp_path} holds none of .*: {lacks}"):
+        check_data_dir(tmp_path)
+    with pytest.raises(InputError, match="does not exist: it should hold"):
+        check_data_dir(tmp_path / "bathymetyr")
+    (tmp_path / "f").write_text("")
+    with pytest.raises(InputError, match="is not a folder: it should hold"):
+        check_data_dir(tmp_path / "f")
+    (tmp_path / REAL_GRIDS["lisbon"]).write_bytes(b"")  # one grid is enough
+    check_data_dir(tmp_path)
+
+
+@pytest.mark.parametrize("verb", ["scenarios", "sweep"])
+def test_a_mistyped_data_dir_exits_2_and_writes_nothing(
+    verb: str, tmp_path: Path, bathymetry_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A typo in --data-dir gave the family without real grids, silently."""
+    typo = bathymetry_dir.parent / "bathymetyr"
+    out = str(tmp_path / "out")
+    argv = {
+        "scenarios": ["scenarios", "3", "-o", out, "--data-dir", str(typo)],
+        "sweep": ["sweep", "scenarios", "--seeds", "3", "-o", out, "--data-dir", str(typo)],
+    }[verb]
+    code = main(argv)
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err == (
+        f"auvplan: error: data folder {typo} does not exist: it should hold the real "
+        f"bathymetry grids (at least one of {', '.join(REAL_GRIDS.values())})\n"
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_default_data_dir_may_be_absent(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.setenv("AUVPLAN_SHARED_DATA", str(tmp_path / "nowhere"))
+    assert main(["-q", "scenarios", "3", "-o", str(tmp_path / "out")]) == 0
+    assert capsys.readouterr().err == ""
+    assert generate(3).terrain in {"bank", "synthetic"}
 
 
 @pytest.mark.parametrize("seed", [1, 4, 11, 18, 25])

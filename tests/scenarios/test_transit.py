@@ -288,13 +288,12 @@ def test_monterey_is_too_small_for_a_transit(bathymetry_dir: Path) -> None:
     assert terrains & {"lisbon", "balanus"}
 
 
-def test_cli_writes_transit_scenarios(tmp_path: Path) -> None:
+def test_cli_writes_transit_scenarios(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    (tmp_path / "empty").mkdir()
+    monkeypatch.setenv("AUVPLAN_SHARED_DATA", str(tmp_path / "empty"))  # no real grids
     stdout = io.StringIO()
     with contextlib.redirect_stdout(stdout):
-        code = main(
-            ["scenarios", "3", "14", "-o", str(tmp_path / "out"), "--kind", "transit",
-             "--data-dir", str(tmp_path / "none")]
-        )  # fmt: skip
+        code = main(["scenarios", "3", "14", "-o", str(tmp_path / "out"), "--kind", "transit"])
     assert code == 0
     for seed in (3, 14):
         folder = tmp_path / "out" / f"seed_{seed:04d}"

@@ -122,9 +122,13 @@ def test_missing_dask_names_the_extra(
 
 
 @pytest.mark.usefixtures("inprocess_cluster")
-def test_scenario_family_seeds_are_missions(tmp_path: Path) -> None:
+def test_scenario_family_seeds_are_missions(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    (tmp_path / "empty").mkdir()
+    monkeypatch.setenv("AUVPLAN_SHARED_DATA", str(tmp_path / "empty"))  # no real grids
     out = tmp_path / "family"
-    options = ["--seeds", "2,3", "--vary", "weights.terrain=0", "--data-dir", str(tmp_path / "no")]
+    options = ["--seeds", "2,3", "--vary", "weights.terrain=0"]
     assert main(["-q", "sweep", "scenarios", "-o", str(out), "--stage", "preplan", *options]) == 0
     table = pd.read_csv(out / "sweep.csv")
     assert table["seed"].tolist() == [2, 3]

@@ -28,7 +28,8 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
         help="write missions of the seeded scenario family (to reproduce a benchmark run)",
         description="Write one folder DIR/seed_NNNN per seed with mission.toml (and terrain.nc "
         "for a generated terrain). Real grids are read from --data-dir when present; the "
-        "family depends on whether they are.",
+        "family depends on whether they are. A --data-dir given must be a folder holding at "
+        "least one of them.",
     )
     parser.add_argument("seeds", metavar="SEED", type=_seed, nargs="+", help="scenario seeds")
     parser.add_argument("-o", "--output", type=Path, required=True, help="output directory")
@@ -36,8 +37,8 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
         "--data-dir",
         type=Path,
         default=None,
-        help="folder of the real bathymetry grids (default: $AUVPLAN_SHARED_DATA/bathymetry, "
-        "else ../shared/data/bathymetry)",
+        help="folder of the real bathymetry grids, holding at least one of them (default: "
+        "$AUVPLAN_SHARED_DATA/bathymetry, else ../shared/data/bathymetry, which may be absent)",
     )
     parser.add_argument(
         "--kind",
@@ -56,8 +57,10 @@ def scenario_folder(output: Path, seed: int) -> Path:
 
 def run(args: argparse.Namespace) -> int:
     """Generate every scenario first, then write them; returns the exit code."""
-    from auvplan.scenarios import generate
+    from auvplan.scenarios import check_data_dir, generate
 
+    if args.data_dir is not None:
+        check_data_dir(args.data_dir)
     scenarios = [generate(seed, data_dir=args.data_dir, kind=args.kind) for seed in args.seeds]
     for scenario in scenarios:
         path = scenario.write(scenario_folder(args.output, scenario.seed))

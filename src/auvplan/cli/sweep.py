@@ -97,7 +97,8 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
         "--data-dir",
         type=Path,
         default=None,
-        help="with 'scenarios': folder of the real bathymetry grids (as 'auvplan scenarios')",
+        help="with 'scenarios': folder of the real bathymetry grids, holding at least one of "
+        "them (as 'auvplan scenarios')",
     )
     parser.set_defaults(run=run)
 
@@ -116,6 +117,10 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--workers must be at least 1, got {args.workers}")
     if args.evaluate and args.stage != "full":
         raise InputError(f"--evaluate needs the full plan, not --stage {args.stage}")
+    if args.data_dir is not None:
+        from auvplan.scenarios import check_data_dir
+
+        check_data_dir(args.data_dir)
     navigation = _navigation(args)
     require_dask()
     seeds: tuple[int | None, ...] = (None,) if args.seeds is None else parse_seeds(args.seeds)

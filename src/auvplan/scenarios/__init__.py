@@ -9,7 +9,8 @@ model, independently of the solver's report.
 
 from __future__ import annotations
 
+from auvplan.scenarios._terrain import check_data_dir
 from auvplan.scenarios.check import CheckFailure, CheckReport, check
 from auvplan.scenarios.family import Scenario, generate
 
-__all__ = ["CheckFailure", "CheckReport", "Scenario", "check", "generate"]
+__all__ = ["CheckFailure", "CheckReport", "Scenario", "check", "check_data_dir", "generate"]

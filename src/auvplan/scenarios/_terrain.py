@@ -26,6 +26,7 @@ from typing import Any, Final
 import numpy as np
 
 from auvplan._typing import FloatArray
+from auvplan.errors import InputError
 from auvplan.io.bathymetry import read_bathymetry
 from auvplan.terrain import (
     BathymetryGrid,
@@ -85,6 +86,30 @@ def default_data_dir() -> Path:
     """``$AUVPLAN_SHARED_DATA/bathymetry``, else ``../shared/data/bathymetry`` from the cwd."""
     shared = os.environ.get("AUVPLAN_SHARED_DATA")
     return (Path(shared) if shared else Path("..") / "shared" / "data") / "bathymetry"
+
+
+def check_data_dir(path: Path) -> None:
+    """Refuse a given data folder that holds none of the :data:`REAL_GRIDS`.
+
+    For a folder named on purpose (``--data-dir``): a typo would otherwise silently give the
+    family without real grids. The default folder (:func:`default_data_dir`) may be absent.
+
+    Raises
+    ------
+    InputError
+        If ``path`` is not a folder, or holds none of the real grid files (all are named).
+    """
+    grids = ", ".join(REAL_GRIDS.values())
+    if not path.is_dir():
+        state = "is not a folder" if path.exists() else "does not exist"
+        raise InputError(
+            f"data folder {path} {state}: it should hold the real bathymetry grids "
+            f"(at least one of {grids})"
+        )
+    if not any((path / name).is_file() for name in REAL_GRIDS.values()):
+        raise InputError(
+            f"data folder {path} holds none of the real bathymetry grids: lacks {grids}"
+        )
 
 
 @cache
