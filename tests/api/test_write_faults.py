@@ -8,6 +8,7 @@ one WriteError naming the file in the folder asked for and the cause, and leaves
 
 from __future__ import annotations
 
+import builtins
 import errno
 import io
 import os
@@ -28,6 +29,7 @@ import auvplan
 from auvplan.cli.main import main
 from auvplan.errors import WriteError
 from auvplan.io import writing as writing_module
+from auvplan.io.writing import shown_path
 
 CODES = (errno.ENOSPC, errno.EFBIG, errno.EROFS)
 DATA_FILES = (
@@ -67,8 +69,8 @@ class _RefusedFile:
 def _refuse(monkeypatch: pytest.MonkeyPatch, name: str, code: int) -> None:
     """Make every write of the file ``name`` (a path's last parts) fail as ``code`` would."""
 
-    def is_refused(path: object) -> bool:
-        return Path(str(path)).as_posix().endswith("/" + name)
+    def is_refused(path: object) -> bool:  # (a staged file by the name the user gave)
+        return shown_path(Path(str(path))).as_posix().endswith("/" + name)
 
     if name.endswith(".nc"):
         close = NetCDF4DataStore.close
@@ -91,7 +93,8 @@ def _refuse(monkeypatch: pytest.MonkeyPatch, name: str, code: int) -> None:
         handle = real_open(file, mode, *args, **kwargs)
         return _RefusedFile(handle, code) if "w" in mode and is_refused(file) else handle
 
-    monkeypatch.setattr(io, "open", refusing_open)
+    monkeypatch.setattr(io, "open", refusing_open)  # pathlib's
+    monkeypatch.setattr(builtins, "open", refusing_open)  # matplotlib's
 
 
 def _expected(folder: Path, name: str, code: int) -> str:
@@ -182,3 +185,28 @@ def test_a_real_file_size_limit_is_one_line_naming_the_file(
         lines[0],
     )
     _assert_nothing_left(out)
+
+
+@pytest.mark.parametrize("name", ["maps.nc", "maps.png"])
+def test_a_refused_file_of_auvplan_maps_is_one_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], name: str
+) -> None:
+    out = tmp_path / "out"
+    _refuse(monkeypatch, name, errno.ENOSPC)
+    assert main(["-q", "maps", "synthetic", "--seed", "3", "-o", str(out)]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"auvplan: error: {_expected(out, name, errno.ENOSPC)}"
+    ]
+    _assert_nothing_left(out)
+
+
+def test_a_refused_vehicle_figure_is_one_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    figure = tmp_path / "vehicle.png"
+    _refuse(monkeypatch, "vehicle.png", errno.EROFS)
+    assert main(["-q", "vehicle", "--figure", str(figure)]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"auvplan: error: cannot write {figure.resolve()}: Read-only file system"
+    ]
+    assert list(tmp_path.iterdir()) == []

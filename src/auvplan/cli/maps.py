@@ -63,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
     from auvplan.io.bathymetry import read_bathymetry
     from auvplan.io.maps_file import write_maps_netcdf
     from auvplan.io.output import staged_output_dir
+    from auvplan.io.writing import writing
     from auvplan.record.files import MAPS_FILE
     from auvplan.terrain import MapParameters, compute_terrain_maps, synthetic_bank
     from auvplan.viz.maps import plot_terrain_maps
@@ -98,7 +99,8 @@ def run(args: argparse.Namespace) -> int:
     figure_name = f"maps.{args.figure_format}"
     with staged_output_dir(args.output) as staging:
         write_maps_netcdf(maps, staging / MAPS_FILE)
-        (staging / figure_name).write_bytes(figure.data)
+        with writing(staging / figure_name):
+            (staging / figure_name).write_bytes(figure.data)
     if not args.quiet:
         _print_summary(maps, args.output, figure_name)
     return 0

@@ -78,10 +78,11 @@ def run(args: argparse.Namespace) -> int:
     table = vehicle_characteristics(model)
     if args.figure is not None:
         from auvplan.io.output import staged_output_file
+        from auvplan.io.writing import writing
         from auvplan.viz.vehicle import plot_vehicle_validation
 
         figure = plot_vehicle_validation(model)
-        with staged_output_file(args.figure) as staging:
+        with staged_output_file(args.figure) as staging, writing(staging):
             figure.savefig(staging, dpi=120)
     if args.json:
         document = {"characteristics": table.to_dict(), "units": UNITS}
