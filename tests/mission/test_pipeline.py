@@ -106,3 +106,32 @@ dt_s = 1.0
 
     assert abs(leaving_bearing("remus100")) < 15.0
     assert leaving_bearing("medusa") > 30.0
+
+
+def test_before_optimization_is_called_once_between_stages_2_and_3() -> None:
+    """The explicit event a second process waits on (not a progress stage's name)."""
+    from contextlib import contextmanager
+
+    from auvplan.mission.config import load_mission
+    from auvplan.mission.pipeline import Stage, run_mission
+
+    events: list[str] = []
+
+    @contextmanager
+    def progress(name: str, *, total: int | None = None):  # type: ignore[no-untyped-def]
+        del total
+        events.append(f"start {name}")
+        yield lambda label: None
+        events.append(f"end {name}")
+
+    golden = Path(__file__).parents[1] / "regression" / "golden_mission.toml"
+    run_mission(
+        load_mission(golden),
+        stage=Stage.FULL,
+        progress=progress,
+        before_optimization=lambda: events.append("hook"),
+    )
+    assert events.count("hook") == 1
+    hook = events.index("hook")
+    assert events[hook - 1] == "end deconflict"
+    assert events[hook + 1] == "start optimize"

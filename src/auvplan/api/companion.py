@@ -7,7 +7,8 @@ nothing with the mission's process but the disk caches) that
 * on the first run with a mission's vehicle types and solver settings
   (:meth:`Companion.warm_up`), runs :func:`auvplan.mission.warmup.warm_up`: it compiles the
   optimiser's kernels (about 30 s) while the mission's process compiles and runs its path
-  searches; stage 3 waits for it (:meth:`Companion.waiting`) and then reads the kernels from
+  searches; stage 3 waits for it (:meth:`Companion.wait_for_warm_up`, the pipeline's
+  ``before_optimization``) and then reads the kernels from
   numba's disk cache;
 * renders about half the figures of the output folder (:meth:`Companion.render_figures`)
   while the mission's process renders the rest.
@@ -35,8 +36,7 @@ import multiprocessing
 import signal
 import time
 import warnings
-from collections.abc import Callable, Iterator
-from contextlib import AbstractContextManager, contextmanager
+from contextlib import AbstractContextManager
 from multiprocessing.pool import AsyncResult, Pool
 from pathlib import Path
 from types import TracebackType
@@ -47,7 +47,6 @@ import numba
 import auvplan
 from auvplan.interrupts import checkpoint
 from auvplan.mission.config import MissionConfig
-from auvplan.mission.progress import ProgressReporter
 from auvplan.mission.warmup import warm_up, warm_up_missions
 from auvplan.optimization._kernel_cache import cache_root
 
@@ -58,8 +57,6 @@ if TYPE_CHECKING:
 logger = logging.getLogger(__name__)
 T = TypeVar("T")
 
-#: The stage that needs the warm-up's kernels (a name of the pipeline's progress).
-NEEDS_KERNELS = "optimize"
 #: How often a wait for the worker checks for a stop request, in seconds.
 POLL_S: Final = 0.05
 #: The figures that the worker draws: about half of the drawing time of a run (the maps,
@@ -135,18 +132,6 @@ class Companion(AbstractContextManager["Companion"]):
             marker.touch()
         except OSError as error:  # a read-only cache: the next run warms up again
             logger.info("cannot mark the warm-up done (%s)", error)
-
-    def waiting(self, progress: ProgressReporter) -> ProgressReporter:
-        """``progress`` that waits for the warm-up when stage :data:`NEEDS_KERNELS` begins."""
-
-        @contextmanager
-        def reporter(name: str, *, total: int | None = None) -> Iterator[Callable[[str], None]]:
-            if name == NEEDS_KERNELS:
-                self.wait_for_warm_up()
-            with progress(name, total=total) as advance:
-                yield advance
-
-        return reporter
 
     def render_figures(
         self, result: MissionResult, *, figure_format: str, dpi: int

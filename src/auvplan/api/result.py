@@ -300,7 +300,6 @@ def plan(
         stages: ProgressReporter = no_progress if reporter is None else reporter
         if companion is not None and last_stage is Stage.FULL:
             companion.warm_up(config)
-            stages = companion.waiting(stages)
         result = run_mission(
             config,
             stage=last_stage,
@@ -309,6 +308,7 @@ def plan(
             compare_paper=compare_paper,
             callback=None if reporter is None else reporter.iteration,
             progress=stages,
+            before_optimization=None if companion is None else companion.wait_for_warm_up,
         )
     return MissionPlan.from_result(result, warnings=warnings)
 

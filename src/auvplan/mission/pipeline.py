@@ -84,6 +84,7 @@ def run_mission(
     compare_paper: bool = False,
     callback: Callable[[Any], None] | None = None,
     progress: ProgressReporter = no_progress,
+    before_optimization: Callable[[], None] | None = None,
 ) -> MissionResult:
     """Run the pipeline on a validated mission up to ``stage``.
 
@@ -106,6 +107,9 @@ def run_mission(
     progress : ProgressReporter
         Told of each stage (by its ``timings`` name) and of each vehicle's A* search
         (:mod:`auvplan.mission.progress`).
+    before_optimization : callable, optional
+        Called once when stage 3 is about to start (after stage 2), e.g. to wait for the
+        optimiser's kernels compiled in another process (:mod:`auvplan.api.companion`).
     """
     timings: dict[str, float] = {}
     progress = with_checkpoints(progress)
@@ -143,6 +147,8 @@ def run_mission(
             config, layout, preplan, deconfliction, terrain_weight, callback=callback
         )
 
+    if before_optimization is not None:
+        before_optimization()
     try:
         plan = timed("optimize", lambda: optimize(config.weights.terrain))
         energy_only = None
