@@ -25,6 +25,8 @@ REPORT_FILE: Final = "report.html"
 EXPORT_FOLDER: Final = "export"
 #: The navigation evaluation (``auvplan evaluate``, ``sweep --evaluate``).
 NAVIGATION_FILE: Final = "navigation.json"
+#: A sweep's record of the run that wrote the folder (:mod:`auvplan.sweep.table`).
+RUN_RECORD_FILE: Final = "sweep_run.json"
 
 
 @dataclass(frozen=True)
@@ -72,6 +74,7 @@ __all__ = [
     "PATHS_FILE",
     "PLAN_FILES",
     "REPORT_FILE",
+    "RUN_RECORD_FILE",
     "SUMMARY_FILE",
     "PlanFiles",
 ]

@@ -43,11 +43,9 @@ from auvplan.io.output import staged_output_file
 from auvplan.io.results import write_json
 from auvplan.io.text import read_json
 from auvplan.record import PlanSummary, read_summary
-from auvplan.record.files import NAVIGATION_FILE
+from auvplan.record.files import NAVIGATION_FILE, RUN_RECORD_FILE
 from auvplan.sweep.spec import SweepRun
 
-#: The sweep's own record in each run folder.
-RUN_RECORD_FILE: Final = "sweep_run.json"
 TAN_COLUMN: Final = "tan_rmse_m"
 #: Further columns from ``navigation.json``: column -> key of ``plans.terrain_aware``.
 NAVIGATION_EXTRAS: Final = {
