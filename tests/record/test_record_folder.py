@@ -149,6 +149,8 @@ def _damage(folder: Path, damage: str) -> None:
     elif damage == "stale":
         del summary["digest"]["trajectories.csv"]  # as a --stage preplan rerun records it
         summary_path.write_text(json.dumps(summary))
+    elif damage == "depth":
+        (folder / "mission.toml").write_text('[mission]\ndepth_m = "deep"\n')
     elif damage == "other_maps":
         from auvplan.io.maps_file import write_maps_netcdf
 
@@ -172,6 +174,7 @@ def _damage(folder: Path, damage: str) -> None:
         ("edited", ["trajectories.csv is not the file the run of", "SHA-256 differs"]),
         ("stale", ["trajectories.csv is stale", "did not write it"]),
         ("other_maps", ["maps.nc was not written by the run of"]),
+        ("depth", ["mission.toml: mission.depth_m = 'deep' is not a number"]),
     ],
 )
 @pytest.mark.parametrize("verb", ["evaluate", "export"])

@@ -35,6 +35,7 @@ from auvplan.io.results import (
 )
 from auvplan.io.text import read_json, read_toml, write_toml
 from auvplan.io.writing import writing
+from auvplan.record.dataset import trajectories_dataset_of
 from auvplan.record.files import (
     DESIRED_FILE,
     MAIN_PLAN,
@@ -101,11 +102,18 @@ class PlanRecord:
 
     @property
     def depth(self) -> float:
-        """The plan's constant depth [m], positive down (``mission.toml``'s ``depth_m``)."""
-        depth = self.mission.get("mission", {}).get("depth_m", 0.0)
+        """The plan's constant depth [m], positive down (``mission.toml``'s ``depth_m``).
+
+        Raises
+        ------
+        DataFormatError
+            If ``mission.depth_m`` is not a finite number.
+        """
+        table = self.mission.get("mission", {})
+        depth = table.get("depth_m", 0.0) if isinstance(table, dict) else None
         if (
-            not isinstance(depth, int | float)
-            or isinstance(depth, bool)
+            isinstance(depth, bool)
+            or not isinstance(depth, int | float)
             or not math.isfinite(depth)
         ):
             raise DataFormatError(f"{MISSION_FILE}: mission.depth_m = {depth!r} is not a number")
@@ -179,8 +187,6 @@ def write_record(record: PlanRecord, directory: Path) -> list[Path]:
     InputError
         If ``record`` was read from a folder (it has no :class:`RunLayers` to write).
     """
-    from auvplan.record.dataset import trajectories_dataset_of
-
     layers = record.layers
     if layers is None:
         raise InputError("a record read from a folder is copied, not written again")
