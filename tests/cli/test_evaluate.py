@@ -95,7 +95,7 @@ def test_same_seed_same_json_and_only_the_plans_present(
     ("damage", "extra", "fragment"),
     [
         ("no_maps", [], "maps.nc not found"),
-        ("no_trajectories", [], "has no trajectories.csv"),
+        ("no_trajectories", [], "trajectories.csv is missing: the run of"),
         ("bad_column", [], "no column 'psi' of vehicle 'blue'"),
         ("bad_number", [], "is not a finite number"),
         (None, ["--runs", "0"], "--runs must be >= 1"),

@@ -41,3 +41,8 @@ def test_trajectories_of_an_earlier_run_are_refused(
     assert not (folder / "export").exists()
     with pytest.raises(DataFormatError, match="stale"):
         auvplan.load(folder)
+    for stale in folder.glob("trajectories*"):
+        stale.unlink()
+    assert auvplan.load(folder).status is None  # a pre-planned folder, as written
+    assert main(["evaluate", str(folder), "--runs", "2"]) == 2
+    assert "run the plan to the full stage first" in capsys.readouterr().err

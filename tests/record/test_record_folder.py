@@ -149,6 +149,11 @@ def _damage(folder: Path, damage: str) -> None:
     elif damage == "stale":
         del summary["digest"]["trajectories.csv"]  # as a --stage preplan rerun records it
         summary_path.write_text(json.dumps(summary))
+    elif damage == "field":
+        csv_path.write_text("vehicle,t\nsix," + "9" * 200_000 + "\n")
+    elif damage == "missing":
+        csv_path.unlink()
+        csv_path.mkdir()
     elif damage == "depth":
         (folder / "mission.toml").write_text('[mission]\ndepth_m = "deep"\n')
     elif damage == "other_maps":
@@ -174,6 +179,8 @@ def _damage(folder: Path, damage: str) -> None:
         ("edited", ["trajectories.csv is not the file the run of", "SHA-256 differs"]),
         ("stale", ["trajectories.csv is stale", "did not write it"]),
         ("other_maps", ["maps.nc was not written by the run of"]),
+        ("field", ["trajectories.csv: not a CSV table (field larger than field limit"]),
+        ("missing", ["trajectories.csv is missing: the run of"]),
         ("depth", ["mission.toml: mission.depth_m = 'deep' is not a number"]),
     ],
 )

@@ -262,6 +262,10 @@ def read_record(folder: Path) -> PlanRecord:
     for label, files in PLAN_FILES.items():
         path = folder / files.csv
         if not path.is_file():
+            if label == MAIN_PLAN and digest is not None and files.csv in digest:
+                raise DataFormatError(
+                    f"{path} is missing: the run of {folder / SUMMARY_FILE} wrote it"
+                )
             continue
         if digest is not None and files.csv not in digest:
             raise DataFormatError(

@@ -108,6 +108,8 @@ def read_trajectory_tables(
             lines = list(csv.reader(handle))
     except UnicodeDecodeError:
         raise DataFormatError(f"{path}: not a UTF-8 text file") from None
+    except csv.Error as error:
+        raise DataFormatError(f"{path}: not a CSV table ({error})") from None
     if not lines or not lines[0]:
         raise DataFormatError(f"{path}: empty file (no header)")
     header, rows = lines[0], lines[1:]
