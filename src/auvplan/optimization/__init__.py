@@ -33,7 +33,7 @@ from auvplan.optimization.barrier import (
 )
 from auvplan.optimization.block_kernels import BlockKernels, block_kernels
 from auvplan.optimization.constraints import ConstraintModel, discretize_constraints
-from auvplan.optimization.discretization import DiscreteModel, discretize_rk4
+from auvplan.optimization.discretization import DiscreteModel, StepModel, discretize_rk4
 from auvplan.optimization.integration import choose_substeps
 from auvplan.optimization.ipopt import IpoptResult, IpoptStatus, solve_ipopt
 from auvplan.optimization.linesearch import (
@@ -96,6 +96,7 @@ __all__ = [
     "StageBackend",
     "StageBlock",
     "StageWeights",
+    "StepModel",
     "StepTrial",
     "TerminalCost",
     "TerminalRegulator",

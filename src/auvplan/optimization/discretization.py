@@ -27,6 +27,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Protocol
 
 import casadi as ca
 import numpy as np
@@ -47,6 +48,69 @@ from auvplan.optimization.integration import check_substeps, rk4_step
 from auvplan.optimization.stage_functions import StageFunctions
 
 __all__ = ["DiscreteModel", "discretize_rk4"]
+
+
+class StepModel(Protocol):
+    """What the solver needs of a discrete model ``x_{k+1} = F(x_k, u_k, p_k)`` and its cost.
+
+    Implemented by :class:`DiscreteModel` (stacked CasADi functions) and
+    :class:`~auvplan.optimization.separable.BlockDiscreteModel` (compiled per-block kernels).
+    Arrays are time-major: ``states`` ``(N, n_x)``, ``inputs`` ``(N, n_u)``, ``parameters``
+    ``(N, n_p)`` for the ``N`` stages.
+    """
+
+    @property
+    def n_x(self) -> int:
+        """State dimension."""
+        ...
+
+    @property
+    def n_u(self) -> int:
+        """Input dimension."""
+        ...
+
+    def cost(self, states: FloatArray, inputs: FloatArray, parameters: FloatArray) -> FloatArray:
+        """Stage costs ``L(x_k, u_k, p_k)``, shape ``(N,)``."""
+        ...
+
+    def first_order(
+        self, states: FloatArray, inputs: FloatArray, parameters: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+        """``(F_x, F_u, L, L_x, L_u)``."""
+        ...
+
+    def jacobians(
+        self, states: FloatArray, inputs: FloatArray, parameters: FloatArray
+    ) -> tuple[FloatArray, FloatArray]:
+        """``F_x (N, n_x, n_x)`` and ``F_u (N, n_x, n_u)``."""
+        ...
+
+    def cost_hessians(
+        self, states: FloatArray, inputs: FloatArray, parameters: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Hessian blocks ``L_xx``, ``L_xu``, ``L_uu`` of the stage cost."""
+        ...
+
+    def lagrangian_hessians(
+        self,
+        states: FloatArray,
+        inputs: FloatArray,
+        parameters: FloatArray,
+        costate_next: FloatArray,
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Hessian blocks of ``L + λ_{k+1}ᵀ F``."""
+        ...
+
+    def rollout(
+        self,
+        initial_state: FloatArray,
+        reference_states: FloatArray,
+        reference_inputs: FloatArray,
+        gains: FloatArray,
+        parameters: FloatArray,
+    ) -> tuple[FloatArray, FloatArray]:
+        """Closed-loop simulation ``u_k = μ_k + K_k (α_k − x_k)``: states and inputs."""
+        ...
 
 
 @dataclass(frozen=True, eq=False)

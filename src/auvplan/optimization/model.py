@@ -17,7 +17,7 @@ from auvplan._typing import BoolArray, FloatArray
 from auvplan.optimization._numba_codegen import UnsupportedOperation
 from auvplan.optimization.barrier import BarrierKind
 from auvplan.optimization.constraints import ConstraintModel, discretize_constraints
-from auvplan.optimization.discretization import DiscreteModel, discretize_rk4
+from auvplan.optimization.discretization import StepModel, discretize_rk4
 from auvplan.optimization.options import StageBackend
 from auvplan.optimization.problem import TrajectoryProblem
 from auvplan.optimization.separable import BlockDiscreteModel
@@ -36,7 +36,7 @@ class ProntoModel:
     ----------
     problem : TrajectoryProblem
         The problem.
-    discrete : DiscreteModel or BlockDiscreteModel
+    discrete : StepModel
         Step ``F`` and stage cost ``L`` with their derivatives (CasADi or block kernels).
     terminal : TerminalCost
         ``m(x_N)`` with its derivatives.
@@ -52,7 +52,7 @@ class ProntoModel:
     """
 
     problem: TrajectoryProblem
-    discrete: DiscreteModel | BlockDiscreteModel
+    discrete: StepModel
     terminal: TerminalCost
     constraints: ConstraintModel | None
     slack_scales: FloatArray
@@ -65,9 +65,7 @@ class ProntoModel:
         return self.constraints is not None and self.constraints.n_c > 0
 
 
-def _discrete_model(
-    problem: TrajectoryProblem, backend: StageBackend
-) -> DiscreteModel | BlockDiscreteModel:
+def _discrete_model(problem: TrajectoryProblem, backend: StageBackend) -> StepModel:
     """The step's evaluator: block kernels when possible, else the stacked CasADi functions."""
     if problem.blocks and backend.stage_kernels:
         sizes = (problem.n_states, problem.n_inputs, problem.n_parameters)

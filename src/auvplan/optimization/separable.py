@@ -16,7 +16,7 @@ equations; the IPOPT reference and the CasADi path use them), and
 :class:`BlockDiscreteModel` evaluates the discrete step and its derivatives block by block
 with the compiled substep kernels (:mod:`~auvplan.optimization.block_kernels`): blocks with
 the same model share one kernel set and are evaluated together, the stacked derivatives are
-block-diagonal. It has the interface of :class:`~auvplan.optimization.discretization.DiscreteModel`.
+block-diagonal. It is a :class:`~auvplan.optimization.discretization.StepModel`.
 """
 
 from __future__ import annotations

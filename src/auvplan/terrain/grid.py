@@ -189,11 +189,6 @@ class BathymetryGrid:
                 f"depth_std shape {self.depth_std.shape} does not match depth {self.depth.shape}"
             )
 
-    @property
-    def is_navigable(self) -> FloatArray:
-        """Boolean mask of cells with a finite depth (NaN/land cells are no-go)."""
-        return np.asarray(np.isfinite(self.depth))
-
     def window(
         self, north: tuple[float, float] | None = None, east: tuple[float, float] | None = None
     ) -> BathymetryGrid:

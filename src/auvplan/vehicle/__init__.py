@@ -30,8 +30,6 @@ from auvplan.vehicle.approximation import (
 )
 from auvplan.vehicle.dynamics import (
     INPUT_NAMES,
-    N_INPUTS,
-    N_STATES,
     STATE_NAMES,
     STATE_UNITS,
     VehicleModel,
@@ -97,8 +95,6 @@ from auvplan.vehicle.trim import (
 
 __all__ = [
     "INPUT_NAMES",
-    "N_INPUTS",
-    "N_STATES",
     "STATE_NAMES",
     "STATE_UNITS",
     "ActuatedVehicleParams",

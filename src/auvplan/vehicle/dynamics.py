@@ -66,8 +66,6 @@ STATE_NAMES: Final = (*BODY_STATE_NAMES, "n_ps", "n_sb")
 STATE_UNITS: Final = ("m", "m", "rad", "m/s", "m/s", "rad/s", "rev/s", "rev/s")
 #: Names of the 2 inputs of the twin-thruster layout (dimensionless propeller commands).
 INPUT_NAMES: Final = ("c_ps", "c_sb")
-N_STATES: Final = 8
-N_INPUTS: Final = 2
 
 
 @dataclass(frozen=True, eq=False)
@@ -436,8 +434,6 @@ def energy(time: FloatArray, states: FloatArray, inputs: FloatArray, model: Vehi
 
 __all__ = [
     "INPUT_NAMES",
-    "N_INPUTS",
-    "N_STATES",
     "STATE_NAMES",
     "STATE_UNITS",
     "VehicleModel",
