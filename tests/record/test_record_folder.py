@@ -154,6 +154,12 @@ def _damage(folder: Path, damage: str) -> None:
     elif damage == "missing":
         csv_path.unlink()
         csv_path.mkdir()
+    elif damage == "no_v":
+        summary["vehicles"][0]["state_names"].remove("v")
+        summary_path.write_text(json.dumps(summary))
+    elif damage == "twins":
+        summary["vehicles"][1]["name"] = "six"
+        summary_path.write_text(json.dumps(summary))
     elif damage == "depth":
         (folder / "mission.toml").write_text('[mission]\ndepth_m = "deep"\n')
     elif damage == "other_maps":
@@ -181,6 +187,8 @@ def _damage(folder: Path, damage: str) -> None:
         ("other_maps", ["maps.nc was not written by the run of"]),
         ("field", ["trajectories.csv: not a CSV table (field larger than field limit"]),
         ("missing", ["trajectories.csv is missing: the run of"]),
+        ("no_v", ["trajectories.csv vehicle 'six'", "lack 'v' (every vehicle has"]),
+        ("twins", ["summary.json: entry (document): value error, vehicle name 'six' appears"]),
         ("depth", ["mission.toml: mission.depth_m = 'deep' is not a number"]),
     ],
 )

@@ -13,7 +13,14 @@ from __future__ import annotations
 from datetime import datetime
 from typing import Annotated, Any, Literal
 
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    model_validator,
+)
 
 from auvplan.errors import DataFormatError
 from auvplan.record.files import PLAN_FILES
@@ -162,6 +169,14 @@ class PlanSummary(_Entry):
     paper: PlanOutcome | None = None
     current_comparison: dict[str, Any] | None = None
     digest: dict[str, str] | None = None
+
+    @model_validator(mode="after")
+    def _unique_names(self) -> PlanSummary:
+        names = [vehicle.name for vehicle in self.vehicles]
+        twice = next((name for name in names if names.count(name) > 1), None)
+        if twice is not None:
+            raise ValueError(f"vehicle name {twice!r} appears twice")
+        return self
 
     @property
     def start(self) -> datetime:

@@ -24,6 +24,8 @@ from auvplan.record.summary import VehicleSummary
 
 #: Margin on a vehicle's top speed [-] beyond which a row is not a plan of that vehicle.
 SPEED_MARGIN: Final = 1.5
+#: The states of every vehicle type: pose ``eta`` and body velocities ``nu`` (Fossen).
+BODY_STATES: Final = ("north", "east", "psi", "u", "v", "r")
 
 
 @dataclass(frozen=True)
@@ -143,6 +145,12 @@ def _vehicle_table(
     if not rows:
         raise DataFormatError(f"{path}: no rows of vehicle {vehicle.name!r}")
     state_names, input_names = _own_columns(vehicle, header, rows[0][1])
+    lacking = [name for name in BODY_STATES if name not in state_names]
+    if lacking:
+        raise DataFormatError(
+            f"{path} vehicle {vehicle.name!r}: its states {', '.join(state_names)} lack "
+            f"{lacking[0]!r} (every vehicle has {', '.join(BODY_STATES)})"
+        )
     own = ("t", *state_names, *input_names, "power")
     missing = [name for name in own if name not in header]
     if missing:
@@ -245,4 +253,4 @@ def _number(text: str, where: str, vehicle: str, column: str) -> float:
     return value
 
 
-__all__ = ["SPEED_MARGIN", "VehicleTrajectory", "read_trajectory_tables"]
+__all__ = ["BODY_STATES", "SPEED_MARGIN", "VehicleTrajectory", "read_trajectory_tables"]
