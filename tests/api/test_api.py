@@ -24,13 +24,14 @@ def test_public_namespace_is_curated_and_lazy() -> None:
         assert getattr(auvplan, name) is not None
     with pytest.raises(AttributeError, match="no attribute 'nope'"):
         _ = auvplan.nope  # type: ignore[attr-defined]
-    # `import auvplan` alone loads none of the heavy packages (the CLI starts fast)
+    # `import auvplan` alone loads none of the heavy packages (the CLI starts fast): the
+    # version and the error types only
     heavy = ("auvplan.", "casadi", "matplotlib", "xarray")
     code = f"import sys, auvplan; print(sorted(m for m in sys.modules if m.startswith({heavy})))"
     loaded = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, check=True
     )
-    assert loaded.stdout.strip() == "['auvplan.errors']"
+    assert loaded.stdout.strip() == "['auvplan._version', 'auvplan.errors']"
 
 
 def test_to_xarray_is_trajectories_nc(

@@ -44,7 +44,6 @@ DATA_FILES = (
 )
 FIGURE_FILES = ("paths.png", "report.html")
 #: Written by ``api/folder.py`` (another owner), which does not use ``io.writing`` yet.
-UNWRAPPED = pytest.mark.xfail(strict=True, reason="api/folder.py writes it without io.writing")
 
 
 class _RefusedFile:
@@ -125,7 +124,7 @@ def test_a_refused_data_file_stops_the_save_naming_it(
     _assert_nothing_left(out)
 
 
-@pytest.mark.parametrize("name", [pytest.param(n, marks=UNWRAPPED) for n in FIGURE_FILES])
+@pytest.mark.parametrize("name", FIGURE_FILES)
 def test_a_refused_figure_or_report_stops_the_save_naming_it(
     mission_plan: auvplan.MissionPlan, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, name: str
 ) -> None:

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 from auvplan._figures import DEFAULT_DPI
 from auvplan.export import DEFAULT_TOLERANCE_M, MoosFrame, write_exports
 from auvplan.io.output import staged_output_dir
+from auvplan.io.writing import writing
 from auvplan.mission.pipeline import MissionResult
 from auvplan.record import PlanRecord, export_plan, write_record
 from auvplan.record.files import EXPORT_FOLDER, REPORT_FILE
@@ -89,13 +90,14 @@ def write_output_folder(
             )
         for stem, figure in rendered.items():
             path = staging / f"{stem}.{figure.figure_format}"
-            path.write_bytes(figure.data)
+            with writing(path):
+                path.write_bytes(figure.data)
             written.append(path)
         report = staging / REPORT_FILE
         names = [path.relative_to(staging).as_posix() for path in [*written, report]]
-        report.write_text(
-            render_report(record.summary.document(), rendered, files=names), encoding="utf-8"
-        )
+        page = render_report(record.summary.document(), rendered, files=names)
+        with writing(report):
+            report.write_text(page, encoding="utf-8")
         written.append(report)
         return [target / path.relative_to(staging) for path in written]
 
