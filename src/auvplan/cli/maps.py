@@ -1,10 +1,9 @@
 """``auvplan maps``: terrain-information maps (paper Fig. 5) from a bathymetry file.
 
 Writes ``DIR/maps.nc`` and ``DIR/maps.png`` (or ``.svg``/``.pdf``, ``--figure-format``)
-all-or-nothing: ``DIR`` is checked before any work
-(by :mod:`auvplan.cli.main`) and replaced as a whole at the end
-(:func:`auvplan.io.output.staged_output_dir`: other files already in ``DIR`` are kept); on any
-error nothing is written.
+all-or-nothing (:func:`auvplan.api.maps.write_terrain_maps`): ``DIR`` is checked before any
+work (by :mod:`auvplan.cli.main`) and replaced as a whole at the end (other files already in
+``DIR`` are kept); on any error nothing is written.
 """
 
 from __future__ import annotations
@@ -60,53 +59,32 @@ def _pair(values: list[float] | None) -> tuple[float, float] | None:
 
 def run(args: argparse.Namespace) -> int:
     """Compute the maps and write them; returns the exit code."""
-    from auvplan.io.bathymetry import read_bathymetry
-    from auvplan.io.maps_file import write_maps_netcdf
-    from auvplan.io.output import staged_output_dir
-    from auvplan.io.writing import writing
-    from auvplan.record.files import MAPS_FILE
-    from auvplan.terrain import MapParameters, compute_terrain_maps, synthetic_bank
-    from auvplan.viz.maps import plot_terrain_maps
-    from auvplan.viz.report import render_figure
+    from auvplan.api.maps import write_terrain_maps
+    from auvplan.terrain import MapParameters
 
-    parameters = MapParameters(
-        exponent=args.exponent,
-        block=(int(args.block[0]), int(args.block[1])),
-        omega=args.omega,
-        weight=args.weight,
+    folder = write_terrain_maps(
+        None if args.bathymetry == "synthetic" else args.bathymetry,
+        args.output,
+        parameters=MapParameters(
+            exponent=args.exponent,
+            block=(int(args.block[0]), int(args.block[1])),
+            omega=args.omega,
+            weight=args.weight,
+        ),
+        seed=args.seed,
+        window_north=_pair(args.window_north),
+        window_east=_pair(args.window_east),
+        window_lat=_pair(args.window_lat),
+        window_lon=_pair(args.window_lon),
+        figure_format=args.figure_format,
+        dpi=args.dpi,
     )
-    window_north, window_east = _pair(args.window_north), _pair(args.window_east)
-    if args.bathymetry == "synthetic":
-        if args.window_lat is not None or args.window_lon is not None:
-            from auvplan.errors import InputError
-
-            raise InputError(
-                "the synthetic bank has no geographic reference: use --window-north/east"
-            )
-        grid = synthetic_bank(seed=args.seed)
-        if window_north is not None or window_east is not None:
-            grid = grid.window(north=window_north, east=window_east)
-    else:
-        grid = read_bathymetry(
-            args.bathymetry,
-            window_north=window_north,
-            window_east=window_east,
-            window_lat=_pair(args.window_lat),
-            window_lon=_pair(args.window_lon),
-        )
-    maps = compute_terrain_maps(grid, parameters)
-    figure = render_figure(plot_terrain_maps(maps), figure_format=args.figure_format, dpi=args.dpi)
-    figure_name = f"maps.{args.figure_format}"
-    with staged_output_dir(args.output) as staging:
-        write_maps_netcdf(maps, staging / MAPS_FILE)
-        with writing(staging / figure_name):
-            (staging / figure_name).write_bytes(figure.data)
     if not args.quiet:
-        _print_summary(maps, args.output, figure_name)
+        _print_summary(folder.maps, folder.written)
     return 0
 
 
-def _print_summary(maps: TerrainMaps, output: Path, figure_name: str) -> None:
+def _print_summary(maps: TerrainMaps, written: tuple[Path, ...]) -> None:
     import numpy as np
 
     fine, coarse = maps.bathymetry.geometry, maps.cost_geometry
@@ -122,4 +100,4 @@ def _print_summary(maps: TerrainMaps, output: Path, figure_name: str) -> None:
         f"cost grid    {coarse.n_rows} x {coarse.n_cols} blocks of {coarse.spacing_north:.2f} m x "
         f"{coarse.spacing_east:.2f} m; shifted cost {np.nanmin(cost):.2f} … {np.nanmax(cost):.2f}"
     )
-    print(f"wrote        {output / 'maps.nc'}, {output / figure_name}")
+    print(f"wrote        {', '.join(str(path) for path in written)}")

@@ -7,6 +7,7 @@ import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Final
 
 import numpy as np
@@ -86,18 +87,59 @@ class PreplanStage:
 def load_terrain(terrain: TerrainConfig) -> BathymetryGrid:
     """The mission's bathymetry: a file (any supported format) or the synthetic bank."""
     window = terrain.window
-    if terrain.synthetic:
-        if window.is_geographic:
-            raise InputError("terrain.window: the synthetic bank has no lat/lon; use north/east")
-        grid = synthetic_bank(seed=terrain.seed)
-        return grid.window(window.north, window.east) if window.north or window.east else grid
-    assert terrain.file is not None  # guaranteed by TerrainConfig
-    return read_bathymetry(
-        terrain.file,
+    return read_terrain(
+        None if terrain.synthetic else terrain.file,
+        seed=terrain.seed,
         window_north=window.north,
         window_east=window.east,
         window_lat=window.lat,
         window_lon=window.lon,
+    )
+
+
+def read_terrain(
+    file: str | Path | None,
+    *,
+    seed: int = 7,
+    window_north: tuple[float, float] | None = None,
+    window_east: tuple[float, float] | None = None,
+    window_lat: tuple[float, float] | None = None,
+    window_lon: tuple[float, float] | None = None,
+) -> BathymetryGrid:
+    """A bathymetry file (any format of :func:`~auvplan.io.bathymetry.read_bathymetry`) or the bank.
+
+    Parameters
+    ----------
+    file : str, Path or None
+        The bathymetry file; None for the synthetic bank
+        (:func:`~auvplan.terrain.synthetic.synthetic_bank`).
+    seed : int
+        Seed of the synthetic bank (unused for a file).
+    window_north, window_east : (float, float), optional
+        Crop to these north and east ranges [m].
+    window_lat, window_lon : (float, float), optional
+        Crop to these latitude and longitude ranges [deg] (files with a geographic reference).
+
+    Raises
+    ------
+    InputError
+        If the synthetic bank is cropped in lat/lon, or a window leaves no cell.
+    DataFormatError
+        If the file cannot be read (:func:`~auvplan.io.bathymetry.read_bathymetry`).
+    """
+    if file is None:
+        if window_lat is not None or window_lon is not None:
+            raise InputError(
+                "the synthetic bank has no geographic reference: crop it in north/east, not lat/lon"
+            )
+        grid = synthetic_bank(seed=seed)
+        return grid.window(window_north, window_east) if window_north or window_east else grid
+    return read_bathymetry(
+        file,
+        window_north=window_north,
+        window_east=window_east,
+        window_lat=window_lat,
+        window_lon=window_lon,
     )
 
 
