@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +13,9 @@ from auvplan.cli.main import main
 from auvplan.record import VehicleTrajectory
 from auvplan.terrain import BathymetryGrid, GridGeometry, compute_terrain_maps
 from auvplan.vehicle import INPUT_NAMES, STATE_NAMES
-from conftest import PlanFolderWriter
+
+#: The ``write_plan_folder`` fixture of ``tests/conftest.py``.
+PlanFolderWriter = Callable[..., Path]
 
 FAST = ["--runs", "3", "--particles", "200", "--seed", "1", "--update-period", "2"]
 

@@ -194,7 +194,7 @@ def test_export_user_errors(
     message = _fails_cleanly(["export", str(folder), "--format", "gpx,dxf"], folder, capsys)
     assert "unknown export format 'dxf'" in message
     message = _fails_cleanly(["export", str(folder), "--format", "gpx"], folder, capsys)
-    assert "holds no optimised plan" in message
+    assert "trajectories.csv is missing: the run of" in message
     assert _fails_cleanly(["export", str(tmp_path), "--format", "gpx"], tmp_path, capsys).endswith(
         "(no summary.json)"
     )

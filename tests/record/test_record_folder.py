@@ -9,6 +9,7 @@ vehicle and the column, nothing written).
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +24,9 @@ from auvplan.sweep.navigation import NavigationOptions, evaluate_folder
 from auvplan.terrain import BathymetryGrid, GridGeometry, LocalProjection, compute_terrain_maps
 from auvplan.terrain.maps import TerrainMaps
 from auvplan.vehicle import INPUT_NAMES, STATE_NAMES
-from conftest import PlanFolderWriter
+
+#: The ``write_plan_folder`` fixture of ``tests/conftest.py``.
+PlanFolderWriter = Callable[..., Path]
 
 #: A 6-state vehicle type (no actuator states: surge force and yaw moment commanded directly).
 SIX_STATES = ("north", "east", "psi", "u", "v", "r")
