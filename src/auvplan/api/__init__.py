@@ -2,24 +2,57 @@
 
 :mod:`auvplan.api.result` plans and loads missions, :mod:`auvplan.api.folder` writes output
 folders (data, exports, figures, ``report.html``), :mod:`auvplan.api.maps` writes the terrain
-maps of a bathymetry, :mod:`auvplan.api.progress` shows progress on the console. The command
-line is built on these.
+maps of a bathymetry, :mod:`auvplan.api.vehicle` describes a vehicle type,
+:mod:`auvplan.api.progress` shows progress on the console. The command line is built on these.
+
+The names are imported on first use, so a verb that needs one module (``auvplan vehicle``)
+does not load the planning pipeline.
 """
 
 from __future__ import annotations
 
-from auvplan.api.folder import write_output_folder
-from auvplan.api.maps import MapsFolder, write_terrain_maps
-from auvplan.api.progress import ConsoleProgress
-from auvplan.api.result import MissionPlan, MissionSource, load, plan
+import importlib
+from typing import TYPE_CHECKING, Any
+
+#: Public name -> the module that defines it (imported on first access).
+_LAZY = {
+    "write_output_folder": "auvplan.api.folder",
+    "MapsFolder": "auvplan.api.maps",
+    "write_terrain_maps": "auvplan.api.maps",
+    "ConsoleProgress": "auvplan.api.progress",
+    "MissionPlan": "auvplan.api.result",
+    "MissionSource": "auvplan.api.result",
+    "load": "auvplan.api.result",
+    "plan": "auvplan.api.result",
+    "VehicleDescription": "auvplan.api.vehicle",
+    "describe_vehicle": "auvplan.api.vehicle",
+}
+
+if TYPE_CHECKING:
+    from auvplan.api.folder import write_output_folder
+    from auvplan.api.maps import MapsFolder, write_terrain_maps
+    from auvplan.api.progress import ConsoleProgress
+    from auvplan.api.result import MissionPlan, MissionSource, load, plan
+    from auvplan.api.vehicle import VehicleDescription, describe_vehicle
 
 __all__ = [
     "ConsoleProgress",
     "MapsFolder",
     "MissionPlan",
     "MissionSource",
+    "VehicleDescription",
+    "describe_vehicle",
     "load",
     "plan",
     "write_output_folder",
     "write_terrain_maps",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name of :data:`__all__` on first use (PEP 562)."""
+    if name not in _LAZY:
+        raise AttributeError(f"module 'auvplan.api' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_LAZY[name]), name)
+    globals()[name] = value
+    return value

@@ -10,24 +10,6 @@ if TYPE_CHECKING:
     from auvplan.vehicle.params import Propeller
     from auvplan.vehicle.trim import VehicleCharacteristics
 
-#: Units of the JSON fields (SI; propeller speeds in rev/s).
-UNITS = {
-    "n_max": "rev/s",
-    "bollard_thrust": "N",
-    "bollard_torque": "N m",
-    "bollard_power": "W",
-    "top_speed": "m/s",
-    "cruise_speed": "m/s",
-    "cruise_energy_per_metre": "J/m",
-    "hotel_power": "W",
-    "power_at_0_5": "W",
-    "power_at_1_0": "W",
-    "n_at_0_5": "rev/s",
-    "n_at_1_0": "rev/s",
-    "max_yaw_rate": "rad/s",
-    "turning_radius": "m",
-}
-
 
 def register(subparsers: argparse._SubParsersAction[Any]) -> None:
     """Add the ``vehicle`` verb to the command line."""
@@ -67,28 +49,15 @@ def run(args: argparse.Namespace) -> int:
     """Compute and print the characteristics; returns the exit code."""
     import json
 
-    from auvplan.io.vehicles import load_vehicle
-    from auvplan.vehicle.dynamics import build_vehicle_model
-    from auvplan.vehicle.trim import vehicle_characteristics
+    from auvplan.api.vehicle import describe_vehicle
 
     if args.figure is not None:
         _check_figure_path(args.figure)
-    params = load_vehicle(args.vehicle)
-    model = build_vehicle_model(params, propeller_order=args.order)
-    table = vehicle_characteristics(model)
-    if args.figure is not None:
-        from auvplan.io.output import staged_output_file
-        from auvplan.io.writing import writing
-        from auvplan.viz.vehicle import plot_vehicle_validation
-
-        figure = plot_vehicle_validation(model)
-        with staged_output_file(args.figure) as staging, writing(staging):
-            figure.savefig(staging, dpi=120)
+    description = describe_vehicle(args.vehicle, propeller_order=args.order, figure=args.figure)
     if args.json:
-        document = {"characteristics": table.to_dict(), "units": UNITS}
-        print(json.dumps(document, indent=2))
+        print(json.dumps(description.characteristics.to_document(), indent=2))
     elif not args.quiet:
-        _print_table(table, model.vehicle.propeller)
+        _print_table(description.characteristics, description.propeller)
     if args.figure is not None and not args.quiet and not args.json:
         print(f"wrote                      {args.figure}")
     return 0

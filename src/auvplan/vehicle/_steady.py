@@ -6,7 +6,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from functools import cache
-from typing import NamedTuple
+from typing import Final, NamedTuple
 
 import casadi as ca
 import numpy as np
@@ -133,6 +133,25 @@ def solve_equilibrium(
     raise SolverError(f"{what} did not converge: {message}")
 
 
+#: Units of the fields of :class:`VehicleCharacteristics` (SI; propeller speeds in rev/s).
+CHARACTERISTIC_UNITS: Final = {
+    "n_max": "rev/s",
+    "bollard_thrust": "N",
+    "bollard_torque": "N m",
+    "bollard_power": "W",
+    "top_speed": "m/s",
+    "cruise_speed": "m/s",
+    "cruise_energy_per_metre": "J/m",
+    "hotel_power": "W",
+    "power_at_0_5": "W",
+    "power_at_1_0": "W",
+    "n_at_0_5": "rev/s",
+    "n_at_1_0": "rev/s",
+    "max_yaw_rate": "rad/s",
+    "turning_radius": "m",
+}
+
+
 @dataclass(frozen=True)
 class VehicleCharacteristics:
     """Headline numbers of a vehicle type (what ``auvplan vehicle`` prints)."""
@@ -184,8 +203,16 @@ class VehicleCharacteristics:
         """
         return dict(asdict(self))
 
+    def to_document(self) -> dict[str, dict[str, float | int | str]]:
+        """The JSON document of ``auvplan vehicle --json``: the fields and their units.
+
+        ``{"characteristics": self.to_dict(), "units": CHARACTERISTIC_UNITS}``.
+        """
+        return {"characteristics": self.to_dict(), "units": dict(CHARACTERISTIC_UNITS)}
+
 
 __all__ = [
+    "CHARACTERISTIC_UNITS",
     "NU",
     "BollardPull",
     "CruiseOptimum",

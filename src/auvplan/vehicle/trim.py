@@ -18,6 +18,7 @@ from scipy.optimize import brentq, minimize_scalar
 from auvplan._typing import FloatArray
 from auvplan.errors import InfeasibleError, InputError, SolverError
 from auvplan.vehicle._steady import (
+    CHARACTERISTIC_UNITS,
     BollardPull,
     CruiseOptimum,
     SteadyMotion,
@@ -420,6 +421,7 @@ def vehicle_characteristics(model: VehicleModel) -> VehicleCharacteristics:
 
 
 __all__ = [
+    "CHARACTERISTIC_UNITS",
     "BollardPull",
     "CruiseOptimum",
     "SteadyMotion",
