@@ -29,6 +29,7 @@ import json
 import math
 import os
 import random
+import re
 import shutil
 import signal
 import tempfile
@@ -44,9 +45,14 @@ from hypothesis import HealthCheck, event, given, note, settings
 from hypothesis import strategies as st
 
 from auvplan.cli.main import main
-from conftest import SHARED_DATA
 from export._plans import MISSION, write_geographic_grid
 
+SHARED_BATHYMETRY = (
+    Path(
+        os.environ.get("AUVPLAN_SHARED_DATA", Path(__file__).parents[2] / ".." / "shared" / "data")
+    )
+    / "bathymetry"
+)
 #: A case taking longer than this [s] is a hang.
 TIMEOUT_S = 60.0
 #: Written by ``@`` at the start of an argument: the case's folder (also the current folder).
@@ -148,9 +154,10 @@ def damaged_folder_cases(draw: st.DrawFn) -> Case:
 #: Numbers a careless user or a script may pass.
 BAD_NUMBERS: tuple[str, ...] = (
     "-1", "0", "-0", "nan", "NaN", "inf", "-inf", "1e300", "-1e300", "1e-300", "1e999",
-    "9223372036854775808", "1" + "0" * 400, "0x10", "1_0", "1e", "", " ", "½", "２", "名前",
+    "9223372036854775808", "1" + "0" * 400, "1" + "0" * 5000, "0x10", "1_0", "1e", "", " ",
+    "½", "２", "名前",
 )  # fmt: skip
-STRINGS: tuple[str, ...] = ("", " ", "名前", "😀", "a\nb", "-x", "x" * 300, "..", "/")
+STRINGS: tuple[str, ...] = ("", " ", "名前", "😀", "a\nb", "-x", "x" * 300, "..", "/", "a\u2028b")
 PATHS: tuple[str, ...] = (
     "@/missing", "@/missing/deeper/file.png", "@/a_folder", "@/a_folder/", "@/empty.toml",
     "@/garbage.bin", "@/plan/summary.json", "@/名前 😀", "/dev/null", "",
@@ -274,7 +281,7 @@ VERBS: dict[str, Verb] = {
             "--scheduler": tuple(
                 (v,) for v in ("", "tcp://127.0.0.1:1", "nonsense", "名前", "tcp://:99999")
             ),
-            "--data-dir": _path_option(str(SHARED_DATA / "bathymetry")),
+            "--data-dir": _path_option(str(SHARED_BATHYMETRY)),
             **NAVIGATION,
         },
     ),
@@ -284,7 +291,7 @@ VERBS: dict[str, Verb] = {
         ("-o", "@/scenarios"),
         {
             "-o": _path_option("@/scenarios", PLAN),
-            "--data-dir": _path_option(str(SHARED_DATA / "bathymetry")),
+            "--data-dir": _path_option(str(SHARED_BATHYMETRY)),
             "--kind": _choice_option("reliability", "transit"),
         },
     ),
@@ -579,7 +586,11 @@ def _problem(
     if code == 2:
         allowed: list[Path] = []
     else:
-        allowed = [p for p in changed if any(p == o or o in p.parents for o in outputs)]
+        allowed = [  # the outputs, what is in them, and the folders made to hold them
+            p for p in changed
+            if any(p == o or o in p.parents or (p in o.parents and p not in before)
+                   for o in outputs)
+        ]  # fmt: skip
     others = sorted(str(p) for p in changed if p not in allowed)
     if others:
         return f"leftover: exit {code} changed {others[:3]}"
@@ -660,3 +671,90 @@ def test_campaign_over_every_verb(template: Path) -> None:
     campaign()
     print(tally.report())  # noqa: T201  (the campaign's counts, with -s)
     assert not tally.problems, tally.report()
+
+
+# --- cases the campaign found ----------------------------------------------------------------
+
+
+def _refused(case: Case, template: Path) -> str:
+    """Run ``case`` (checked as the campaign does); its one stderr line, asserted exit 2."""
+    assert check_case(case, template) == (2, None)
+    with tempfile.TemporaryDirectory() as folder:  # again, to read the line
+        root = Path(folder)
+        shutil.copytree(template, root, dirs_exist_ok=True)
+        apply(root / "plan", case)
+        argv = [str(root) + a[1:] if a.startswith(ROOT + "/") else a for a in case.argv]
+        code, err = _run_captured(["-q", *argv])
+    assert code == 2
+    return err.strip().replace(str(root), "@")
+
+
+def test_garbage_in_a_compressed_chunk_of_maps_nc_is_one_line(template: Path) -> None:
+    """The NetCDF library opened the file but raised RuntimeError('NetCDF: HDF error') when
+    reading a damaged chunk (exit 1 and a traceback from export and evaluate)."""
+    from auvplan.errors import DataFormatError
+    from auvplan.io.maps_file import read_maps_netcdf
+
+    data = (template / "plan" / "maps.nc").read_bytes()
+    chunks = [m.start() for m in re.finditer(rb"\x78\x5e", data)]  # zlib level 4 headers
+    unreadable = 0
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "maps.nc"
+        for start in chunks:
+            path.write_bytes(data[: start + 2] + b"\xff" * 8 + data[start + 10 :])
+            with contextlib.suppress(DataFormatError):
+                read_maps_netcdf(path)
+                continue
+            unreadable += 1
+    assert unreadable >= 5  # the five maps at least
+
+
+def test_maps_nc_damaged_as_the_campaign_found_it(
+    template: Path,
+) -> None:
+    damage = Damage("maps.nc", "garbage", (0.424, 0.0), b"\x94`\xb6\xad")
+    case = _with_outputs(Case(("export", PLAN, "--format", "kml", "-o", "@/exported"), (damage,)))
+    assert "@/plan/maps.nc: cannot " in _refused(case, template)
+
+
+def test_a_1e300_position_is_a_step_too_long_not_an_overflow(
+    template: Path,
+) -> None:
+    """north = 1e300 in one row (no digest): numpy's norm overflowed squaring the step."""
+    damage = Damage("trajectories.csv", "cell", (0.13, 0.203), "1e300")
+    argv = ("evaluate", PLAN, "--runs", "2", "--particles", "50", "--no-figure")
+    line = _refused(_with_outputs(Case(argv, (damage,), undigested=True)), template)
+    assert line == (
+        "auvplan: error: @/plan/trajectories.csv line 23: vehicle 'blue': north/east step of "
+        "1e+300 m in 1 s is longer than 1.5 x (top speed 1.47 + current 0 m/s) x dt"
+    )
+
+
+@pytest.mark.parametrize("verb", ["scenarios", "sweep"])
+def test_a_seed_above_2_63_is_refused_before_any_folder_is_made(verb: str, template: Path) -> None:
+    """scenarios 1e400 made the output folder, then failed naming seed_1000…'s folder
+    ("File name too long"); sweep --seeds of 5000 digits was a ValueError traceback."""
+    big = "1" + "0" * 400
+    if verb == "scenarios":
+        argv: tuple[str, ...] = ("scenarios", big, "-o", "@/scenarios")
+        expected = f"scenario seed must be in 0 … 9223372036854775807 (2**63 - 1), got {big}"
+    else:
+        huge = "1" + "0" * 5000
+        argv = ("sweep", "scenarios", "-o", "@/swept", "--seeds", huge)
+        expected = f"--seeds '{huge}': '{huge}' is above the largest seed 9223372036854775807"
+    assert _refused(_with_outputs(Case(argv)), template) == f"auvplan: error: {expected}"
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (("vehicle", "--figure", "a\nb"), "auvplan: error: --figure a\\nb: unsupported"),
+        (("scenarios", "0", "-o", "@/s", "--data-dir", "a\u2028b"), "data folder a\\u2028b does"),
+        (("vehicle", "medusa", "x\ry"), "unrecognized arguments: x\\ry (see auvplan --help)"),
+    ],
+)
+def test_a_line_break_in_an_argument_stays_in_the_one_line(
+    argv: tuple[str, ...], expected: str, template: Path
+) -> None:
+    """A path with a newline split the error message over two lines."""
+    assert expected in _refused(_with_outputs(Case(argv)), template)

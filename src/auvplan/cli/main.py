@@ -39,13 +39,26 @@ COMMAND_MODULES = ("maps", "plan", "export", "evaluate", "sweep", "vehicle", "ke
 EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 128 + signal.SIGINT
 EXIT_TERMINATED = 128 + signal.SIGTERM
+#: What ``str.splitlines`` breaks a line at, escaped in messages (a path given with a newline
+#: must not split the one error line).
+_LINE_BREAKS = {ord(c): repr(c)[1:-1] for c in "\n\r\v\f\x1c\x1d\x1e\x85\u2028\u2029"}
+
+
+def _one_line(message: str) -> str:
+    r"""``message`` with its line breaks escaped.
+
+    >>> _one_line("no such file: a\nb")
+    'no such file: a\\nb'
+    """
+    return message.translate(_LINE_BREAKS)
 
 
 class _Parser(argparse.ArgumentParser):
     """An argument parser whose usage errors are one line (``prog: error: ...``), exit 2."""
 
     def error(self, message: str) -> NoReturn:
-        self.exit(EXIT_USER_ERROR, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+        line = _one_line(f"{self.prog}: error: {message} (see {self.prog} --help)")
+        self.exit(EXIT_USER_ERROR, line + "\n")
 
 
 def _add_verbosity(parser: argparse.ArgumentParser, *, default: Any) -> None:
@@ -96,11 +109,11 @@ def main(argv: Sequence[str] | None = None) -> int:
                 check_output_dir(args.output)  # before any work: fail fast, write nothing
             code: int = args.run(args)
     except AuvplanError as error:
-        print(f"auvplan: error: {error}", file=sys.stderr)
+        print(_one_line(f"auvplan: error: {error}"), file=sys.stderr)
         return EXIT_USER_ERROR
     except OSError as error:
         where = f": {error.filename}" if error.filename else ""
-        print(f"auvplan: error: {error.strerror or error}{where}", file=sys.stderr)
+        print(_one_line(f"auvplan: error: {error.strerror or error}{where}"), file=sys.stderr)
         return EXIT_USER_ERROR
     except KeyboardInterrupt:
         print("auvplan: interrupted", file=sys.stderr)

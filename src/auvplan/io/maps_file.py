@@ -206,7 +206,8 @@ def read_maps_netcdf(path: str | Path) -> TerrainMaps:
     Raises
     ------
     DataFormatError
-        If the file is missing or is not an auvplan maps file.
+        If the file is missing, damaged (the NetCDF library cannot read its data) or is not
+        an auvplan maps file.
     """
     import xarray as xr
 
@@ -243,6 +244,8 @@ def read_maps_netcdf(path: str | Path) -> TerrainMaps:
             )
         except KeyError as error:
             raise DataFormatError(f"maps file {path}: missing {error}") from None
+        except (RuntimeError, ValueError, TypeError) as error:  # damaged data or attributes
+            raise DataFormatError(f"maps file {path}: cannot read ({error})") from None
     coarse = GridGeometry(
         north_block.size,
         east_block.size,

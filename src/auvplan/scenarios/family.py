@@ -56,10 +56,14 @@ SAFETY_RADII_M: Final = (2.5, 5.0, 5.0, 10.0)
 TERRAIN_ATTEMPTS: Final = 4
 #: Family kinds :func:`generate` draws from.
 KINDS: Final = ("reliability", "transit")
+#: Largest seed: seeds fit a signed 64-bit integer, as the sweep's tables store them (and a
+#: seed's folder name ``seed_NNNN`` stays short).
+MAX_SEED: Final = 2**63 - 1
 
 __all__ = [
     "DT_BY_HORIZON",
     "KINDS",
+    "MAX_SEED",
     "MISSION_FILE",
     "VEHICLE_NAMES",
     "Scenario",
@@ -89,8 +93,10 @@ def generate(seed: int, *, data_dir: Path | None = None, kind: str = "reliabilit
     Raises
     ------
     InputError
-        If ``kind`` is not one of :data:`KINDS`.
+        If ``seed`` is not in 0 … :data:`MAX_SEED` or ``kind`` is not one of :data:`KINDS`.
     """
+    if not 0 <= seed <= MAX_SEED:
+        raise InputError(f"scenario seed must be in 0 … {MAX_SEED} (2**63 - 1), got {seed}")
     if kind == "transit":
         return transit.generate_transit(seed, data_dir=data_dir)
     if kind != "reliability":

@@ -28,6 +28,7 @@ from typing import Any, Final
 
 from auvplan.errors import InputError
 from auvplan.mission.config import parse_mission, resolved_document
+from auvplan.scenarios.family import MAX_SEED
 
 #: Most runs one sweep may hold.
 MAX_RUNS: Final = 100_000
@@ -125,7 +126,8 @@ def parse_seeds(text: str) -> tuple[int, ...]:
     Raises
     ------
     InputError
-        If a part is not a non-negative integer or range, a range runs backwards, a seed
+        If a part is not an integer or range in 0 … 2**63 - 1
+        (:data:`auvplan.scenarios.family.MAX_SEED`), a range runs backwards, a seed
         repeats, or there are more than :data:`MAX_RUNS` seeds (counted from the ranges, in
         time linear in the number of parts).
 
@@ -139,6 +141,8 @@ def parse_seeds(text: str) -> tuple[int, ...]:
         match = _SEEDS.match(part.strip())
         if match is None:
             raise InputError(f"--seeds {text!r}: {part!r} is not a seed (N) or a range (A..B)")
+        if any(len(n) > len(str(MAX_SEED)) or int(n) > MAX_SEED for n in match.groups() if n):
+            raise InputError(f"--seeds {text!r}: {part!r} is above the largest seed {MAX_SEED}")
         low = int(match[1])
         high = low if match[2] is None else int(match[2])
         if high < low:
