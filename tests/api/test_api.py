@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 import xarray as xr
 
@@ -61,10 +62,32 @@ def test_to_dataframe_is_long_format_of_the_csv(
         expected = np.array([float(row[column]) for row in rows])
         np.testing.assert_allclose(frame[column].to_numpy(), expected, rtol=1e-12, atol=1e-9)
     assert list(frame["vehicle"]) == [row["vehicle"] for row in rows]
-    start = np.datetime64("2025-03-14T09:00:00")
-    np.testing.assert_array_equal(
-        frame["time"].to_numpy(), start + (frame["t"].to_numpy() * 1e9).astype("timedelta64[ns]")
-    )
+    start = pd.Timestamp("2025-03-14T09:00:00", tz="UTC")  # time zone aware, as documented
+    assert str(frame["time"].dt.tz) == "UTC"
+    expected_times = start + pd.to_timedelta(frame["t"].to_numpy(), unit="s")
+    assert (frame["time"] - expected_times).abs().max() < pd.Timedelta(microseconds=1)
+
+
+def test_figures_show_in_a_notebook_without_magics(mission_plan: auvplan.MissionPlan) -> None:
+    """IPython displays an object through its ``_repr_png_``: no ``%matplotlib inline`` needed."""
+    figure = mission_plan.plot()
+    png = figure._repr_png_()  # type: ignore[attr-defined]
+    assert png.startswith(b"\x89PNG\r\n\x1a\n")
+    assert len(png) > 10_000
+
+
+def test_progress_in_jupyter_without_widgets_is_log_lines(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """rich's Jupyter display needs ipywidgets (else a warning per refresh): plain lines then."""
+    from rich.console import Console
+
+    from auvplan.api import progress
+
+    console = Console(force_jupyter=True)
+    monkeypatch.setattr(progress.importlib.util, "find_spec", lambda name: None)
+    with progress.ConsoleProgress(console=console) as reporter:
+        assert reporter._display is None
 
 
 def test_load_gives_back_the_same_plan(

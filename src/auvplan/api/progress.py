@@ -4,8 +4,8 @@
 :meth:`ConsoleProgress.iteration`, the optimiser's per-iteration ``callback``. Used as a
 context manager around :func:`~auvplan.mission.pipeline.run_mission`, it shows
 
-* on a terminal (or in Jupyter), a rich progress display: one line per stage with its elapsed
-  time, a bar with the estimated time left where the amount of work is known (one A* search
+* on a terminal (or in Jupyter with ipywidgets), a rich progress display: one line per stage
+  with its elapsed time, a bar with the estimated time left where the amount of work is known (one A* search
   per vehicle; the optimiser's barrier levels ``ε``, with the iteration, cost ``h``,
   decrement ``−Dh·ζ`` and ``ε`` of the last iteration), and the log above it;
 * otherwise (a file, a pipe, a CI log), plain log lines of logger ``auvplan.api.progress`` at
@@ -17,6 +17,7 @@ The time left is the elapsed time scaled by the work still to do (ETA of a const
 
 from __future__ import annotations
 
+import importlib.util
 import io
 import logging
 import math
@@ -98,7 +99,8 @@ class ConsoleProgress:
             from rich.console import Console
 
             console = Console(stderr=True)
-        is_live = console.is_terminal or console.is_jupyter if self._live is None else self._live
+        live = console.is_terminal or (console.is_jupyter and _has_widgets())
+        is_live = live if self._live is None else self._live
         if is_live:
             self._log_through(console)  # before the display replaces sys.stderr by its proxy
             self._display = _rich_display(console)
@@ -199,6 +201,11 @@ class _ConsoleStream(io.TextIOBase):
     def write(self, text: str) -> int:
         self._console.out(text.rstrip("\n"), highlight=False)
         return len(text)
+
+
+def _has_widgets() -> bool:
+    """Whether ipywidgets is installed: rich's display in Jupyter needs it (else it warns)."""
+    return importlib.util.find_spec("ipywidgets") is not None
 
 
 def _rich_display(console: Console) -> Progress:

@@ -163,6 +163,7 @@ class MissionPlan:
         frame = dataset.to_dataframe().reset_index().drop(columns="obs")
         frame = frame.rename(columns={"trajectory": "vehicle"}).astype({"vehicle": str})
         frame["t"] = (frame["time"] - dataset["time"].values.min()).dt.total_seconds()
+        frame["time"] = frame["time"].dt.tz_localize("UTC")  # the file's times are UTC
         places = [name for name in ("lat", "lon", "depth") if name in dataset.coords]
         return frame[["vehicle", "time", "t", *places, *map(str, dataset.data_vars)]]
 

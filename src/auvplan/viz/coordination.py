@@ -12,6 +12,7 @@ from auvplan.deconfliction import (
     timed_positions,
 )
 from auvplan.errors import InputError
+from auvplan.viz.figure import NotebookFigure
 from auvplan.viz.style import pair_colors, plain_tick_labels, vehicle_colors
 
 #: Raster resolution of the shaded collision region (samples per axis).
@@ -59,7 +60,7 @@ def plot_coordination_space(
     distance = np.hypot(
         p_i[:, None, 0] - p_j[None, :, 0], p_i[:, None, 1] - p_j[None, :, 1]
     )  # (s_i, s_j)
-    figure = Figure(figsize=(width_inches, width_inches * length_j / length_i * 0.9 + 0.6))
+    figure = NotebookFigure(figsize=(width_inches, width_inches * length_j / length_i * 0.9 + 0.6))
     ax = figure.add_subplot()
     ax.contourf(
         s_i, s_j, distance.T, levels=[0.0, problem.separation], colors=["tab:red"], alpha=0.35
@@ -118,7 +119,7 @@ def plot_timed_paths(
         separation. Right: every pair's distance against time, ``2 r_c`` and the certified
         bound. Created without pyplot.
     """
-    figure = Figure(figsize=(width_inches, 0.45 * width_inches), layout="constrained")
+    figure = NotebookFigure(figsize=(width_inches, 0.45 * width_inches), layout="constrained")
     ax_map, ax_sep = figure.subplots(1, 2)
     colors = vehicle_colors(problem.n_vehicles)
     snapshots = np.linspace(0.0, result.time[-1], n_snapshots)

@@ -10,6 +10,7 @@ from matplotlib.figure import Figure
 from auvplan._typing import FloatArray
 from auvplan.terrain.grid import GridGeometry
 from auvplan.terrain.maps import TerrainMaps
+from auvplan.viz.figure import NotebookFigure
 from auvplan.viz.geography import add_geographic_axes
 from auvplan.viz.style import plain_tick_labels
 
@@ -42,7 +43,7 @@ def plot_terrain_maps(maps: TerrainMaps, *, width_inches: float = 11.0) -> Figur
     aspect = (north - south) / max(east - west, 1e-9)
     panel_width = 0.5 * width_inches
     height = 2.0 * panel_width * aspect * 0.85 + 1.2
-    figure = Figure(figsize=(width_inches, float(np.clip(height, 3.0, 3.0 * width_inches))))
+    figure = NotebookFigure(figsize=(width_inches, float(np.clip(height, 3.0, 3.0 * width_inches))))
     figure.set_layout_engine("constrained")
     axes = figure.subplots(2, 2, sharex=True, sharey=True)
     parameters = maps.parameters

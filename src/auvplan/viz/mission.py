@@ -19,6 +19,7 @@ from matplotlib.patches import Circle, Polygon
 from auvplan._typing import FloatArray
 from auvplan.terrain.grid import BathymetryGrid
 from auvplan.vehicle import VehicleModel
+from auvplan.viz.figure import NotebookFigure
 from auvplan.viz.geography import add_geographic_axes
 from auvplan.viz.style import lighter, pair_colors, plain_tick_labels, vehicle_colors
 
@@ -66,7 +67,7 @@ def plot_mission_paths(
         Field to draw instead of depth (e.g. the cost map on its own grid is not supported:
         pass a field on the bathymetry grid).
     """
-    figure = Figure(figsize=(9.0, 5.5), layout="constrained")
+    figure = NotebookFigure(figsize=(9.0, 5.5), layout="constrained")
     axes = figure.add_subplot()
     g = bathymetry.geometry
     field = bathymetry.depth if background is None else background
@@ -125,7 +126,7 @@ def plot_time_series(
     layouts = [(m.state_names, m.thruster_states, m.surface_states) for m in models]
     has_surfaces = any(surfaces for _, _, surfaces in layouts)
     panels = 5 if has_surfaces else 4
-    figure = Figure(figsize=(9.0, 2.25 * panels), layout="constrained")
+    figure = NotebookFigure(figsize=(9.0, 2.25 * panels), layout="constrained")
     axes = figure.subplots(panels, 1, sharex=True)
     colors = vehicle_colors(len(names))
     for k, (name, (own, thrusters, surfaces)) in enumerate(zip(names, layouts, strict=True)):
@@ -161,7 +162,7 @@ def plot_separation(
     time: FloatArray, separations: Mapping[str, FloatArray], minimum: float
 ) -> Figure:
     """Pairwise (and vehicle-obstacle) separation [m] against time with the limit ``minimum``."""
-    figure = Figure(figsize=(9.0, 4.0), layout="constrained")
+    figure = NotebookFigure(figsize=(9.0, 4.0), layout="constrained")
     axes = figure.add_subplot()
     colors = pair_colors(len(separations))
     for color, (label, distance) in zip(colors, separations.items(), strict=True):

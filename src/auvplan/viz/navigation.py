@@ -18,6 +18,7 @@ from matplotlib.figure import Figure
 from auvplan.navigation.evaluation import PlanNavigation, time_series
 from auvplan.navigation.prediction import ErrorPrediction
 from auvplan.terrain import BathymetryGrid
+from auvplan.viz.figure import NotebookFigure
 from auvplan.viz.geography import add_geographic_axes
 from auvplan.viz.style import plain_tick_labels, vehicle_colors
 
@@ -49,7 +50,9 @@ def plot_navigation(
     """
     labels = list(evaluations)
     names = list(dict.fromkeys(n for e in evaluations.values() for n in e.results))
-    figure = Figure(figsize=(5.2 * len(labels) + 1.0, 4.6 + 2.3 * len(names)), layout="constrained")
+    figure = NotebookFigure(
+        figsize=(5.2 * len(labels) + 1.0, 4.6 + 2.3 * len(names)), layout="constrained"
+    )
     grid = figure.add_gridspec(1 + len(names), len(labels), height_ratios=[2.2] + [1] * len(names))
     bounds = _track_bounds(evaluations)
     colors = vehicle_colors(len(names))
@@ -176,7 +179,7 @@ def plot_predicted_error(
     first drawn solid, the others dashed and dotted); ``budget`` [m], if given, is drawn from
     ``settle_s`` [s] on.
     """
-    figure = Figure(figsize=(9.0, 1.2 + 2.0 * len(names)), layout="constrained")
+    figure = NotebookFigure(figsize=(9.0, 1.2 + 2.0 * len(names)), layout="constrained")
     axes_list = figure.subplots(len(names), 1, sharex=True, squeeze=False)[:, 0]
     colors = vehicle_colors(len(names))
     styles = ("-", "--", ":")

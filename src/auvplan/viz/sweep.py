@@ -7,6 +7,7 @@ from typing import Final
 from matplotlib.figure import Figure
 
 from auvplan.sweep.pareto import ParetoView
+from auvplan.viz.figure import NotebookFigure
 
 #: Groups drawn with a legend entry (and points with a text label) at most.
 MAX_LABELLED_GROUPS: Final = 10
@@ -37,7 +38,7 @@ def plot_pareto(view: ParetoView, *, title: str = "") -> Figure:
     points = view.points
     groups = list(dict.fromkeys(points["group"]))
     relative = not view.same_mission and len(groups) > 1
-    figure = Figure(figsize=(7.5, 5.0), layout="constrained")
+    figure = NotebookFigure(figsize=(7.5, 5.0), layout="constrained")
     axes = figure.add_subplot()
     annotate = len(points) <= MAX_LABELLED_POINTS and view.label_key is not None
     for index, group in enumerate(groups):

@@ -22,6 +22,7 @@ from auvplan.vehicle.trim import (
     top_speed,
     trim_surge,
 )
+from auvplan.viz.figure import NotebookFigure
 from auvplan.viz.style import plain_tick_labels
 
 
@@ -60,7 +61,7 @@ def plot_vehicle_validation(
     matplotlib.figure.Figure
         Created without pyplot (no global state); save with ``figure.savefig(path)``.
     """
-    figure = Figure(figsize=(14.0, 4.6))
+    figure = NotebookFigure(figsize=(14.0, 4.6))
     figure.set_layout_engine("constrained")
     propeller_axes, speed_axes, turn_axes = figure.subplots(1, 3)
     _plot_propeller(propeller_axes, model.vehicle.propeller, orders)
