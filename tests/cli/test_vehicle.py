@@ -88,5 +88,5 @@ def test_malformed_file_is_one_line_exit_2(
     path.write_text('name = "x"\n[hull]\nm = 3\n')
     assert main(["vehicle", str(path)]) == 2
     err = capsys.readouterr().err
-    assert "'hull.m' must be a table" in err
+    assert 'hull.m: must be a table { value = ..., unit = "kg" }, got 3' in err
     assert err.count("\n") == 1

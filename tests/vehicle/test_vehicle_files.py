@@ -77,14 +77,34 @@ def test_vehicle_file_with_relative_propeller_path_and_unit_conversion(tmp_path:
 @pytest.mark.parametrize(
     ("old", "new", "error", "message"),
     [
-        ('m      = { value = 30.0,   unit = "kg" }', "", DataFormatError, "'hull.m'"),
-        ('unit = "kg/m^3"', 'unit = "g/cm^3"', DataFormatError, "'hull.rho' has unit 'g/cm^3'"),
-        ("value = 0.29,", "value = -0.29,", InputError, "motor.R_a must be >= 0"),
-        ("value = -55.1,", "value = 55.1,", InputError, "Y_v must be <= 0"),
-        ("value = 30.0,", 'value = "heavy",', DataFormatError, "'hull.m' must be a number"),
+        ('m      = { value = 30.0,   unit = "kg" }', "", DataFormatError, "hull.m is required"),
+        (
+            'unit = "kg/m^3"',
+            'unit = "g/cm^3"',
+            DataFormatError,
+            "hull.rho: unit 'g/cm^3' is not 'kg/m^3'",
+        ),
+        (
+            "value = 0.29,",
+            "value = -0.29,",
+            InputError,
+            "motor.R_a: Input should be greater than or equal to 0, got -0.29 ohm",
+        ),
+        (
+            "value = -55.1,",
+            "value = 55.1,",
+            InputError,
+            "hull.Y_v: Input should be less than or equal to 0, got 55.1 kg/s",
+        ),
+        (
+            "value = 30.0,",
+            'value = "heavy",',
+            DataFormatError,
+            "hull.m: value must be a number, got 'heavy'",
+        ),
         ('current_model = "torque"', 'current_model = "magic"', InputError, "current_model"),
         ('"wageningen_b4-70_pd1.4"', '"nope.csv"', InputError, "propeller table 'nope.csv'"),
-        ("[power]", "[powerx]", DataFormatError, "'[power]'"),
+        ("[power]", "[powerx]", DataFormatError, "power is required"),
         ("name = ", "name = = ", DataFormatError, "not valid TOML"),
     ],
 )

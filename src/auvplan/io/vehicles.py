@@ -34,6 +34,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 from importlib.resources.abc import Traversable
 from pathlib import Path
+from typing import Any, Final
+
+import numpy as np
+from pydantic import ValidationError
 
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError, InputError
@@ -69,7 +73,15 @@ from auvplan.io._vehicle_schema import (
     text,
     vector,
 )
+from auvplan.io.tables import one_line
 from auvplan.io.text import read_toml
+from auvplan.io.vehicle_tables import (
+    FourQuadrantPropellerTable,
+    LinearPropellerTable,
+    MotorTable,
+    ThrusterTable,
+    VehicleFile,
+)
 from auvplan.vehicle.actuators import (
     ActuatedVehicleParams,
     ControlSurfaceParams,
@@ -82,6 +94,19 @@ from auvplan.vehicle.params import (
     MotorParams,
     Propeller,
     VehicleParams,
+)
+
+#: Validation errors of a value outside its range or set (InputError); the others are
+#: errors of the file's layout (DataFormatError).
+_OUT_OF_RANGE: Final = frozenset(
+    {
+        "greater_than",
+        "greater_than_equal",
+        "less_than",
+        "less_than_equal",
+        "finite_number",
+        "literal_error",
+    }
 )
 
 
@@ -113,6 +138,71 @@ def vehicle_file(type_or_path: str) -> Path | Traversable:
     if type_or_path in packaged_vehicle_types():
         return data_dir("vehicles").joinpath(f"{type_or_path}.toml")
     return Path(type_or_path)
+
+
+def _propeller(
+    table: FourQuadrantPropellerTable | LinearPropellerTable, base_dir: Path | None
+) -> Propeller:
+    if isinstance(table, LinearPropellerTable):
+        return LinearPropellerParams(**table.model_dump(exclude={"model"}))
+    return load_propeller_table(
+        table.table,
+        diameter=table.diameter,
+        c_T=table.c_T,
+        c_Q=table.c_Q,
+        order=table.order,
+        base_dir=base_dir,
+    )
+
+
+def _motor(table: MotorTable) -> MotorParams:
+    curve = table.current_curve
+    return MotorParams(
+        R_a=table.R_a,
+        K_e=table.K_e,
+        V_bus=table.V_bus,
+        I_0=table.I_0,
+        current_model=table.current_model,
+        current_curve_n=None if curve is None else np.asarray(curve.n, dtype=np.float64),
+        current_curve_amps=None if curve is None else np.asarray(curve.current, dtype=np.float64),
+    )
+
+
+def _thruster(table: ThrusterTable, base_dir: Path | None) -> ThrusterParams:
+    return ThrusterParams(
+        propeller=_propeller(table.propeller, base_dir),
+        motor=_motor(table.motor),
+        **table.model_dump(exclude={"propeller", "motor"}),
+    )
+
+
+def _vehicle(tables: VehicleFile, base_dir: Path | None) -> VehicleParams | ActuatedVehicleParams:
+    """The parameters of a validated vehicle file (SI units, propeller speeds in rev/s)."""
+    hull = tables.hull
+    crossflow = hull.crossflow
+    common: dict[str, Any] = {
+        "name": tables.name,
+        "hull": HullParams(
+            **hull.model_dump(exclude={"crossflow"}),
+            crossflow=None if crossflow is None else CrossFlowParams(**crossflow.model_dump()),
+        ),
+        "hotel_power": tables.power.hotel,
+        **{f"eps_{key}": value for key, value in tables.smoothing.model_dump().items()},
+        "description": tables.description,
+    }
+    propulsion, propeller, motor = tables.propulsion, tables.propeller, tables.motor
+    if propulsion is not None and propeller is not None and motor is not None:  # the shorthand
+        return VehicleParams(
+            propeller=_propeller(propeller, base_dir),
+            motor=_motor(motor),
+            **propulsion.model_dump(),
+            **common,
+        )
+    return ActuatedVehicleParams(
+        thrusters=tuple(_thruster(table, base_dir) for table in tables.thrusters),
+        surfaces=tuple(ControlSurfaceParams(**table.model_dump()) for table in tables.surfaces),
+        **common,
+    )
 
 
 def _parse_hull(document: Mapping[str, object]) -> HullParams:
@@ -299,11 +389,14 @@ def load_vehicle(type_or_path: str | Path) -> VehicleParams | ActuatedVehiclePar
         base_dir = path.resolve().parent
         origin = str(path)
     try:
-        return _parse_vehicle(document, base_dir)
+        tables = VehicleFile.model_validate(document)
+    except ValidationError as error:
+        kind = InputError if error.errors()[0]["type"] in _OUT_OF_RANGE else DataFormatError
+        raise kind(f"{origin}: {one_line(error, VehicleFile)}") from None
+    try:
+        return _vehicle(tables, base_dir)
     except (DataFormatError, InputError) as error:
         raise type(error)(f"{origin}: {error}") from None
-    except TypeError as error:
-        raise DataFormatError(f"{origin}: {error}") from None
 
 
 __all__ = [
