@@ -3,6 +3,7 @@
 :mod:`auvplan.api.result` plans and loads missions, :mod:`auvplan.api.folder` writes output
 folders (data, exports, figures, ``report.html``), :mod:`auvplan.api.maps` writes the terrain
 maps of a bathymetry, :mod:`auvplan.api.vehicle` describes a vehicle type,
+:mod:`auvplan.api.navigation` flies a folder's plans through the TAN simulator,
 :mod:`auvplan.api.progress` shows progress on the console. The command line is built on these.
 
 The names are imported on first use, so a verb that needs one module (``auvplan vehicle``)
@@ -18,6 +19,8 @@ from typing import TYPE_CHECKING, Any
 _LAZY = {
     "write_output_folder": "auvplan.api.folder",
     "MapsFolder": "auvplan.api.maps",
+    "EvaluatedFolder": "auvplan.api.navigation",
+    "evaluate_output_folder": "auvplan.api.navigation",
     "write_terrain_maps": "auvplan.api.maps",
     "ConsoleProgress": "auvplan.api.progress",
     "MissionPlan": "auvplan.api.result",
@@ -31,17 +34,20 @@ _LAZY = {
 if TYPE_CHECKING:
     from auvplan.api.folder import write_output_folder
     from auvplan.api.maps import MapsFolder, write_terrain_maps
+    from auvplan.api.navigation import EvaluatedFolder, evaluate_output_folder
     from auvplan.api.progress import ConsoleProgress
     from auvplan.api.result import MissionPlan, MissionSource, load, plan
     from auvplan.api.vehicle import VehicleDescription, describe_vehicle
 
 __all__ = [
     "ConsoleProgress",
+    "EvaluatedFolder",
     "MapsFolder",
     "MissionPlan",
     "MissionSource",
     "VehicleDescription",
     "describe_vehicle",
+    "evaluate_output_folder",
     "load",
     "plan",
     "write_output_folder",

@@ -6,7 +6,7 @@ and ``trajectories.csv``, and ``trajectories_energy_only.csv`` when the plan was
 Monte-Carlo particle-filter navigation along every vehicle's track and writes
 ``navigation.json`` and ``navigation.png`` (or ``.svg``/``.pdf``: ``--figure-format``) into the
 same folder, all-or-nothing (:func:`auvplan.io.output.staged_output_dir`: the folder's other
-files are kept).
+files are kept): :func:`auvplan.api.navigation.evaluate_output_folder`.
 """
 
 from __future__ import annotations
@@ -22,8 +22,7 @@ from typing import TYPE_CHECKING, Any
 from auvplan.cli.figure_options import add_figure_options
 
 if TYPE_CHECKING:  # the sweep package (pandas) is imported only when a command runs
-    from auvplan.record import PlanRecord
-    from auvplan.sweep.navigation import NavigationOptions
+    from auvplan.sweep.navigation import NavigationRequest
 
 
 def register(subparsers: argparse._SubParsersAction[Any]) -> None:
@@ -93,27 +92,16 @@ def add_navigation_options(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def navigation_options(
-    args: argparse.Namespace,
-    *,
-    seed: int,
-    threads: int | None = None,
-    record: PlanRecord | None = None,
-) -> NavigationOptions:
-    """The :class:`~auvplan.sweep.NavigationOptions` of :func:`add_navigation_options`'s args.
-
-    The model is the ``[navigation]`` table of ``record``'s mission (defaults without a
-    record) with the flags given on top (:func:`auvplan.mission.folder.mission_navigation`),
-    at the plan's depth.
+def navigation_request(args: argparse.Namespace) -> NavigationRequest:
+    """The :class:`~auvplan.sweep.NavigationRequest` of :func:`add_navigation_options`'s args.
 
     Raises
     ------
     InputError
-        If ``--runs`` is below 1 or a model value is out of its range.
+        If ``--runs`` is below 1.
     """
     from auvplan.errors import InputError
-    from auvplan.mission.folder import mission_navigation
-    from auvplan.sweep.navigation import NavigationOptions
+    from auvplan.sweep.navigation import NavigationRequest
 
     if args.runs < 1:
         raise InputError(f"--runs must be >= 1, got {args.runs}")
@@ -123,49 +111,28 @@ def navigation_options(
         "initial_sigma_m": args.initial_sigma,
         "drift_percent": args.drift,
     }
-    overrides = {key: value for key, value in flags.items() if value is not None}
-    table = mission_navigation({} if record is None else record.mission, overrides)
-    settings = table.settings(
-        vehicle_depth=0.0 if record is None else record.depth,
+    return NavigationRequest(
+        {key: value for key, value in flags.items() if value is not None},
+        n_runs=args.runs,
         particles=args.particles,
         convergence_updates=args.convergence_updates,
     )
-    return NavigationOptions(settings, n_runs=args.runs, seed=seed, threads=threads)
 
 
 def run(args: argparse.Namespace) -> int:
     """Evaluate the folder's plans and write the results; returns the exit code."""
-    from auvplan.io.output import staged_output_dir
-    from auvplan.io.results import write_json
-    from auvplan.record import read_record
-    from auvplan.record.files import NAVIGATION_FILE
-    from auvplan.sweep.navigation import evaluate_folder
+    from auvplan.api.navigation import evaluate_output_folder
 
-    record = read_record(args.output)
-    options = navigation_options(args, seed=args.seed, record=record)
-    n_tracks = sum(len(vehicles) for vehicles in record.plans.values())
-    with _progress(n_tracks * args.runs, args.runs, quiet=args.quiet) as progress:
-        navigation = evaluate_folder(record, options, progress=progress)
-    document = navigation.document
-    figure = None
-    if not args.no_figure:
-        from auvplan.viz.navigation import plot_navigation
-        from auvplan.viz.report import render_figure
-
-        figure = render_figure(
-            plot_navigation(record.maps.bathymetry, navigation.evaluations),
-            figure_format=args.figure_format,
-            dpi=args.dpi,
-        )
-    with staged_output_dir(args.output) as staging:
-        write_json(document, staging / NAVIGATION_FILE)
-        written = [args.output / NAVIGATION_FILE]
-        if figure is not None:
-            figure_name = f"navigation.{args.figure_format}"
-            (staging / figure_name).write_bytes(figure.data)
-            written.append(args.output / figure_name)
+    evaluated = evaluate_output_folder(
+        args.output,
+        navigation_request(args),
+        seed=args.seed,
+        figure_format=None if args.no_figure else args.figure_format,
+        dpi=args.dpi,
+        progress=lambda total: _progress(total, args.runs, quiet=args.quiet),
+    )
     if not args.quiet:
-        _print_report(document, written)
+        _print_report(evaluated.document, evaluated.written)
     return 0
 
 
@@ -200,7 +167,7 @@ def _progress(total: int, n_runs: int, *, quiet: bool) -> Iterator[Callable[[str
         yield update
 
 
-def _print_report(document: dict[str, Any], written: list[Path]) -> None:
+def _print_report(document: dict[str, Any], written: tuple[Path, ...]) -> None:
     def number(value: float | None, unit: str = "") -> str:
         return "n/a" if value is None else f"{value:.2f}{unit}"
 

@@ -11,7 +11,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from auvplan.cli.evaluate import add_navigation_options, navigation_options
+from auvplan.cli.evaluate import add_navigation_options, navigation_request
 from auvplan.cli.plan import EXIT_NOT_CONVERGED, STAGES
 
 if TYPE_CHECKING:  # the command line imports the sweep package only when it runs
@@ -159,7 +159,7 @@ def _navigation(args: argparse.Namespace) -> NavigationOptions | None:
 
         cpus = available_cpus()
         threads = max(1, cpus // (args.workers or cpus))
-    return navigation_options(args, seed=0, threads=threads)
+    return navigation_request(args).options(None, seed=0, threads=threads)
 
 
 def _run(

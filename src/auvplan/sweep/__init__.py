@@ -16,6 +16,7 @@ from auvplan.sweep.missions import mission_file_base, scenario_bases
 from auvplan.sweep.navigation import (
     FolderNavigation,
     NavigationOptions,
+    NavigationRequest,
     evaluate_folder,
     evaluate_run_folder,
     is_evaluated,
@@ -47,6 +48,7 @@ __all__ = [
     "FolderNavigation",
     "MissionBase",
     "NavigationOptions",
+    "NavigationRequest",
     "ParetoView",
     "RunOptions",
     "RunRecord",

@@ -22,6 +22,7 @@ from auvplan.errors import DataFormatError, InputError
 from auvplan.io.output import staged_output_file
 from auvplan.io.results import write_json
 from auvplan.io.text import read_json
+from auvplan.mission.folder import mission_navigation
 from auvplan.navigation import (
     NavigationSettings,
     PlanNavigation,
@@ -55,6 +56,46 @@ class NavigationOptions:
     def settings_document(self) -> dict[str, Any]:
         """``navigation.json``'s ``settings`` for these options."""
         return settings_document(self.settings, n_runs=self.n_runs, seed=self.seed)
+
+
+@dataclass(frozen=True)
+class NavigationRequest:
+    """The navigation to fly along a plan, as ``auvplan evaluate`` and ``sweep --evaluate`` ask.
+
+    ``overrides`` are keys of the mission's ``[navigation]`` table (``sensor``,
+    ``update_period_s``, ``initial_sigma_m``, ``drift_percent``) put over the plan's table;
+    ``n_runs`` is the Monte-Carlo runs per vehicle and plan, ``particles`` the particles per
+    filter and ``convergence_updates`` the updates with sigma <= 5 m in a row that count as
+    converged.
+    """
+
+    overrides: Mapping[str, Any] = field(default_factory=dict)
+    n_runs: int = 100
+    particles: int = 5000
+    convergence_updates: int = 200
+
+    def options(
+        self, record: PlanRecord | None, *, seed: int, threads: int | None = None
+    ) -> NavigationOptions:
+        """The :class:`NavigationOptions` of this request for ``record``'s plan.
+
+        The model is the ``[navigation]`` table of ``record``'s mission (its defaults without
+        a record) with :attr:`overrides` on top
+        (:func:`auvplan.mission.folder.mission_navigation`), at the plan's depth [m] (0
+        without a record); ``seed`` is the runs' base seed and ``threads`` their threads.
+
+        Raises
+        ------
+        InputError
+            If a model value is out of its range.
+        """
+        table = mission_navigation({} if record is None else record.mission, self.overrides)
+        settings = table.settings(
+            vehicle_depth=0.0 if record is None else record.depth,
+            particles=self.particles,
+            convergence_updates=self.convergence_updates,
+        )
+        return NavigationOptions(settings, n_runs=self.n_runs, seed=seed, threads=threads)
 
 
 @dataclass(frozen=True)
@@ -153,6 +194,7 @@ __all__ = [
     "NAVIGATION_FILE",
     "FolderNavigation",
     "NavigationOptions",
+    "NavigationRequest",
     "evaluate_folder",
     "evaluate_run_folder",
     "has_plan",
