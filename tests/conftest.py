@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from scipy.ndimage import gaussian_filter
 
+from auvplan.io.samples import samples_folder
 from auvplan.scenarios._terrain import write_synthetic_terrain
 from auvplan.terrain import BathymetryGrid, GridGeometry
 
@@ -39,12 +40,9 @@ def shared_data() -> Path:
 
 
 @pytest.fixture(scope="session")
-def bathymetry_dir(shared_data: Path) -> Path:
-    """``../shared/data/bathymetry`` (skip when absent)."""
-    path = shared_data / "bathymetry"
-    if not path.is_dir():
-        pytest.skip(f"bathymetry folder not found at {path}")
-    return path
+def bathymetry_dir() -> Path:
+    """The real bathymetry grids: the samples packaged with auvplan (no ``../shared`` needed)."""
+    return samples_folder()
 
 
 #: A mission writer of :func:`transit_mission`: ``(folder, ridge=..., navigation=...)``.

@@ -21,8 +21,6 @@ MISSIONS = Path(__file__).parents[2] / "examples" / "missions"
 @pytest.mark.parametrize("name", ["four_vehicles", "monterey"])
 def test_example_mission(name: str) -> None:
     config = load_mission(MISSIONS / f"{name}.toml")
-    if config.terrain.file is not None and not config.terrain.file.is_file():
-        pytest.skip(f"bathymetry not found: {config.terrain.file}")
     result = run_mission(config)
     plan = result.plan
     assert plan is not None
@@ -39,7 +37,7 @@ def test_example_mission(name: str) -> None:
     states = plan.states
     for comm in config.comms:
         i, j = config.vehicle_index(comm.pair[0]), config.vehicle_index(comm.pair[1])
-        assert np.hypot(*(states[i, :, :2] - states[j, :, :2]).T).max() <= comm.max_range
+        assert np.hypot(*(states[i][:, :2] - states[j][:, :2]).T).max() <= comm.max_range
 
 
 def test_mixed_fleet_in_a_current_converges_and_saves_energy(tmp_path: Path) -> None:
@@ -49,9 +47,6 @@ def test_mixed_fleet_in_a_current_converges_and_saves_energy(tmp_path: Path) -> 
     current saves 2.4 %; issue 15's 15.6 % was on the paper's routes.
     """
     mission = MISSIONS / "mixed_fleet_current.toml"
-    config = load_mission(mission)
-    if config.terrain.file is not None and not config.terrain.file.is_file():
-        pytest.skip(f"bathymetry not found: {config.terrain.file}")
     folder = tmp_path / "out"
     assert main(["-q", "plan", str(mission), "-o", str(folder), "--compare-no-current"]) == 0
     summary = json.loads((folder / "summary.json").read_text(encoding="utf-8"))

@@ -85,10 +85,10 @@ class PreplanStage:
 
 
 def load_terrain(terrain: TerrainConfig) -> BathymetryGrid:
-    """The mission's bathymetry: a file (any supported format) or the synthetic bank."""
+    """The mission's bathymetry: a file (any supported format), a sample or the synthetic bank."""
     window = terrain.window
     return read_terrain(
-        None if terrain.synthetic else terrain.file,
+        terrain.path,
         seed=terrain.seed,
         window_north=window.north,
         window_east=window.east,

@@ -121,7 +121,7 @@ def _inputs(config: MissionConfig) -> dict[str, Any]:
     """Path and SHA-256 of every file the run read: mission, bathymetry, vehicle files."""
     return {
         "mission": None if config.source is None else _fingerprint(config.source),
-        "bathymetry": None if config.terrain.file is None else _fingerprint(config.terrain.file),
+        "bathymetry": None if config.terrain.path is None else _fingerprint(config.terrain.path),
         "current": None
         if config.current is None or config.current.file is None
         else _fingerprint(config.current.file),

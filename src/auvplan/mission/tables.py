@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Final, Literal, Union, get_arg
 from pydantic import BaseModel, ConfigDict, Field, Strict, field_validator, model_validator
 
 from auvplan.errors import InputError
+from auvplan.io.samples import SampleName, sample_path
 from auvplan.optimization import ProntoOptions
 
 if TYPE_CHECKING:  # the navigation package (numba kernels) loads only when a run needs it
@@ -81,10 +82,13 @@ class WindowConfig(TableModel):
 
 
 class TerrainConfig(TableModel):
-    """Where the bathymetry comes from: a file (resolved next to the mission) or the bank."""
+    """Where the bathymetry comes from: a file (next to the mission), a sample or the bank."""
 
     file: Path | None = Field(
         None, description="bathymetry file: NetCDF, GeoTIFF, ESRI ASCII or XYZ"
+    )
+    sample: SampleName | None = Field(
+        None, description="a real grid shipped with auvplan: monterey, balanus or lisbon"
     )
     synthetic: Flag = Field(False, description="use the built-in synthetic volcanic bank")
     seed: Integer = Field(7, ge=0, le=2**32 - 1, description="seed of the synthetic bank")
@@ -92,9 +96,16 @@ class TerrainConfig(TableModel):
 
     @model_validator(mode="after")
     def _one_source(self) -> TerrainConfig:
-        if (self.file is None) == (not self.synthetic):
-            raise ValueError("give a bathymetry file = '...' or synthetic = true (one of them)")
+        if [self.file is not None, self.sample is not None, self.synthetic].count(True) != 1:
+            raise ValueError(
+                "give a bathymetry file = '...', a sample = '...' or synthetic = true (one of them)"
+            )
         return self
+
+    @property
+    def path(self) -> Path | None:
+        """The bathymetry file read: ``file``, or the packaged sample's (None: the bank)."""
+        return sample_path(self.sample) if self.sample is not None else self.file
 
 
 class MapsConfig(TableModel):
