@@ -289,7 +289,7 @@ CASES: dict[str, tuple[Callable[[Path], list[str]], str]] = {
             "vehicle",
             _write(tmp / "boat.toml", MEDUSA.replace("value = 75.0,", "value = 1e-9,")),
         ],
-        "propulsion.n_max must be >= 0.5 rev/s (range 0.5 … 1000 rev/s), got 1e-09",
+        "propulsion.n_max: Input should be greater than or equal to 0.5, got 1e-09 rev/s",
     ),
     # 5. command-line values
     "maps --seed -1": (

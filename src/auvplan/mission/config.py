@@ -13,14 +13,14 @@ from these models (:mod:`auvplan.mission.keys`).
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Final
 
-from pydantic import BaseModel, Field, ValidationError, model_validator
+from pydantic import Field, ValidationError, model_validator
 
 from auvplan.errors import InputError
+from auvplan.io.tables import one_line
 from auvplan.io.text import read_toml
 from auvplan.mission.tables import (
     CommConfig,
@@ -41,7 +41,6 @@ from auvplan.mission.tables import (
     VehicleConfig,
     WeightsConfig,
     WindowConfig,
-    nested_model,
 )
 
 #: Most solver steps a mission may ask for (``horizon_s / dt_s``) before anything is allocated.
@@ -152,7 +151,7 @@ def parse_mission(
     try:
         config = MissionConfig.model_validate({**data, "source": source})
     except ValidationError as error:
-        raise InputError(one_line(error)) from None
+        raise InputError(one_line(error, MissionConfig)) from None
     if config.terrain.file is not None and not config.terrain.file.is_absolute():
         terrain = config.terrain.model_copy(update={"file": base_dir / config.terrain.file})
         config = config.model_copy(update={"terrain": terrain})
@@ -210,58 +209,6 @@ def _resolve_vehicle_file(vehicle: VehicleConfig, base_dir: Path) -> VehicleConf
     if vehicle.type.endswith(".toml") and candidate.is_file():
         return vehicle.model_copy(update={"type": str(candidate)})
     return vehicle
-
-
-def _key_path(location: tuple[int | str, ...]) -> str:
-    """``('vehicle', 2, 'start', 'north')`` -> ``vehicle[2].start.north``."""
-    text = ""
-    for part in location:
-        if isinstance(part, int):
-            text += f"[{part}]"
-        elif part not in ("function-after",) and not part.startswith(("int", "literal[", "tuple[")):
-            text += f".{part}" if text else part
-    return text or "mission"
-
-
-def _keys_of(location: tuple[int | str, ...]) -> list[str]:
-    """The TOML keys allowed in the table at ``location`` (walking the models)."""
-    model: type[BaseModel] = MissionConfig
-    for part in location:
-        if isinstance(part, int):
-            continue
-        field = next(
-            (f for name, f in model.model_fields.items() if (f.alias or name) == part), None
-        )
-        nested = nested_model(field.annotation)[0] if field is not None else None
-        if nested is None:
-            return []
-        model = nested
-    return [f.alias or name for name, f in model.model_fields.items() if not f.exclude]
-
-
-def one_line(error: ValidationError, within: tuple[str, ...] = ()) -> str:
-    """The first validation error as one line naming the key path and the value.
-
-    ``within``: the path of the validated table in the mission (e.g. ``("navigation",)`` for
-    a :class:`~auvplan.mission.tables.NavigationConfig` validated on its own).
-    """
-    first = error.errors(include_url=False)[0]
-    location = (*within, *first["loc"])
-    path = _key_path(location)
-    if first["type"] == "extra_forbidden":
-        allowed = ", ".join(_keys_of(location[:-1]))
-        return f"unknown key {path!r} (allowed here: {allowed})"
-    if first["type"] == "missing":
-        return f"{path} is required"
-    message = str(first["msg"]).removeprefix("Value error, ")
-    if first["type"] == "value_error":
-        key = re.match(r"([a-z_]+): ", message)
-        if key and path != "mission":  # a model validator naming one of its keys
-            return f"{path}.{message}"
-        return message if path == "mission" else f"{path}: {message}"
-    value = first.get("input")
-    shown = repr(value) if not isinstance(value, dict | list) else type(value).__name__
-    return f"{path}: {message}, got {shown[:60]}"
 
 
 __all__ = [

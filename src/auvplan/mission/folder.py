@@ -8,7 +8,8 @@ from typing import Any
 from pydantic import ValidationError
 
 from auvplan.errors import InputError
-from auvplan.mission.config import one_line
+from auvplan.io.tables import one_line
+from auvplan.mission.config import MissionConfig
 from auvplan.mission.tables import NavigationConfig
 
 
@@ -33,7 +34,7 @@ def mission_navigation(
             {**(table if isinstance(table, dict) else {}), **overrides}
         )
     except ValidationError as error:
-        raise InputError(one_line(error, within=("navigation",))) from None
+        raise InputError(one_line(error, MissionConfig, within=("navigation",))) from None
 
 
 __all__ = ["mission_navigation"]
