@@ -33,6 +33,7 @@ import importlib
 import io
 import logging
 import multiprocessing
+import os
 import signal
 import time
 import warnings
@@ -45,6 +46,7 @@ from typing import TYPE_CHECKING, Final, TypeVar
 import numba
 
 import auvplan
+from auvplan.errors import InputError
 from auvplan.interrupts import checkpoint
 from auvplan.mission.config import MissionConfig
 from auvplan.mission.warmup import warm_up, warm_up_missions
@@ -208,4 +210,24 @@ def _prepare() -> None:
     figure.savefig(io.BytesIO(), format="png")
 
 
-__all__ = ["Companion", "warm_marker"]
+def resolve_jobs(given: int | None) -> int:
+    """The processes of a run: ``given``, else ``$AUVPLAN_JOBS``, else 2 with 2+ cores, else 1.
+
+    2 runs a :class:`Companion` beside the mission; 1 runs in this process only.
+
+    Raises
+    ------
+    InputError
+        If the number given (or the variable's text, quoted) is not 1 or 2.
+    """
+    text = os.environ.get("AUVPLAN_JOBS", "") if given is None else str(given)
+    if text in ("1", "2"):
+        return int(text)
+    if text:
+        shown = text if given is not None else repr(text)
+        raise InputError(f"--jobs (or $AUVPLAN_JOBS) must be 1 or 2, got {shown}")
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    return 2 if (cores or 1) >= 2 else 1
+
+
+__all__ = ["Companion", "resolve_jobs", "warm_marker"]

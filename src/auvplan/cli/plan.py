@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-from contextlib import nullcontext
 from pathlib import Path
 from typing import Any
 
@@ -81,26 +79,6 @@ def _add_common(parser: argparse.ArgumentParser, *, default_output: Path | None)
     add_figure_options(parser)
 
 
-def _jobs(given: int | None) -> int:
-    """The processes: ``--jobs``, else ``$AUVPLAN_JOBS``, else 2 with 2+ cores, else 1.
-
-    Raises
-    ------
-    InputError
-        If the number given (or the variable's text, quoted) is not 1 or 2.
-    """
-    from auvplan.errors import InputError
-
-    text = os.environ.get("AUVPLAN_JOBS", "") if given is None else str(given)
-    if text in ("1", "2"):
-        return int(text)
-    if text:
-        shown = text if given is not None else repr(text)
-        raise InputError(f"--jobs (or $AUVPLAN_JOBS) must be 1 or 2, got {shown}")
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    return 2 if (cores or 1) >= 2 else 1
-
-
 def run_plan(args: argparse.Namespace) -> int:
     """Load, validate and run the mission file."""
     from auvplan.mission.config import load_mission
@@ -115,85 +93,45 @@ def run_demo(args: argparse.Namespace) -> int:
     return _run(demo_mission(), args)
 
 
-def _export_formats(config: Any, args: argparse.Namespace) -> tuple[str, ...]:
-    """The ``--export`` formats, checked before any planning (fail fast)."""
-    from auvplan.errors import InputError
-    from auvplan.export import parse_formats
-
-    if getattr(args, "formats", None) is None:
-        return ()
-    formats = parse_formats(args.formats)
-    if args.stage != "full":
-        raise InputError(f"--export needs the optimised plan: drop --stage {args.stage}")
-    if config.terrain.synthetic:
-        raise InputError(
-            "--export needs lat/lon, but the synthetic bank has no geographic reference: "
-            "plan on a georeferenced bathymetry file"
-        )
-    return formats
-
-
 def _run(config: Any, args: argparse.Namespace) -> int:
-    from auvplan.api import plan
-    from auvplan.api.companion import Companion
+    """Plan ``config`` into ``--output``, print the report, and choose the exit code."""
+    from auvplan.api.planning import plan_to_folder
     from auvplan.export import DEFAULT_TOLERANCE_M
 
-    formats = _export_formats(config, args)
-    jobs = _jobs(args.jobs)
-    with Companion() if jobs == 2 else nullcontext() as companion:
-        if companion is not None and not args.no_figures:
-            companion.start()  # its imports overlap the planning
-        mission_plan = plan(
-            config,
-            stage=args.stage,
-            compare_energy_only=args.compare_energy_only,
-            compare_no_current=args.compare_no_current,
-            compare_paper=args.compare_paper,
-            progress=not args.quiet,
-            companion=companion,
-        )
-        written = mission_plan.save(
-            args.output,
-            figures=not args.no_figures,
-            figure_format=args.figure_format,
-            dpi=args.dpi,
-            exports=formats,
-            tolerance_m=getattr(args, "tolerance_m", DEFAULT_TOLERANCE_M),  # demo: no --export
-            moos_frame=getattr(args, "moos_frame", "utm"),
-            companion=companion,
-        )
-    result = mission_plan.result
+    saved = plan_to_folder(
+        config,
+        args.output,
+        stage=args.stage,
+        compare_energy_only=args.compare_energy_only,
+        compare_no_current=args.compare_no_current,
+        compare_paper=args.compare_paper,
+        progress=not args.quiet,
+        jobs=args.jobs,
+        figures=not args.no_figures,
+        figure_format=args.figure_format,
+        dpi=args.dpi,
+        exports=getattr(args, "formats", None),  # demo: no --export
+        tolerance_m=getattr(args, "tolerance_m", DEFAULT_TOLERANCE_M),
+        moos_frame=getattr(args, "moos_frame", "utm"),
+    )
     if not args.quiet:
-        _print_report(result, written)
-    return _exit_code(result)
+        _print_report(saved.result, saved.written)
+    return _exit_code(saved.result.problem)
 
 
-def _exit_code(result: Any) -> int:
+def _exit_code(problem: str | None) -> int:
     """0 for a plan that converged with every constraint met between samples; otherwise 3.
 
     The outputs are still written (the best plan found), the summary records the status and
     the violations, and one line on stderr names the first problem and what to change.
     """
-    if result.failure is not None:
-        print(f"auvplan: plan FAILED: {result.failure}", file=sys.stderr)
-        return EXIT_NOT_CONVERGED
-    if result.plan is None:  # stopped before stage 3: the routes' navigation budgets
-        for choice in result.preplan.navigation or ():
-            if not choice.budget_met:
-                print(f"auvplan: plan NAVIGATION_BUDGET: {choice.message}", file=sys.stderr)
-                return EXIT_NOT_CONVERGED
-    comparisons = (("energy-only plan", result.energy_only), ("paper's plan", result.paper_plan))
-    for label, plan in (("plan", result.plan), *comparisons):
-        if plan is not None and not plan.verdict.success:
-            print(
-                f"auvplan: {label} {plan.verdict.status.name}: {plan.verdict.message}",
-                file=sys.stderr,
-            )
-            return EXIT_NOT_CONVERGED
-    return 0
+    if problem is None:
+        return 0
+    print(f"auvplan: {problem}", file=sys.stderr)
+    return EXIT_NOT_CONVERGED
 
 
-def _print_report(result: Any, written: list[Path]) -> None:
+def _print_report(result: Any, written: tuple[Path, ...]) -> None:
     out = sys.stdout
     print(f"stage: {result.stage.value}", file=out)
     for name, seconds in result.timings.items():

@@ -74,6 +74,27 @@ class MissionResult:
         """The optimised plan of :attr:`paper`, if it was planned and optimised."""
         return None if self.paper is None else self.paper.plan
 
+    @property
+    def problem(self) -> str | None:
+        """The first reason this run is not a usable plan, in one line; None if it is.
+
+        None when the plan converged with every constraint met between samples, and the
+        comparison plans (energy-only, the paper's) did too; before stage 3, when every
+        route meets its navigation budget. Otherwise the line names the plan, its status and
+        what to change, e.g. ``"plan FAILED: ..."`` or ``"paper's plan MAX_ITER: ..."``.
+        """
+        if self.failure is not None:
+            return f"plan FAILED: {self.failure}"
+        if self.plan is None:  # stopped before stage 3: the routes' navigation budgets
+            for choice in self.preplan.navigation or ():
+                if not choice.budget_met:
+                    return f"plan NAVIGATION_BUDGET: {choice.message}"
+        comparisons = (("energy-only plan", self.energy_only), ("paper's plan", self.paper_plan))
+        for label, plan in (("plan", self.plan), *comparisons):
+            if plan is not None and not plan.verdict.success:
+                return f"{label} {plan.verdict.status.name}: {plan.verdict.message}"
+        return None
+
 
 def run_mission(
     config: MissionConfig,
