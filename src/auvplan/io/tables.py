@@ -12,7 +12,13 @@ import re
 import types
 from typing import Annotated, Any, Union, get_args, get_origin
 
-from pydantic import BaseModel, ConfigDict, Tag, ValidationError
+from pydantic import BaseModel, ConfigDict, Strict, Tag, ValidationError
+
+#: Strict scalar types: TOML's own types, no strings parsed as numbers, no NaN/inf.
+Number = Annotated[float, Strict()]
+Integer = Annotated[int, Strict()]
+Flag = Annotated[bool, Strict()]
+Text = Annotated[str, Strict()]
 
 
 class TableModel(BaseModel):
@@ -113,4 +119,4 @@ def one_line(error: ValidationError, root: type[BaseModel], within: tuple[str, .
     return f"{path}: {message}" if path else message
 
 
-__all__ = ["TableModel", "nested_model", "one_line"]
+__all__ = ["Flag", "Integer", "Number", "TableModel", "Text", "nested_model", "one_line"]

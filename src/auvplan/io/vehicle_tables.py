@@ -24,7 +24,7 @@ from pydantic import (
     model_validator,
 )
 
-from auvplan.io.tables import TableModel
+from auvplan.io.tables import Flag, Integer, TableModel, Text
 from auvplan.vehicle.params import (
     DEFAULT_EPS_ABS_RATE,
     DEFAULT_EPS_ABS_SPEED,
@@ -59,8 +59,6 @@ UNITS: Final[dict[str, dict[str, float]]] = {
     "s/m": {"s/m": 1.0},
 }
 
-Integer = Annotated[int, Strict()]
-Flag = Annotated[bool, Strict()]
 Name = Annotated[str, Strict(), Field(min_length=1)]
 #: Bound of a propeller's ``order`` (its table checks the harmonics it has) [-].
 _MAX_ORDER: Final = 2**31
@@ -174,9 +172,7 @@ class FourQuadrantPropellerTable(VehicleTable):
     """A four-quadrant Fourier table (packaged or a CSV next to the file), scaled."""
 
     model: Literal["four_quadrant"] = Field("four_quadrant", description="propeller model")
-    table: Annotated[str, Strict()] = Field(
-        description="packaged table name or CSV path relative to the vehicle file"
-    )
+    table: Text = Field(description="packaged table name or CSV path relative to the vehicle file")
     diameter: float = _quantity(*_DIAMETER)
     c_T: float = _quantity("1", 0.1, 10.0, "thrust correction factor")
     c_Q: float = _quantity("1", 0.1, 10.0, "torque correction factor")
@@ -302,7 +298,7 @@ class VehicleFile(VehicleTable):
     """A vehicle file: the twin-thruster shorthand or a list of actuators."""
 
     name: Name = Field(description="vehicle type name")
-    description: Annotated[str, Strict()] = Field("", description="free text (origin of the set)")
+    description: Text = Field("", description="free text (origin of the set)")
     hull: HullTable
     power: PowerTable
     smoothing: SmoothingTable = Field(default_factory=SmoothingTable)

@@ -20,7 +20,7 @@ from typing import Any, Final
 from pydantic import Field, ValidationError, model_validator
 
 from auvplan.errors import InputError
-from auvplan.io.tables import one_line
+from auvplan.io.tables import TableModel, one_line
 from auvplan.io.text import read_toml
 from auvplan.mission.tables import (
     CommConfig,
@@ -36,7 +36,6 @@ from auvplan.mission.tables import (
     Position,
     SolverConfig,
     StartPose,
-    TableModel,
     TerrainConfig,
     VehicleConfig,
     WeightsConfig,

@@ -18,8 +18,8 @@ from pydantic import BaseModel
 from pydantic.fields import FieldInfo
 from pydantic_core import PydanticUndefined
 
+from auvplan.io.tables import nested_model
 from auvplan.mission.config import MissionConfig
-from auvplan.mission.tables import nested_model
 
 _BOUNDS = (
     (annotated_types.Gt, "gt", ">"),

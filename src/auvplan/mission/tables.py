@@ -8,25 +8,20 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import types
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, Final, Literal, Union, get_args, get_origin
+from typing import TYPE_CHECKING, Annotated, Any, Final, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, Strict, field_validator, model_validator
+from pydantic import Field, Strict, field_validator, model_validator
 
 from auvplan.errors import InputError
 from auvplan.io.samples import SampleName, sample_path
+from auvplan.io.tables import Flag, Integer, Number, TableModel, Text
 from auvplan.optimization import ProntoOptions
 
 if TYPE_CHECKING:  # the navigation package (numba kernels) loads only when a run needs it
     from auvplan.navigation import NavigationSettings
 
-#: Strict scalar types: TOML's own types, no strings parsed as numbers, no NaN/inf.
-Number = Annotated[float, Strict()]
-Integer = Annotated[int, Strict()]
-Flag = Annotated[bool, Strict()]
-Text = Annotated[str, Strict()]
 Interval = tuple[Number, Number]
 BlockSize = Annotated[int, Strict(), Field(ge=1, le=256)]
 
@@ -44,12 +39,6 @@ START_YEARS: Final = (1900, 2200)
 
 def _unit(unit: str) -> dict[str, Any]:
     return {"unit": unit}
-
-
-class TableModel(BaseModel):
-    """A TOML table: unknown keys and NaN/inf are refused; instances are immutable."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 def _check_interval(value: Interval | None, key: str) -> None:
@@ -568,16 +557,3 @@ class ExecutionConfig(TableModel):
         if not START_YEARS[0] <= value.year <= START_YEARS[1]:
             raise ValueError(f"year {value.year} is outside {START_YEARS[0]}-{START_YEARS[1]}")
         return value.astimezone(UTC)
-
-
-def nested_model(annotation: Any) -> tuple[type[BaseModel] | None, bool]:
-    """The table model inside ``X``, ``X | None`` or ``tuple[X, ...]``, and whether an array."""
-    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return annotation, False
-    origin = get_origin(annotation)
-    if origin in (Union, types.UnionType, tuple):
-        for argument in get_args(annotation):
-            model, _ = nested_model(argument)
-            if model is not None:
-                return model, origin is tuple
-    return None, False
