@@ -206,6 +206,9 @@ class Verb:
     options: dict[str, tuple[tuple[str, ...], ...]]
 
 
+#: The cheapest sweep: one preplan run of the folder's mission on an in-process cluster.
+SWEEP_TAIL = ("-o", "@/swept", "--stage", "preplan", "--workers", "1", "--vary",
+              "weights.terrain=1", "--seeds", "0", "--runs", "2", "--particles", "50")  # fmt: skip
 VERBS: dict[str, Verb] = {
     "export": Verb(
         ("export",),
@@ -227,18 +230,7 @@ VERBS: dict[str, Verb] = {
     "sweep": Verb(
         ("sweep",),
         (("@/mission.toml",), ("scenarios",), *((p,) for p in PATHS)),
-        (
-            "-o",
-            "@/swept",
-            "--stage",
-            "preplan",
-            "--workers",
-            "1",
-            "--runs",
-            "2",
-            "--particles",
-            "50",
-        ),
+        SWEEP_TAIL,
         {
             "--vary": tuple(
                 (v,)
@@ -601,7 +593,7 @@ def _problem(
 
 
 CI = settings(
-    max_examples=12,
+    max_examples=20,
     derandomize=True,
     deadline=None,
     database=None,
@@ -618,7 +610,7 @@ def test_damaged_folders_are_refused_in_one_line(template: Path, case: Case) -> 
     event(f"{case.argv[0]}: exit {code}")
 
 
-@settings(CI, max_examples=24)
+@settings(CI, max_examples=40)
 @given(case=argument_cases())
 def test_bad_arguments_are_refused_in_one_line(template: Path, case: Case) -> None:
     note(str(case))
