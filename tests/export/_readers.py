@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -128,16 +129,22 @@ def moos_points(value: str) -> list[tuple[float, float]]:
     return [(float(x), float(y)) for x, y in pairs]
 
 
-def cf_findings(path: Path, report: Path) -> dict[str, list[str]]:
-    """Names of the failed checks of the IOOS compliance checker's CF-1.8 test, by priority.
-
-    ``report`` is where the checker writes its JSON report.
-    """
+def checker_report(path: Path, report: Path, test: str) -> dict[str, Any]:
+    """The IOOS compliance checker's JSON report of ``test`` (``"cf:1.8"``, ``"acdd:1.3"``,
+    ``"ncei-trajectory:2.0"`` with the NCEI plugin) on ``path``, written to ``report``."""
     CheckSuite.load_all_available_checkers()
-    ComplianceChecker.run_checker(
-        str(path), ["cf:1.8"], 0, "normal", output_filename=str(report), output_format="json"
-    )
-    results = json.loads(report.read_text())["cf:1.8"]
+    with warnings.catch_warnings():  # the NCEI plugin calls a deprecated checker interface
+        warnings.simplefilter("ignore", DeprecationWarning)
+        ComplianceChecker.run_checker(
+            str(path), [test], 0, "normal", output_filename=str(report), output_format="json"
+        )
+    results: dict[str, Any] = json.loads(report.read_text())[test]
+    return results
+
+
+def cf_findings(path: Path, report: Path, test: str = "cf:1.8") -> dict[str, list[str]]:
+    """Names of the failed checks of a compliance-checker ``test``, by priority."""
+    results = checker_report(path, report, test)
     return {
         priority: [item["name"] for item in results[f"{priority}_priorities"] if item["msgs"]]
         for priority in ("high", "medium", "low")

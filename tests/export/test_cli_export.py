@@ -23,7 +23,7 @@ from auvplan.mission.config import load_mission, parse_mission
 from auvplan.terrain import LocalProjection
 
 from ._plans import MISSION
-from ._readers import cf_findings
+from ._readers import cf_findings, checker_report
 
 ALL = ",".join(FORMATS)
 
@@ -32,7 +32,8 @@ def test_trajectories_netcdf_is_a_cf_trajectory_file(planned_folder: Path, tmp_p
     path = planned_folder / "trajectories.nc"
     findings = cf_findings(path, tmp_path / "cf.json")
     assert findings["high"] == [], findings
-    assert findings["medium"] == [], findings
+    # the one warning: Conventions names CF-1.6, as the NCEI template v2.0 requires verbatim
+    assert findings["medium"] == ["§2.6 Attributes"], findings
     table = pd.read_csv(planned_folder / "trajectories.csv")
     summary = json.loads((planned_folder / "summary.json").read_text())
     with xr.open_dataset(path) as dataset:
@@ -62,6 +63,21 @@ def test_trajectories_netcdf_is_a_cf_trajectory_file(planned_folder: Path, tmp_p
                 dataset["heading"].values[i] - np.degrees(rows["psi"].to_numpy()) + 180.0
             ) % 360.0 - 180.0
             assert np.max(np.abs(turn)) < 0.01
+
+
+def test_trajectories_netcdf_follows_the_ncei_template_and_acdd(
+    planned_folder: Path, tmp_path: Path
+) -> None:
+    """NCEI trajectory template v2.0: no required failure; ACDD-1.3 discovery attributes."""
+    path = planned_folder / "trajectories.nc"
+    assert cf_findings(path, tmp_path / "ncei.json", "ncei-trajectory:2.0")["high"] == []
+    acdd = checker_report(path, tmp_path / "acdd.json", "acdd:1.3")
+    assert acdd["scored_points"] / acdd["possible_points"] >= 0.8  # 68 of 85 measured
+    with xr.open_dataset(path) as dataset:
+        assert dataset.attrs["ncei_template_version"] == "NCEI_NetCDF_Trajectory_Template_v2.0"
+        assert dataset.attrs["geospatial_lat_min"] == pytest.approx(float(dataset["lat"].min()))
+        assert dataset["u"].attrs["coverage_content_type"] == "modelResult"
+        assert dataset["u"].attrs["valid_max"] == pytest.approx(float(dataset["u"].max()))
 
 
 def test_summary_records_version_inputs_and_start_time(planned_folder: Path) -> None:

@@ -1,4 +1,8 @@
-"""``trajectories.nc``: the optimised trajectories as a CF-1.8 ``featureType = "trajectory"`` file.
+"""``trajectories.nc``: the optimised trajectories as a CF ``featureType = "trajectory"`` file.
+
+It follows the NCEI NetCDF trajectory template v2.0 and carries ACDD-1.3 discovery attributes
+(:func:`_discovery_attributes`), and every variable its ``coverage_content_type`` and valid
+range.
 
 The layout follows the NCEI NetCDF trajectory template (v2.0, multidimensional array
 representation, CF §H.4.1): one ``trajectory`` per vehicle (the ``trajectory`` variable holds
@@ -33,14 +37,16 @@ is a true heading. On terrain without georeference (the synthetic bank) there is
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Mapping, Sequence
-from datetime import datetime
+from datetime import datetime, timedelta
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Final
 
 import numpy as np
 
 from auvplan._typing import FloatArray
+from auvplan._version import __version__
 from auvplan.errors import DataFormatError
 from auvplan.terrain.projection import LocalProjection
 
@@ -241,12 +247,15 @@ def trajectories_dataset(
             {"long_name": "vehicle type (auvplan vehicle file name)"},
         )
     dataset = xr.Dataset(data, coords=coords)
+    for name, variable in dataset.variables.items():
+        variable.attrs["coverage_content_type"] = (
+            "coordinate" if name in dataset.coords else "modelResult"
+        )
+        if variable.dtype.kind == "f" and bool(np.isfinite(variable.values).any()):
+            variable.attrs["valid_min"] = float(np.nanmin(variable.values))
+            variable.attrs["valid_max"] = float(np.nanmax(variable.values))
     dataset.attrs = {
-        "Conventions": "CF-1.8",
-        "featureType": "trajectory",
-        "cdm_data_type": "Trajectory",
-        "title": "auvplan optimised trajectories",
-        "time_coverage_start": start_time.isoformat(),
+        **_discovery_attributes(dataset, names, time, start_time, depth),
         **attributes,
     }
     for variable in dataset.variables.values():
@@ -261,6 +270,84 @@ def trajectories_dataset(
         dtype="float64",
     )
     return dataset
+
+
+#: The NCEI NetCDF template the file follows (checked by ``cc-plugin-ncei``).
+NCEI_TEMPLATE: Final = "NCEI_NetCDF_Trajectory_Template_v2.0"
+#: ``Conventions``: the NCEI trajectory template v2.0 requires exactly this string (its CF
+#: layer is CF-1.6); the content is also CF-1.8-clean (``compliance-checker -t cf:1.8``).
+CONVENTIONS: Final = "CF-1.6, ACDD-1.3"
+
+
+def _discovery_attributes(
+    dataset: xr.Dataset,
+    names: Sequence[str],
+    time: FloatArray,
+    start_time: datetime,
+    depth: float,
+) -> dict[str, Any]:
+    """CF, ACDD-1.3 and NCEI trajectory-template global attributes from the data itself.
+
+    Everything is derived from the plan (extent, times, vehicles), so the same plan gives the
+    same file: no creation date.
+    """
+    end_time = start_time + timedelta(seconds=float(time[-1]))
+    digest = hashlib.sha256(np.ascontiguousarray(dataset["north"].values).tobytes())
+    digest.update(np.ascontiguousarray(dataset["east"].values).tobytes())
+    attributes: dict[str, Any] = {
+        "Conventions": CONVENTIONS,
+        "ncei_template_version": NCEI_TEMPLATE,
+        "featureType": "trajectory",
+        "cdm_data_type": "Trajectory",
+        "title": "auvplan optimised trajectories",
+        "summary": f"Energy-optimal, collision-free trajectories of {len(names)} marine "
+        f"vehicle(s) ({', '.join(names)}) planned by auvplan over a bathymetry grid, from "
+        f"{start_time.isoformat()} to {end_time.isoformat()}, at a constant depth of "
+        f"{depth:g} m: positions, body velocities, actuator states and electrical power at "
+        "the solver's time steps.",
+        "keywords": "autonomous underwater vehicle, AUV, trajectory planning, multi-vehicle, "
+        "terrain-aided navigation, bathymetry, energy",
+        "id": f"auvplan-{digest.hexdigest()[:16]}",
+        "product_version": __version__,
+        "standard_name_vocabulary": "CF Standard Name Table v93",
+        "source": "numerical trajectory optimisation (auvplan)",
+        "processing_level": "planned trajectories (model output), not measurements",
+        "time_coverage_start": start_time.isoformat(),
+        "time_coverage_end": end_time.isoformat(),
+        "time_coverage_duration": f"PT{float(time[-1]):g}S",
+        "time_coverage_resolution": f"PT{float(time[1] - time[0]):g}S" if time.size > 1 else "",
+        "comment": "A plan, not observations: what each vehicle is to fly, at the optimiser's "
+        "time steps (trajectories.csv holds the same numbers).",
+        "acknowledgment": "Method: Häusler, Saccon, Pascoal, Hauser and Aguiar, Cooperative AUV "
+        "Motion Planning using Terrain Information, OCEANS 2013; bathymetry: the source named "
+        "in the run's summary.json",
+        "geospatial_vertical_min": float(depth),
+        "geospatial_vertical_max": float(depth),
+        "geospatial_vertical_units": "m",
+        "geospatial_vertical_positive": "down",
+    }
+    if "lat" in dataset.coords:
+        lat, lon = dataset["lat"].values, dataset["lon"].values
+        attributes.update(
+            geospatial_lat_min=float(np.min(lat)),
+            geospatial_lat_max=float(np.max(lat)),
+            geospatial_lat_units="degrees_north",
+            geospatial_lon_min=float(np.min(lon)),
+            geospatial_lon_max=float(np.max(lon)),
+            geospatial_lon_units="degrees_east",
+            geospatial_bounds=_bounds_wkt(lat, lon),
+            geospatial_bounds_crs="EPSG:4326",
+            geospatial_bounds_vertical_crs="EPSG:5831",  # depth below the sea surface
+        )
+    return attributes
+
+
+def _bounds_wkt(lat: FloatArray, lon: FloatArray) -> str:
+    """ACDD ``geospatial_bounds``: the WKT polygon (lat lon order) around every position."""
+    south, north = float(np.min(lat)), float(np.max(lat))
+    west, east = float(np.min(lon)), float(np.max(lon))
+    corners = [(south, west), (north, west), (north, east), (south, east), (south, west)]
+    return "POLYGON ((" + ", ".join(f"{a:.7f} {b:.7f}" for a, b in corners) + "))"
 
 
 def read_trajectories_netcdf(path: Path) -> xr.Dataset:
