@@ -5,7 +5,8 @@ folders (data, exports, figures, ``report.html``), :mod:`auvplan.api.progress` s
 on the console. The command line is built on these, one function per verb:
 :mod:`auvplan.api.planning` plans a mission into its output folder, :mod:`auvplan.api.maps`
 writes the terrain maps of a bathymetry, :mod:`auvplan.api.navigation` flies a folder's
-plans through the TAN simulator and :mod:`auvplan.api.vehicle` describes a vehicle type.
+plans through the TAN simulator, :mod:`auvplan.api.sweep` runs a parameter sweep and
+:mod:`auvplan.api.vehicle` describes a vehicle type.
 
 The names are imported on first use, so a verb that needs one module (``auvplan vehicle``)
 does not load the planning pipeline.
@@ -30,6 +31,8 @@ _LAZY = {
     "MissionSource": "auvplan.api.result",
     "load": "auvplan.api.result",
     "plan": "auvplan.api.result",
+    "SweepOutcome": "auvplan.api.sweep",
+    "sweep_to_folder": "auvplan.api.sweep",
     "VehicleDescription": "auvplan.api.vehicle",
     "describe_vehicle": "auvplan.api.vehicle",
 }
@@ -41,6 +44,7 @@ if TYPE_CHECKING:
     from auvplan.api.planning import SavedPlan, plan_to_folder
     from auvplan.api.progress import ConsoleProgress
     from auvplan.api.result import MissionPlan, MissionSource, load, plan
+    from auvplan.api.sweep import SweepOutcome, sweep_to_folder
     from auvplan.api.vehicle import VehicleDescription, describe_vehicle
 
 __all__ = [
@@ -50,12 +54,14 @@ __all__ = [
     "MissionPlan",
     "MissionSource",
     "SavedPlan",
+    "SweepOutcome",
     "VehicleDescription",
     "describe_vehicle",
     "evaluate_output_folder",
     "load",
     "plan",
     "plan_to_folder",
+    "sweep_to_folder",
     "write_output_folder",
     "write_terrain_maps",
 ]

@@ -97,6 +97,13 @@ class RunRecord:
         """True when the run produced no plan output (it raised, or the optimiser failed)."""
         return self.folder is None or self.status == PLAN_FAILED
 
+    @property
+    def description(self) -> str:
+        """One line for progress displays: ``run-id: status[ wall s][: reason]``."""
+        wall = "" if self.wall_s is None else f" {self.wall_s:.1f} s"
+        reason = f": {self.reason}" if self.reason else ""
+        return f"{self.run_id}: {self.status}{wall}{reason}"
+
 
 def run_record_document(
     run: SweepRun, *, wall_s: float, peak_rss_mb: float | None, messages: Sequence[str]
