@@ -65,6 +65,11 @@ def test_summary_keeps_the_keys_users_read(tmp_path: Path) -> None:
     assert summary["fleet"]["deconfliction_method"] == summary["deconfliction"]["method"]
     assert summary["solver"]["dt"] == 1.0
     assert summary["solver"]["propeller_order"] is None  # "full", as before
+    # what to install to rerun it elsewhere: Python and the numeric packages' versions
+    from importlib import metadata
+
+    assert summary["environment"]["packages"]["numpy"] == metadata.version("numpy")
+    assert summary["environment"]["python"].count(".") == 2
 
 
 def test_routes_keep_out_of_the_other_vehicles_goals() -> None:

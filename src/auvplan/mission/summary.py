@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import dataclasses
+import platform
 from collections.abc import Sequence
 from enum import Enum
+from importlib import metadata
 from importlib.resources.abc import Traversable
 from pathlib import Path
-from typing import Any
+from typing import Any, Final
 
 import numpy as np
 
@@ -117,6 +119,31 @@ def _fingerprint(path: Path | Traversable) -> dict[str, str]:
     return {"path": location, "sha256": file_sha256(path)}
 
 
+#: The distributions whose versions decide a plan's numbers (recorded in ``summary.json``).
+NUMERIC_PACKAGES: Final = (
+    "numpy", "scipy", "casadi", "numba", "llvmlite", "xarray", "netCDF4", "pyproj", "shapely",
+    "pydantic", "rasterio",
+)  # fmt: skip
+
+
+def environment() -> dict[str, Any]:
+    """Python, the platform and the versions of :data:`NUMERIC_PACKAGES`.
+
+    What to install to rerun a folder to the same numbers on another machine.
+    """
+    versions: dict[str, str | None] = {}
+    for name in NUMERIC_PACKAGES:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = None
+    return {
+        "python": platform.python_version(),
+        "platform": platform.platform(terse=True),
+        "packages": versions,
+    }
+
+
 def _inputs(config: MissionConfig) -> dict[str, Any]:
     """Path and SHA-256 of every file the run read: mission, bathymetry, vehicle files."""
     return {
@@ -170,6 +197,7 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> P
     method = config.deconfliction.method if stage2 is None else stage2.coordination.method
     summary: dict[str, Any] = {
         "auvplan_version": __version__,
+        "environment": environment(),
         "mission": None if config.source is None else str(config.source),
         "inputs": _inputs(config),
         "start_time": config.mission.start_time.isoformat(),
