@@ -701,10 +701,14 @@ def test_garbage_in_a_compressed_chunk_of_maps_nc_is_one_line(template: Path) ->
     assert unreadable >= 5  # the five maps at least
 
 
-def test_maps_nc_damaged_as_the_campaign_found_it(
-    template: Path,
-) -> None:
-    damage = Damage("maps.nc", "garbage", (0.424, 0.0), b"\x94`\xb6\xad")
+@pytest.mark.parametrize(
+    "damage",
+    [
+        Damage("maps.nc", "garbage", (0.424, 0.0), b"\x94`\xb6\xad"),  # a data chunk
+        Damage("maps.nc", "garbage", (0.994, 0.0), b"\xe6Z\xbd\x82"),  # an attribute
+    ],
+)
+def test_maps_nc_damaged_as_the_campaign_found_it(damage: Damage, template: Path) -> None:
     case = _with_outputs(Case(("export", PLAN, "--format", "kml", "-o", "@/exported"), (damage,)))
     assert "@/plan/maps.nc: cannot " in _refused(case, template)
 

@@ -214,7 +214,7 @@ def read_maps_netcdf(path: str | Path) -> TerrainMaps:
     path = Path(path)
     try:
         dataset = xr.open_dataset(path, engine="netcdf4")
-    except (OSError, ValueError) as error:
+    except (OSError, ValueError, RuntimeError) as error:  # RuntimeError: damaged attributes
         raise DataFormatError(f"maps file {path}: cannot open ({error})") from None
     with dataset:
         try:
