@@ -70,6 +70,7 @@ print(frame.groupby("vehicle")[["u", "power"]].mean())
 figure = plan.plot()
 Path("out").mkdir(exist_ok=True)
 figure.savefig("out/notebook_api_paths.png", dpi=100)
+figure  # noqa: B018  (the cell's value: a notebook shows the figure, no %matplotlib needed)
 
 # %% [markdown]
 # The output folder of `auvplan plan` (data, figures as SVG, `report.html`), opened again.
