@@ -437,6 +437,8 @@ def _damage_summary(document: Any, damage: Damage) -> None:
 
 
 def _damage_table(lines: list[str], damage: Damage) -> list[str]:
+    if not lines:  # truncated to nothing before
+        return lines
     header, rows = lines[0].split(","), [line.split(",") for line in lines[1:]]
     if damage.how == "header-only":
         return lines[:1]
