@@ -162,6 +162,19 @@ def test_the_default_data_dir_may_be_absent(
     assert generate(3).terrain in {"bank", "synthetic"}
 
 
+def test_without_shared_data_the_family_reads_the_packaged_grids(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A fresh clone (no ../shared) draws the same family from the grids auvplan ships."""
+    from auvplan.io.samples import samples_folder
+    from auvplan.scenarios._terrain import default_data_dir
+
+    monkeypatch.delenv("AUVPLAN_SHARED_DATA", raising=False)
+    monkeypatch.chdir(tmp_path)  # no ../shared/data beside it
+    assert default_data_dir() == samples_folder()
+    assert {path.name for path in samples_folder().glob("*.nc")} == set(REAL_GRIDS.values())
+
+
 @pytest.mark.parametrize("seed", [1, 4, 11, 18, 25])
 def test_poses_in_water_away_from_no_go_cells_and_separated(
     seed: int, tmp_path: Path, bathymetry_dir: Path

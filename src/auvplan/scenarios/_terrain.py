@@ -28,6 +28,7 @@ import numpy as np
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
 from auvplan.io.bathymetry import read_bathymetry
+from auvplan.io.samples import SAMPLE_FILES, samples_folder
 from auvplan.terrain import (
     BathymetryGrid,
     GridGeometry,
@@ -36,12 +37,9 @@ from auvplan.terrain import (
     synthetic_bank,
 )
 
-#: Real grids of the shared data folder, by kind.
-REAL_GRIDS: Final = {
-    "monterey": "monterey_canyon_head_ncei_13arcsec.nc",
-    "lisbon": "south_lisbon_shelf_emodnet_dtm.nc",
-    "balanus": "balanus_seamount_gebco2024_15arcsec.nc",
-}
+#: Real grids of the data folder, by kind (the packaged samples' files; this order draws the
+#: seeded family).
+REAL_GRIDS: Final = {kind: SAMPLE_FILES[kind] for kind in ("monterey", "lisbon", "balanus")}
 TERRAIN_KINDS: Final = ("bank", "synthetic", *REAL_GRIDS)
 #: File name of a generated terrain inside the scenario folder.
 SYNTHETIC_FILE: Final = "terrain.nc"
@@ -83,9 +81,16 @@ class DrawnTerrain:
 
 
 def default_data_dir() -> Path:
-    """``$AUVPLAN_SHARED_DATA/bathymetry``, else ``../shared/data/bathymetry`` from the cwd."""
+    """The folder of the real grids of the scenario family.
+
+    ``$AUVPLAN_SHARED_DATA/bathymetry``; else ``../shared/data/bathymetry`` from the cwd if it
+    exists; else the grids packaged with auvplan (the same files: the same family).
+    """
     shared = os.environ.get("AUVPLAN_SHARED_DATA")
-    return (Path(shared) if shared else Path("..") / "shared" / "data") / "bathymetry"
+    if shared:
+        return Path(shared) / "bathymetry"
+    beside = Path("..") / "shared" / "data" / "bathymetry"
+    return beside if beside.is_dir() else samples_folder()
 
 
 def check_data_dir(path: Path) -> None:
