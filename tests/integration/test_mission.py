@@ -13,8 +13,9 @@ import pytest
 
 from auvplan.io.vehicles import load_vehicle
 from auvplan.mission.config import parse_mission
-from auvplan.mission.outputs import write_mission_files
+from auvplan.mission.outputs import plan_record
 from auvplan.mission.pipeline import MissionResult, run_mission
+from auvplan.record import write_record
 from auvplan.vehicle import build_vehicle_model
 from auvplan.vehicle.simulate import simulate_adaptive
 from auvplan.viz.report import save_mission_figures
@@ -31,7 +32,7 @@ def demo_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[MissionResult, P
         parse_mission(tomllib.loads(text)), compare_energy_only=True, compare_paper=True
     )
     out = tmp_path_factory.mktemp("demo")
-    write_mission_files(result, out)
+    write_record(plan_record(result), out)
     save_mission_figures(result, out)
     return result, out
 
