@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import signal
 from collections.abc import Callable
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -104,3 +105,49 @@ def test_install_keeps_the_handlers(monkeypatch: pytest.MonkeyPatch) -> None:
     finally:
         for number, handler in previous.items():
             signal.signal(number, handler)
+
+
+def test_a_child_started_in_the_block_never_sees_ctrl_c() -> None:
+    """SIGINT stays blocked in the child from its first instruction (no KeyboardInterrupt of
+    its own, even while it imports); the parent's mask comes back after the block."""
+    import subprocess
+    import sys
+
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, set())
+    with interrupts.children_ignore_ctrl_c():
+        child = subprocess.Popen(
+            [sys.executable, "-c", "import time; time.sleep(30)"], stderr=subprocess.PIPE
+        )
+    assert signal.pthread_sigmask(signal.SIG_BLOCK, set()) == before
+    try:
+        status = Path(f"/proc/{child.pid}/status").read_text()
+        line = next(row for row in status.splitlines() if row.startswith("SigBlk:"))
+        blocked = int(line.split()[1], 16)
+        assert blocked & (1 << (signal.SIGINT - 1))
+        child.send_signal(signal.SIGINT)
+        with pytest.raises(subprocess.TimeoutExpired):
+            child.wait(timeout=0.5)  # still running: the signal is pending, never delivered
+    finally:
+        child.kill()
+        _, err = child.communicate()
+    assert b"KeyboardInterrupt" not in err
+
+
+def test_after_the_work_a_signal_cannot_change_the_exit_code() -> None:
+    """The console script blocks SIGINT/SIGTERM once main returned: the interpreter's shutdown
+    restores the default handlers, and a late SIGTERM would otherwise kill it (exit -15)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import os, signal, sys\n"
+        "from auvplan import interrupts\n"
+        "interrupts.install()\n"
+        "interrupts.finished()\n"
+        "sys.stdout.write('done')\n"
+        "os.kill(os.getpid(), signal.SIGTERM)\n"
+        "os.kill(os.getpid(), signal.SIGINT)\n"
+        "sys.exit(0)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
+    assert (done.returncode, done.stdout, done.stderr) == (0, "done", "")

@@ -143,4 +143,43 @@ def held() -> Iterator[None]:
             signal.raise_signal(received[0])
 
 
-__all__ = ["STOP_SIGNALS", "Terminated", "checkpoint", "held", "install", "stop_requests"]
+@contextmanager
+def children_ignore_ctrl_c() -> Iterator[None]:
+    """Processes started in the block never see SIGINT (a terminal's Ctrl-C).
+
+    Ctrl-C reaches every process of the terminal's process group. A worker started here
+    inherits SIGINT *blocked* (the signal mask survives fork and exec), from its first
+    instruction — before Python could install any handler — so it never prints a
+    ``KeyboardInterrupt`` of its own; the process that started it stops it. This thread's mask
+    is restored when the block ends, and a SIGINT that arrived meanwhile is then delivered.
+    """
+    if not hasattr(signal, "pthread_sigmask"):  # not POSIX
+        yield
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+def finished() -> None:
+    """The work is done: SIGINT and SIGTERM are blocked for the rest of the process.
+
+    While the interpreter shuts down it restores the default handlers, and a signal then would
+    kill a process whose output is already complete (exit -15 instead of 0).
+    """
+    if hasattr(signal, "pthread_sigmask") and _in_main_thread():
+        signal.pthread_sigmask(signal.SIG_BLOCK, set(STOP_SIGNALS))
+
+
+__all__ = [
+    "STOP_SIGNALS",
+    "Terminated",
+    "checkpoint",
+    "children_ignore_ctrl_c",
+    "finished",
+    "held",
+    "install",
+    "stop_requests",
+]

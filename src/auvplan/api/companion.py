@@ -34,7 +34,6 @@ import io
 import logging
 import multiprocessing
 import os
-import signal
 import time
 import warnings
 from contextlib import AbstractContextManager
@@ -47,7 +46,7 @@ import numba
 
 import auvplan
 from auvplan.errors import InputError
-from auvplan.interrupts import checkpoint
+from auvplan.interrupts import checkpoint, children_ignore_ctrl_c
 from auvplan.mission.config import MissionConfig
 from auvplan.mission.warmup import warm_up, warm_up_missions
 from auvplan.optimization._kernel_cache import cache_root
@@ -94,7 +93,8 @@ class Companion(AbstractContextManager["Companion"]):
         """Spawn the worker now, so that its imports overlap the mission's own work."""
         if self._pool is None:
             context = multiprocessing.get_context("spawn")
-            self._pool = context.Pool(1, initializer=_prepare)
+            with children_ignore_ctrl_c():  # Ctrl-C is this process's to handle
+                self._pool = context.Pool(1, initializer=_prepare)
 
     def warm_up(self, config: MissionConfig) -> bool:
         """Start the warm-up of ``config`` unless it already ran here; True if it started."""
@@ -193,11 +193,11 @@ def _result(task: AsyncResult[T]) -> T:
 def _prepare() -> None:
     """The worker's start: import what it will run while the mission's process plans.
 
-    It ignores SIGINT: Ctrl-C in a terminal reaches every process of the group, and the
-    mission's process, which reports it, stops the worker (:meth:`Companion.close`). Its logs
+    It ignores SIGINT (it was started with SIGINT blocked, :func:`children_ignore_ctrl_c`):
+    Ctrl-C in a terminal reaches every process of the group, and the mission's process, which
+    reports it, stops the worker (:meth:`Companion.close`). Its logs
     and warnings are dropped: the mission's process reports.
     """
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
     logging.getLogger("auvplan").addHandler(logging.NullHandler())
     logging.getLogger("auvplan").propagate = False
     warnings.simplefilter("ignore")

@@ -127,9 +127,14 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def console() -> int:
-    """The ``auvplan`` console script: :func:`main` with stop requests from the first moment."""
+    """The ``auvplan`` console script: :func:`main` with stop requests from the first moment.
+
+    Once :func:`main` returned, SIGINT and SIGTERM are blocked: the exit code stands.
+    """
     interrupts.install()
-    return main()
+    code = main()
+    interrupts.finished()
+    return code
 
 
 if __name__ == "__main__":
