@@ -200,8 +200,11 @@ def _run_trials(count: int, tmp_path: Path, reference: tuple[list[str], float], 
         root.mkdir()
         trial = _trial(root, files, duration, rng)
         broken = _broken_promises(trial, files)
+        name = signal.Signals(trial.signum).name
+        # one line per trial (visible with -s): a long run's progress and its partial count
+        line = f"trial {number}: {name} at {trial.delay_s:.2f} s, exit {trial.code}: "
+        print(line + str(broken or "kept"), flush=True)  # noqa: T201
         if broken:
-            name = signal.Signals(trial.signum).name
             failures.append(f"trial {number} ({name} at {trial.delay_s:.2f} s): {broken}")
     assert failures == [], f"{len(failures)} of {count} trials broke the promise:\n" + "\n".join(
         failures
