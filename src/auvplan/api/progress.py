@@ -5,8 +5,8 @@
 context manager around :func:`~auvplan.mission.pipeline.run_mission`, it shows
 
 * on a terminal (or in Jupyter with ipywidgets), a rich progress display: one line per stage
-  with its elapsed time, a bar with the estimated time left where the amount of work is known (one A* search
-  per vehicle; the optimiser's barrier levels ``ε``, with the iteration, cost ``h``,
+  with its elapsed time, a bar with the estimated time left where the amount of work is known
+  (one A* search per vehicle; the optimiser's barrier levels ``ε``, with the iteration, cost ``h``,
   decrement ``−Dh·ζ`` and ``ε`` of the last iteration), and the log above it;
 * otherwise (a file, a pipe, a CI log), plain log lines of logger ``auvplan.api.progress`` at
   INFO level: each stage's duration, every tenth of a known amount of work with the time
