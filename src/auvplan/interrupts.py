@@ -79,6 +79,17 @@ def install() -> None:
 
 
 @contextmanager
+def _recording() -> Iterator[None]:
+    """:func:`_record` handles SIGINT and SIGTERM in the block; the previous handlers after."""
+    previous = {number: signal.signal(number, _record) for number in STOP_SIGNALS}
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, signal.SIG_DFL if handler is None else handler)
+
+
+@contextmanager
 def stop_requests() -> Iterator[None]:
     """While the block runs, SIGINT and SIGTERM are recorded and raised at checkpoints.
 
@@ -88,16 +99,14 @@ def stop_requests() -> Iterator[None]:
     if not _in_main_thread():
         yield
         return
-    previous = {number: signal.signal(number, _record) for number in STOP_SIGNALS}
-    _state.installed += 1
-    try:
-        yield
-    finally:
-        _state.installed -= 1
-        for number, handler in previous.items():
-            signal.signal(number, signal.SIG_DFL if handler is None else handler)
-        if not _state.installed:
-            del _state.pending[:]
+    with _recording():
+        _state.installed += 1
+        try:
+            yield
+        finally:
+            _state.installed -= 1
+            if not _state.installed:
+                del _state.pending[:]
 
 
 def checkpoint() -> None:
@@ -130,16 +139,16 @@ def held() -> Iterator[None]:
             _state.held -= 1
         checkpoint()
         return
-    previous = {number: signal.signal(number, _record) for number in STOP_SIGNALS}
-    _state.held += 1
     try:
-        yield
+        with _recording():
+            _state.held += 1
+            try:
+                yield
+            finally:
+                _state.held -= 1
     finally:
-        _state.held -= 1
-        for number, handler in previous.items():
-            signal.signal(number, signal.SIG_DFL if handler is None else handler)
         received, _state.pending[:] = list(_state.pending), []
-        if received:
+        if received:  # to the handlers that were in place again
             signal.raise_signal(received[0])
 
 
