@@ -154,32 +154,37 @@ def held() -> Iterator[None]:
 
 @contextmanager
 def children_ignore_ctrl_c() -> Iterator[None]:
-    """Processes started in the block never see SIGINT (a terminal's Ctrl-C).
+    """Processes started in the block ignore SIGINT (a terminal's Ctrl-C) from their start.
 
-    Ctrl-C reaches every process of the terminal's process group. A worker started here
-    inherits SIGINT *blocked* (the signal mask survives fork and exec), from its first
-    instruction — before Python could install any handler — so it never prints a
-    ``KeyboardInterrupt`` of its own; the process that started it stops it. This thread's mask
-    is restored when the block ends, and a SIGINT that arrived meanwhile is then delivered.
+    Ctrl-C reaches every process of the terminal's process group. An ignored disposition
+    survives ``exec`` and Python then installs no ``KeyboardInterrupt`` handler, so a worker
+    started here never prints a traceback of its own, even while it imports; the process that
+    started it stops it. Here SIGINT is blocked for the block's duration (a Ctrl-C meanwhile
+    stays pending: Linux never discards a blocked signal) and ignored, then the handler and
+    the mask are restored and a pending SIGINT is delivered.
     """
-    if not hasattr(signal, "pthread_sigmask"):  # not POSIX
+    if not (hasattr(signal, "pthread_sigmask") and _in_main_thread()):
         yield
         return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    handler = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        signal.signal(signal.SIGINT, signal.SIG_DFL if handler is None else handler)
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 
 
 def finished() -> None:
-    """The work is done: SIGINT and SIGTERM are blocked for the rest of the process.
+    """The work is done: SIGINT and SIGTERM are ignored for the rest of the process.
 
-    While the interpreter shuts down it restores the default handlers, and a signal then would
-    kill a process whose output is already complete (exit -15 instead of 0).
+    While the interpreter shuts down it restores the default action of every signal with a
+    Python handler (not of an ignored one), and a signal then — delivered to any thread, such
+    as a BLAS worker — would kill a process whose output is already complete (exit -15).
     """
-    if hasattr(signal, "pthread_sigmask") and _in_main_thread():
-        signal.pthread_sigmask(signal.SIG_BLOCK, set(STOP_SIGNALS))
+    if _in_main_thread():
+        for number in STOP_SIGNALS:
+            signal.signal(number, signal.SIG_IGN)
 
 
 __all__ = [

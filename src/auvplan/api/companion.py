@@ -37,6 +37,7 @@ import os
 import time
 import warnings
 from contextlib import AbstractContextManager
+from multiprocessing import resource_tracker
 from multiprocessing.pool import AsyncResult, Pool
 from pathlib import Path
 from types import TracebackType
@@ -93,6 +94,9 @@ class Companion(AbstractContextManager["Companion"]):
         """Spawn the worker now, so that its imports overlap the mission's own work."""
         if self._pool is None:
             context = multiprocessing.get_context("spawn")
+            # multiprocessing's resource tracker, started on first need, unblocks SIGINT
+            # when it has started: start it before, so that the block below holds
+            resource_tracker.ensure_running()
             with children_ignore_ctrl_c():  # Ctrl-C is this process's to handle
                 self._pool = context.Pool(1, initializer=_prepare)
 
