@@ -16,6 +16,9 @@ them and every ``with`` block on the way out (staging folders, worker processes)
   at once, outside a held section: the user insists.
 * Without :func:`stop_requests` (a library user in a notebook) Python's own handlers apply,
   and :func:`held` records signals only for the duration of its section, then delivers them.
+* Worker processes started in :func:`children_ignore_ctrl_c` ignore a terminal's Ctrl-C from
+  their first instruction; the process that started them stops them.
+* :func:`finished`: once the work is done, a late signal can no longer change the outcome.
 
 Signal handlers belong to the main thread; in any other thread these functions do nothing.
 """
@@ -68,9 +71,8 @@ def _in_main_thread() -> bool:
 def install() -> None:
     """Make SIGINT and SIGTERM stop requests for the rest of the process (the console script).
 
-    Unlike :func:`stop_requests` nothing is restored: a signal that arrives after the run
-    finished, while the interpreter shuts down, is then ignored instead of killing the
-    process with its output already complete.
+    Unlike :func:`stop_requests` nothing is restored; :func:`finished` ends it when the work
+    is done.
     """
     if _in_main_thread():
         for number in STOP_SIGNALS:
