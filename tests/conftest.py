@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 import numpy as np
@@ -158,3 +159,27 @@ def write_plan_folder() -> PlanFolderWriter:
         return folder
 
     return write
+
+
+#: The golden mission (tests/regression): two MEDUSAs whose paths cross, deconfliction active.
+GOLDEN_MISSION = Path(__file__).parent / "regression" / "golden_mission.toml"
+
+
+@pytest.fixture(scope="session")
+def golden_solved() -> tuple[Any, Any, Any]:
+    """The golden mission planned in full, and its stage-3 problem assembled again:
+    ``(config, result, assembled)`` (read only)."""
+    from auvplan.mission.assembly import assemble_problem
+    from auvplan.mission.config import load_mission
+    from auvplan.mission.pipeline import Stage, run_mission
+
+    config = load_mission(GOLDEN_MISSION)
+    result = run_mission(config, stage=Stage.FULL)
+    assert result.plan is not None
+    assert result.deconfliction is not None
+    assembled = assemble_problem(
+        result.deconfliction.layout, result.preplan, result.deconfliction,
+        weights=config.weights, terrain_weight=config.weights.terrain,
+        safety_radius=config.fleet.safety_radius, comms=config.comms,
+    )  # fmt: skip
+    return config, result, assembled

@@ -15,11 +15,8 @@ import pytest
 
 from auvplan.cli.main import main
 from auvplan.io.vehicles import load_vehicle, packaged_vehicle_types
-from auvplan.mission.assembly import assemble_problem
-from auvplan.mission.config import load_mission
 from auvplan.mission.costs import constraint_slack, cost_breakdown
 from auvplan.mission.fleet import COST_TERMS, RUNNING_TERMS, vehicle_cost_terms
-from auvplan.mission.pipeline import Stage, run_mission
 from auvplan.record import files
 from auvplan.vehicle import build_vehicle_model
 
@@ -49,16 +46,8 @@ def test_every_running_cost_term_has_a_name(vehicle_type: str) -> None:
     assert COST_TERMS[: len(RUNNING_TERMS)] == RUNNING_TERMS
 
 
-def test_every_constraint_row_is_labelled_and_reported() -> None:
-    config = load_mission(GOLDEN)
-    result = run_mission(config, stage=Stage.FULL)
-    assert result.plan is not None
-    assert result.deconfliction is not None
-    assembled = assemble_problem(
-        result.deconfliction.layout, result.preplan, result.deconfliction,
-        weights=config.weights, terrain_weight=config.weights.terrain,
-        safety_radius=config.fleet.safety_radius, comms=config.comms,
-    )  # fmt: skip
+def test_every_constraint_row_is_labelled_and_reported(golden_solved: tuple) -> None:
+    _, result, assembled = golden_solved
     functions = assembled.functions
     for constraint in functions.constraints:
         rows = constraint.function.size1_out(0)

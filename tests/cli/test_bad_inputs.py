@@ -23,8 +23,9 @@ from typing import Literal
 import numpy as np
 import pytest
 import xarray as xr
+from _cli import run_cli
 
-from auvplan.cli.main import EXIT_TERMINATED, main
+from auvplan.cli.main import EXIT_TERMINATED
 from conftest import PlanFolderWriter
 
 MEDUSA = resources.files("auvplan").joinpath("data", "vehicles", "medusa.toml").read_text()
@@ -37,15 +38,6 @@ def _tree(root: Path) -> dict[str, bytes | None]:
         str(path.relative_to(root)): path.read_bytes() if path.is_file() else None
         for path in sorted(root.rglob("*"))
     }
-
-
-def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    try:
-        code = main(argv)
-    except SystemExit as exit_:  # usage errors leave through argparse
-        code = int(exit_.code or 0)
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def _write(path: Path, content: str | bytes) -> str:
@@ -366,7 +358,7 @@ def _assert_refused(
 ) -> None:
     """``argv`` exits 2 with one stderr line holding ``expected``, and ``tmp`` is unchanged."""
     before = _tree(tmp)
-    code, out, err = _run(argv, capsys)
+    code, out, err = run_cli(argv, capsys)
     assert code == 2, err
     lines = err.splitlines()
     assert len(lines) == 1, err
@@ -395,7 +387,7 @@ def test_current_folder_as_output_is_refused(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     monkeypatch.chdir(tmp_path)
-    code, _, err = _run(["maps", "synthetic", "-o", "."], capsys)
+    code, _, err = run_cli(["maps", "synthetic", "-o", "."], capsys)
     assert code == 2
     assert err == "auvplan: error: output folder . is the current folder or contains it: " + (
         "choose a new or dedicated folder\n"
@@ -415,7 +407,7 @@ def test_quiet_before_or_after_the_verb(
     argv: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     previous = _previous_output(tmp_path)
-    code, out, err = _run([*argv, "-o", str(previous)], capsys)
+    code, out, err = run_cli([*argv, "-o", str(previous)], capsys)
     assert (code, out, err) == (0, "", "")
     assert sorted(p.name for p in previous.iterdir()) == ["maps.nc", "maps.png", "notes.txt"]
     assert (previous / "notes.txt").read_text() == "mine"  # other files are kept
@@ -424,7 +416,7 @@ def test_quiet_before_or_after_the_verb(
 
 
 def test_verbose_after_the_verb_enables_debug(capsys: pytest.CaptureFixture[str]) -> None:
-    code, out, _ = _run(["vehicle", "--json", "-v"], capsys)
+    code, out, _ = run_cli(["vehicle", "--json", "-v"], capsys)
     assert code == 0
     assert '"characteristics"' in out
     assert logging.getLogger("auvplan").level == logging.NOTSET  # restored after the run
@@ -436,7 +428,7 @@ def test_plan_accepts_quiet_after_the_verb(
     mission = _write(tmp_path / "demo.toml", DEMO)
     out = tmp_path / "out"
     argv = ["plan", "-q", mission, "-o", str(out), "--stage", "preplan", "--no-figures"]
-    code, stdout, _ = _run(argv, capsys)
+    code, stdout, _ = run_cli(argv, capsys)
     assert (code, stdout) == (0, "")
     assert (out / "paths.geojson").is_file()
 
@@ -455,7 +447,7 @@ def test_stray_fix_and_absurd_values_are_warnings_not_errors(
     ]
     with caplog.at_level(logging.WARNING):
         for build in builds:
-            code, _, err = _run([*build(tmp_path), "-q"], capsys)
+            code, _, err = run_cli([*build(tmp_path), "-q"], capsys)
             assert (code, err) == (0, "")
             assert (tmp_path / "out" / "maps.png").is_file()
     assert "stray.xyz: dropped 1 of 300 soundings" in caplog.text
@@ -467,7 +459,7 @@ def test_current_nan_off_the_maps_water_is_still_water(
 ) -> None:
     """NaN at nodes nearest no water cell of the map (as ocean models leave land) plans."""
     argv = _plan_in_current(slice(0, 2), slice(None))(tmp_path)  # the rows south of the map
-    code, _, err = _run([*argv, "-q"], capsys)
+    code, _, err = run_cli([*argv, "-q"], capsys)
     assert (code, err) == (0, "")
 
 

@@ -2,46 +2,22 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import casadi as ca
 import numpy as np
 import pytest
 
 from auvplan.io.vehicles import load_vehicle
-from auvplan.mission.assembly import assemble_problem, separation_margin
-from auvplan.mission.config import load_mission
+from auvplan.mission.assembly import separation_margin
 from auvplan.mission.costs import constraint_slack, cost_breakdown
 from auvplan.mission.fleet import COST_TERMS, RUNNING_TERMS, StageWeights, vehicle_stage_functions
-from auvplan.mission.pipeline import Stage, run_mission
 from auvplan.optimization.integration import rk4_step
 from auvplan.record.labels import Pair
 from auvplan.vehicle import build_vehicle_model, positions
 
-GOLDEN = Path(__file__).parents[1] / "regression" / "golden_mission.toml"
 
-
-@pytest.fixture(scope="module")
-def solved() -> tuple:
-    config = load_mission(GOLDEN)
-    result = run_mission(config, stage=Stage.FULL)
-    assert result.plan is not None
-    assert result.deconfliction is not None
-    assembled = assemble_problem(
-        result.deconfliction.layout,
-        result.preplan,
-        result.deconfliction,
-        weights=config.weights,
-        terrain_weight=config.weights.terrain,
-        safety_radius=config.fleet.safety_radius,
-        comms=config.comms,
-    )
-    return config, result, assembled
-
-
-def test_the_terms_add_up_to_the_optimisers_running_cost(solved: tuple) -> None:
+def test_the_terms_add_up_to_the_optimisers_running_cost(golden_solved: tuple) -> None:
     """Independently: the RK4 quadrature of the stacked rate l(x, u, p) over every step."""
-    _, result, assembled = solved
+    _, result, assembled = golden_solved
     problem, trajectory = assembled.problem, result.plan.result.trajectory
     costs = cost_breakdown(problem, assembled.functions, trajectory)
     x = ca.SX.sym("x", problem.initial_state.size)
@@ -60,7 +36,7 @@ def test_the_terms_add_up_to_the_optimisers_running_cost(solved: tuple) -> None:
         float(assembled.functions.terminal_cost(trajectory.states[-1])), rel=1e-12
     )
     # the energy term is w_E times the energy (trapezoid of the power: a different quadrature)
-    energy_weight = solved[0].weights.energy
+    energy_weight = golden_solved[0].weights.energy
     np.testing.assert_allclose(
         costs.running["energy"], energy_weight * result.plan.energy, rtol=2e-3
     )
@@ -68,8 +44,8 @@ def test_the_terms_add_up_to_the_optimisers_running_cost(solved: tuple) -> None:
     assert terms["information"] <= 0.0  # a reward
 
 
-def test_the_summary_reports_the_terms(solved: tuple) -> None:
-    _, result, _ = solved
+def test_the_summary_reports_the_terms(golden_solved: tuple) -> None:
+    _, result, _ = golden_solved
     totals = result.plan.costs.totals()
     per_vehicle = result.plan.costs.running
     assert set(totals) == set(COST_TERMS)
@@ -77,9 +53,9 @@ def test_the_summary_reports_the_terms(solved: tuple) -> None:
         assert float(np.sum(per_vehicle[term])) == pytest.approx(totals[term])
 
 
-def test_collision_slack_is_the_normalised_separation(solved: tuple) -> None:
+def test_collision_slack_is_the_normalised_separation(golden_solved: tuple) -> None:
     """The collision row of "blue / green" is min_k ‖p_b − p_g‖²/(2 r_c + margin)² − 1."""
-    config, result, assembled = solved
+    config, result, assembled = golden_solved
     slack = constraint_slack(assembled.problem, assembled.functions, result.plan.result.trajectory)
     layout = assembled.functions.layout
     blue, green = (positions(layout.models[i], result.plan.states[i]) for i in range(2))

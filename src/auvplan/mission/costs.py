@@ -64,9 +64,7 @@ def cost_breakdown(
     """Split the objective of ``problem`` at ``trajectory`` into its named terms (module notes)."""
     states, inputs = trajectory.states, trajectory.inputs
     n_steps = inputs.shape[0]
-    parameters = (
-        np.zeros((n_steps, 0)) if problem.stage_parameters is None else problem.stage_parameters
-    )
+    parameters = _stage_parameters(problem, n_steps)
     running = np.zeros((len(RUNNING_TERMS), len(functions.blocks)))
     for i, (block, model) in enumerate(zip(functions.blocks, functions.layout.models, strict=True)):
         has_current = block.parameters.stop - block.parameters.start > model.n_x
@@ -105,9 +103,7 @@ def constraint_slack(
     """
     states, inputs = trajectory.states, trajectory.inputs
     n_steps = inputs.shape[0]
-    parameters = (
-        np.zeros((n_steps, 0)) if problem.stage_parameters is None else problem.stage_parameters
-    )
+    parameters = _stage_parameters(problem, n_steps)
     slack: dict[str, dict[str, float]] = {}
     for constraint in functions.constraints:
         values = np.asarray(
@@ -118,6 +114,13 @@ def constraint_slack(
             for label, row in zip(constraint.labels, values, strict=True)
         }
     return slack
+
+
+def _stage_parameters(problem: TrajectoryProblem, n_steps: int) -> FloatArray:
+    """The problem's stage parameters ``(n_steps, n_p)`` (no columns when it has none)."""
+    if problem.stage_parameters is None:
+        return np.zeros((n_steps, 0))
+    return problem.stage_parameters
 
 
 __all__ = ["CostBreakdown", "constraint_slack", "cost_breakdown"]
