@@ -28,7 +28,12 @@ from auvplan.deconfliction import (
 )
 from auvplan.errors import InfeasibleError, InputError
 from auvplan.mission.config import DeconflictionConfig, FleetConfig
-from auvplan.mission.current import check_crossable, mean_ground_speed, path_ground_speeds
+from auvplan.mission.current import (
+    check_crossable,
+    mean_ground_speed,
+    path_ground_speeds,
+    segment_times,
+)
 from auvplan.mission.fleet import FleetLayout
 from auvplan.ocean import CurrentField, through_water
 from auvplan.planning import path_length
@@ -47,6 +52,8 @@ logger = logging.getLogger(__name__)
 SPEED_MARGIN: Final = 0.85
 #: Speed-raising rounds when deconfliction overruns a fixed horizon.
 HORIZON_ATTEMPTS: Final = 4
+#: Rounds of limits and speeds in a time-varying current (:func:`speeds_in_current`).
+LIMIT_ROUNDS: Final = 4
 #: Fraction of the steady turn rate on the tightest turning radius that the desired heading
 #: uses to turn from the start heading and onto the goal heading.
 TURN_RATE_FRACTION: Final = 0.5
@@ -85,11 +92,21 @@ def solver_steps(horizon: float, dt: float) -> int:
 
 
 def _nominal_speeds(
-    fleet: FleetConfig, lengths: FloatArray, limits: FloatArray, names: tuple[str, ...]
+    fleet: FleetConfig,
+    lengths: FloatArray,
+    limits: FloatArray,
+    names: tuple[str, ...],
+    cruise: FloatArray | None = None,
 ) -> tuple[FloatArray, float]:
-    """Speeds [m/s] and horizon [s] (NaN when derived later) before deconfliction."""
+    """Speeds [m/s] and horizon [s] (NaN when derived later) before deconfliction.
+
+    ``cruise``: in a current, the ground speeds at ``fleet.cruise_speed`` through the water
+    (NaN where it cannot be held); they are capped at ``limits``.
+    """
     if fleet.horizon is not None:
         horizon, speeds = fleet.horizon, lengths / fleet.horizon
+    elif cruise is not None:
+        return np.fmin(limits, cruise), float("nan")
     else:
         assert fleet.cruise_speed is not None
         horizon, speeds = float("nan"), np.full(len(lengths), fleet.cruise_speed)
@@ -137,18 +154,17 @@ def run_deconfliction(
         Solver (control) interval [s].
     current : CurrentField, optional
         The ocean current (None: still water); speeds and their limits are then ground
-        speeds along each path (:func:`ground_speed_limits`).
+        speeds along each path in the current when the vehicle passes
+        (:func:`speeds_in_current`).
     """
     names = layout.names
     lengths = np.array([path_length(path) for path in paths])
     limits = np.array([SPEED_MARGIN * top_speed(model) for model in layout.models])
     slowest = np.array([minimum_useful_speed(model) for model in layout.models])
+    cruise = None
     if current is not None:
-        limits, slowest = ground_speed_limits(names, paths, limits, slowest, current)
-    speeds, horizon = _nominal_speeds(fleet, lengths, limits, names)
-    if current is not None and fleet.cruise_speed is not None:  # cruise through the water
-        cruise = [mean_ground_speed(path, fleet.cruise_speed, current) for path in paths]
-        speeds = np.fmin(limits, cruise)  # NaN (cannot hold the path at cruise): the limit
+        limits, slowest, cruise = speeds_in_current(fleet, names, paths, limits, slowest, current)
+    speeds, horizon = _nominal_speeds(fleet, lengths, limits, names, cruise)
     accelerations = np.array([max_surge_acceleration(model) for model in layout.models])
     for _attempt in range(HORIZON_ATTEMPTS):
         problem = CoordinationProblem(
@@ -197,33 +213,71 @@ def run_deconfliction(
     return DeconflictStage(layout, horizon, dt, speeds, problem, coordination, time, desired)
 
 
+def speeds_in_current(
+    fleet: FleetConfig,
+    names: tuple[str, ...],
+    paths: tuple[FloatArray, ...],
+    fastest: FloatArray,
+    slowest: FloatArray,
+    current: CurrentField,
+) -> tuple[FloatArray, FloatArray, FloatArray | None]:
+    """Ground-speed limits, and cruise ground speeds, in a current that changes in time.
+
+    The limits depend on when each vehicle passes, which depends on its speed: with
+    ``fleet.horizon_s`` the nominal speed ``L_i / T`` fixes the passage times; with
+    ``fleet.cruise_speed`` the vehicle passes at that speed through the water
+    (:func:`~auvplan.mission.current.mean_ground_speed`) or, where that is above the limit, at
+    the limit, so limits and speeds are iterated (:data:`LIMIT_ROUNDS`) until they agree to
+    0.1 %. Returns the upper and lower limits [m/s] of :func:`ground_speed_limits` and the
+    cruise ground speeds (None with a fixed horizon).
+    """
+    if fleet.horizon is not None:
+        lengths = np.array([path_length(path) for path in paths])
+        return (
+            *ground_speed_limits(names, paths, fastest, slowest, current, lengths / fleet.horizon),
+            None,
+        )
+    assert fleet.cruise_speed is not None
+    cruise = np.array([mean_ground_speed(path, fleet.cruise_speed, current) for path in paths])
+    speeds = np.where(np.isfinite(cruise), cruise, fastest)
+    for _round in range(LIMIT_ROUNDS):
+        upper, lower = ground_speed_limits(names, paths, fastest, slowest, current, speeds)
+        held = np.fmin(upper, cruise)
+        if np.allclose(held, speeds, rtol=1e-3, atol=0.0):
+            break
+        speeds = held
+    return upper, lower, cruise
+
+
 def ground_speed_limits(
     names: tuple[str, ...],
     paths: tuple[FloatArray, ...],
     fastest: FloatArray,
     slowest: FloatArray,
     current: CurrentField,
+    speeds: FloatArray,
 ) -> tuple[FloatArray, FloatArray]:
     """Ground-speed range [m/s] of each vehicle on its path from its through-water range.
 
-    The upper limit is the lowest ground speed along the path at the fastest through-water
-    speed (so it can be held everywhere), the lower one the lowest at the slowest speed
-    (kept >= 1 % of the upper one).
+    The current is taken when the vehicle passes at its ground speed ``speeds`` [m/s]
+    (:func:`~auvplan.mission.current.segment_times`). The upper limit is the lowest ground
+    speed along the path at the fastest through-water speed (so it can be held everywhere),
+    the lower one the lowest at the slowest speed (kept >= 1 % of the upper one).
 
     Raises
     ------
     InfeasibleError
         If the current holds a vehicle off or back on its path (:func:`check_crossable`).
     """
-    upper = np.array(
-        [np.min(check_crossable(name, path, float(top), current), initial=top)
-         for name, path, top in zip(names, paths, fastest, strict=True)]
-    )  # fmt: skip
-    lower = np.array(
-        [np.nanmin(path_ground_speeds(path, float(low), current)[0], initial=low)
-         for path, low in zip(paths, slowest, strict=True)]
-    )  # fmt: skip
-    return upper, np.clip(lower, 0.01 * upper, upper)
+    upper, lower = [], []
+    for name, path, top, low, speed in zip(names, paths, fastest, slowest, speeds, strict=True):
+        times = segment_times(path, float(speed))
+        upper.append(np.min(check_crossable(name, path, float(top), current, times), initial=top))
+        lower.append(
+            np.nanmin(path_ground_speeds(path, float(low), current, times)[0], initial=low)
+        )
+    high = np.array(upper)
+    return high, np.clip(lower, 0.01 * high, high)
 
 
 def desired_states(
