@@ -3,16 +3,21 @@ passes, not the current at ``t = 0`` (issue 26)."""
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import numpy as np
 import pytest
 
 from auvplan.errors import InfeasibleError
+from auvplan.mission.config import parse_mission
 from auvplan.io.vehicles import load_vehicle
 from auvplan.mission.config import DeconflictionConfig, FleetConfig
 from auvplan.mission.current import mean_ground_speed, water_speed_times
 from auvplan.mission.fleet import FleetLayout
+from auvplan.mission.pipeline import fleet_layout, run_optimization
+from auvplan.mission.preplan import run_preplan
+from auvplan.mission.still_water import fly_in_current
 from auvplan.mission.timing import SPEED_MARGIN, run_deconfliction
 from auvplan.ocean import GriddedCurrent
 from auvplan.terrain import GridGeometry
@@ -23,15 +28,15 @@ from auvplan.vehicle import build_vehicle_model, top_speed
 FLOOD, EBB, SLICE_S, TURN_SLICE = 0.3, -0.3, 60.0, 10
 
 
-def _reversing() -> GriddedCurrent:
-    """A uniform eastward current of FLOOD that turns to EBB around t = TURN_SLICE · SLICE_S."""
-    geometry = GridGeometry(9, 41, 50.0, 50.0)
+def _reversing(slice_s: float = SLICE_S) -> GriddedCurrent:
+    """A uniform eastward current of FLOOD that turns to EBB around t = TURN_SLICE · slice_s."""
+    geometry = GridGeometry(9, 41, 50.0, 50.0, -200.0, -200.0)
     values = [FLOOD if k < TURN_SLICE else EBB for k in range(3 * TURN_SLICE)]
     zero = SplineSurface.fit(geometry, np.zeros((9, 41)))
     return GriddedCurrent(
         tuple(zero for _ in values),
         tuple(SplineSurface.fit(geometry, np.full((9, 41), v)) for v in values),
-        time_step=SLICE_S,
+        time_step=slice_s,
         start_offset=0.0,
         to_axes=np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
     )
@@ -112,3 +117,57 @@ def test_fixed_horizon_checks_the_ebb_it_meets(medusa: Any) -> None:
     horizon = float(np.ceil(1.05 * length / (top + EBB)))
     stage = _stage(medusa, {"horizon_s": horizon}, _east_leg(length), current)
     assert stage.horizon == horizon
+
+
+class _FrozenAtStart:
+    """``field`` as a planner that knows only the forecast's first hour would see it: t = 0."""
+
+    def __init__(self, field: GriddedCurrent) -> None:
+        self.field = field
+
+    def velocity(self, north: Any, east: Any, time: Any) -> Any:
+        return self.field.velocity(north, east, np.zeros_like(np.asarray(time, dtype=float)))
+
+    def gradient(self, north: Any, east: Any, time: Any) -> Any:
+        return self.field.gradient(north, east, np.zeros_like(np.asarray(time, dtype=float)))
+
+
+def test_planning_in_the_changing_current_costs_less_than_the_t0_plan_flown_in_it() -> None:
+    """The plan made in the turning current, flown in it with its own regulator, needs no more
+    energy than the plan made in the current frozen at t = 0 flown in the same true current
+    (and it arrives better: the frozen plan's regulator fights the ebb it did not expect)."""
+    config = parse_mission(
+        {
+            "terrain": {
+                "synthetic": True,
+                "window": {"north": [0.0, 120.0], "east": [300.0, 500.0]},
+            },
+            "fleet": {"horizon_s": 240.0, "safety_radius_m": 5.0},
+            "vehicle": [
+                {
+                    "name": "blue",
+                    "start": {"north": 60.0, "east": 30.0, "heading_deg": 90.0, "speed": 0.5},
+                    "goal": {"north": 60.0, "east": 150.0, "heading_deg": 90.0},
+                }
+            ],
+            "weights": {"terrain": 0.0},
+            "solver": {"dt_s": 2.0},
+        }
+    )
+    true = _reversing(slice_s=12.0)  # turns around t = 120 s, half-way
+    layout = fleet_layout(config)
+    preplan = run_preplan(config)
+    flown = []
+    for assumed in (true, _FrozenAtStart(true)):
+        stage1 = dataclasses.replace(preplan, current=assumed)
+        stage2 = run_deconfliction(
+            layout, stage1.paths, stage1.starts[:, 2], stage1.goals[:, 2],
+            fleet=config.fleet, settings=config.deconfliction, dt=config.solver.dt,
+            current=assumed,
+        )  # fmt: skip
+        plan = run_optimization(config, layout, stage1, stage2, 0.0)
+        assert plan.verdict.success, plan.verdict.message
+        flown.append(fly_in_current(plan, layout, preplan.goals, config.solver.dt, true))
+    knowing, frozen = flown
+    assert knowing.energy[0] <= frozen.energy[0]
+    assert knowing.arrival_error[0] < frozen.arrival_error[0]
