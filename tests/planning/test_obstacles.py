@@ -11,6 +11,7 @@ from auvplan.errors import InputError
 from auvplan.planning.obstacles import (
     CircleObstacle,
     Obstacle,
+    OperatingArea,
     PolygonObstacle,
     distance_to_obstacle,
     obstacle_mask,
@@ -168,3 +169,74 @@ def test_obstacle_outside_grid_blocks_nothing() -> None:
 def test_validation(build: object, match: str) -> None:
     with pytest.raises(InputError, match=match):
         build()  # type: ignore[operator]
+
+
+def _ring(centre: tuple[float, float], radii: np.ndarray, phase: float) -> np.ndarray:
+    angles = phase + np.linspace(0.0, 2.0 * np.pi, len(radii), endpoint=False)
+    return np.array(centre) + np.column_stack((radii * np.cos(angles), radii * np.sin(angles)))
+
+
+@pytest.mark.parametrize("seed", range(3))
+@pytest.mark.parametrize("kind", ["holed polygon", "operating area"])
+def test_holes_and_areas_match_a_shapely_oracle(seed: int, kind: str) -> None:
+    """Blocked cells come within the clearance of the no-go region, free cells do not.
+
+    The no-go region of a polygon with a hole excludes the hole; an operating area's is the
+    outside of the area (and its hole, an island). The oracle is shapely's distance from
+    points sampled over each cell to that region.
+    """
+    import shapely
+    from shapely import Polygon, box
+
+    rng = np.random.default_rng(seed)
+    grid = GridGeometry(14, 15, rng.uniform(0.6, 1.2), rng.uniform(0.6, 1.2), 0.0, 0.0)
+    outer = _ring((7.0, 7.5), rng.uniform(5.0, 6.5, 9), rng.uniform(0.0, 1.0))
+    hole = _ring((7.0, 7.5), rng.uniform(1.5, 2.5, 7), rng.uniform(0.0, 1.0))
+    region = PolygonObstacle(outer, holes=(hole,))
+    shape = Polygon(outer[:, ::-1], [hole[:, ::-1]])  # shapely x = east, y = north
+    assert shape.is_valid
+    obstacle: Obstacle = region
+    no_go = shape
+    if kind == "operating area":
+        obstacle = OperatingArea(region)
+        no_go = box(-100.0, -100.0, 100.0, 100.0).difference(shape)
+    clearance = float(rng.choice([0.0, 0.4, 1.3]))
+    mask = obstacle_mask(grid, [obstacle], clearance=clearance)
+    n = 15
+    slack = 0.5 * math.hypot(grid.spacing_north, grid.spacing_east) / (n - 1)
+    s, t = np.meshgrid(np.linspace(-0.5, 0.5, n), np.linspace(-0.5, 0.5, n))
+    rows, cols = np.meshgrid(np.arange(grid.n_rows), np.arange(grid.n_cols), indexing="ij")
+    north = (rows[..., None] + s.ravel()) * grid.spacing_north  # (n_rows, n_cols, n * n)
+    east = (cols[..., None] + t.ravel()) * grid.spacing_east
+    sampled = shapely.distance(no_go, shapely.points(east, north)).min(axis=-1)
+    assert np.all(sampled[mask] <= clearance + slack)
+    free = sampled[~mask]
+    assert np.all(free >= clearance)
+    assert np.all(free > 0.0)
+    assert mask.any()
+    assert (~mask).any()
+    # signed distances: the oracle's distance to the boundary, negative in the no-go region
+    north = rng.uniform(0.0, 14.0, 300)
+    east = rng.uniform(0.0, 15.0, 300)
+    points = shapely.points(east, north)
+    expected = np.where(no_go.contains(points), -1.0, 1.0) * shapely.distance(
+        shape.boundary, points
+    )
+    np.testing.assert_allclose(distance_to_obstacle(obstacle, north, east), expected, atol=1e-9)
+
+
+def test_a_hole_is_free_water_and_an_area_blocks_its_outside() -> None:
+    square = np.array([[0.0, 0.0], [0.0, 10.0], [10.0, 10.0], [10.0, 0.0]])
+    hole = np.array([[3.0, 3.0], [3.0, 7.0], [7.0, 7.0], [7.0, 3.0]])
+    grid = GridGeometry(12, 12, 1.0, 1.0)  # cell (r, c) spans r +- 0.5, c +- 0.5
+    ring = obstacle_mask(grid, [PolygonObstacle(square, holes=(hole,))])
+    assert not ring[5, 5]  # the centre of the hole
+    assert ring[1, 1]
+    assert ring[5, 1]
+    assert not ring[11, 11]  # outside the square
+    area = obstacle_mask(grid, [OperatingArea(PolygonObstacle(square))], clearance=1.0)
+    assert area[11, 11]
+    assert area[0, 5]
+    assert area[1, 5]
+    assert not area[2, 5]
+    assert not area[5, 5]

@@ -7,6 +7,7 @@ from auvplan.planning.astar import heuristic_map, plan_astar
 from auvplan.planning.obstacles import (
     CircleObstacle,
     Obstacle,
+    OperatingArea,
     PolygonObstacle,
     distance_to_obstacle,
     obstacle_mask,
@@ -20,6 +21,7 @@ __all__ = [
     "CircleObstacle",
     "EdgeModel",
     "Obstacle",
+    "OperatingArea",
     "PathResult",
     "PlanningProblem",
     "PolygonObstacle",

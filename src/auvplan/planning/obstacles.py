@@ -5,8 +5,10 @@ e_c + \Delta_e/2]` around its centre. :func:`obstacle_mask` blocks every cell wh
 comes within ``clearance`` of an obstacle:
 
 * circle (centre :math:`p`, radius :math:`R`): :math:`d(p, \text{cell}) < R + \text{clearance}`;
-* polygon :math:`P`: :math:`d(P, \text{cell}) < \text{clearance}`, or the cell intersects
-  :math:`P` (distance 0).
+* polygon :math:`P` (holes are not part of it): :math:`d(P, \text{cell}) < \text{clearance}`,
+  or the cell intersects :math:`P` (distance 0);
+* operating area :math:`A` (the no-go region is its outside): the cell is not inside
+  :math:`A`, or :math:`d(\partial A, \text{cell}) < \text{clearance}`.
 
 So a vehicle that stays in unblocked cells keeps at least ``clearance`` from every obstacle
 at every point of those cells. All computations are vectorised over the cells of the
@@ -57,13 +59,17 @@ class CircleObstacle:
 
 @dataclass(frozen=True, eq=False)
 class PolygonObstacle:
-    """A simple polygon in the horizontal plane.
+    """A polygon in the horizontal plane, possibly with holes (which are free water).
 
     Parameters
     ----------
     vertices : ndarray of shape (n_vertices, 2)
-        ``[north, east]`` [m] of the vertices in order (closing edge implied), ``n >= 3``,
-        finite, with non-zero area.
+        ``[north, east]`` [m] of the exterior ring's vertices in order (closing edge implied),
+        ``n >= 3``, finite, with non-zero area.
+    holes : tuple of ndarray of shape (n_k, 2)
+        Rings of the holes, each like ``vertices``, inside the exterior and apart from each
+        other (a valid polygon: :func:`shapely.validation.explain_validity` is the judge
+        upstream).
 
     Examples
     --------
@@ -73,34 +79,69 @@ class PolygonObstacle:
     """
 
     vertices: FloatArray
+    holes: tuple[FloatArray, ...] = ()
 
     def __post_init__(self) -> None:
-        vertices = np.asarray(self.vertices, dtype=np.float64)
-        if vertices.ndim != 2 or vertices.shape[1] != 2 or vertices.shape[0] < 3:
-            raise InputError(
-                f"polygon vertices must have shape (n >= 3, 2), got {np.shape(self.vertices)}"
-            )
-        if not np.all(np.isfinite(vertices)):
-            raise InputError("polygon vertices must be finite")
-        north, east = vertices[:, 0], vertices[:, 1]
-        area = 0.5 * (np.dot(north, np.roll(east, -1)) - np.dot(east, np.roll(north, -1)))
-        if abs(area) <= 1e-12 * max(1.0, float(np.ptp(vertices)) ** 2):
-            raise InputError(f"polygon has zero area (vertices {vertices.tolist()})")
-        object.__setattr__(self, "vertices", vertices)
+        object.__setattr__(self, "vertices", _ring(self.vertices, "polygon"))
+        object.__setattr__(self, "holes", tuple(_ring(hole, "polygon hole") for hole in self.holes))
+
+    @property
+    def rings(self) -> tuple[FloatArray, ...]:
+        """The exterior ring, then the holes' (each ``(n_k, 2)`` north/east [m])."""
+        return (self.vertices, *self.holes)
+
+    def contains(self, north: FloatArray, east: FloatArray) -> BoolArray:
+        """Whether each point [m] (same shape) lies inside the exterior and in no hole."""
+        points = np.column_stack((np.ravel(north), np.ravel(east)))
+        inside = MplPath(self.vertices).contains_points(points)
+        for hole in self.holes:
+            inside &= ~MplPath(hole).contains_points(points)
+        return np.asarray(inside.reshape(np.shape(north)))
+
+
+def _ring(vertices: FloatArray, what: str) -> FloatArray:
+    """``vertices`` as a float array ``(n >= 3, 2)`` of finite values enclosing an area."""
+    ring = np.asarray(vertices, dtype=np.float64)
+    if ring.ndim != 2 or ring.shape[1] != 2 or ring.shape[0] < 3:
+        raise InputError(f"{what} vertices must have shape (n >= 3, 2), got {np.shape(vertices)}")
+    if not np.all(np.isfinite(ring)):
+        raise InputError(f"{what} vertices must be finite")
+    north, east = ring[:, 0], ring[:, 1]
+    area = 0.5 * (np.dot(north, np.roll(east, -1)) - np.dot(east, np.roll(north, -1)))
+    if abs(area) <= 1e-12 * max(1.0, float(np.ptp(ring)) ** 2):
+        raise InputError(f"{what} has zero area (vertices {ring.tolist()})")
+    return ring
+
+
+@dataclass(frozen=True, eq=False)
+class OperatingArea:
+    """The outside of an operating area: every vehicle stays inside ``region``.
+
+    As an obstacle its no-go region is the complement of ``region`` (a hole of ``region``
+    is an island of the area, no-go too), so its distance from a point inside the area is
+    the distance to the area's boundary, and negative outside.
+
+    Examples
+    --------
+    >>> area = OperatingArea(
+    ...     PolygonObstacle(np.array([[0.0, 0.0], [0.0, 9.0], [9.0, 9.0], [9.0, 0.0]])))
+    >>> distance_to_obstacle(area, np.array([3.0, 10.0]), np.array([4.0, 4.0])).tolist()
+    [3.0, -1.0]
+    """
+
+    region: PolygonObstacle
 
 
 #: Any obstacle (annotate mixed lists as ``list[Obstacle]``).
-Obstacle: TypeAlias = CircleObstacle | PolygonObstacle
+Obstacle: TypeAlias = CircleObstacle | PolygonObstacle | OperatingArea
 
 
-def distance_to_obstacle(
-    obstacle: CircleObstacle | PolygonObstacle, north: FloatArray, east: FloatArray
-) -> FloatArray:
+def distance_to_obstacle(obstacle: Obstacle, north: FloatArray, east: FloatArray) -> FloatArray:
     r"""Signed distance [m] from points to an obstacle's boundary (negative inside).
 
     Parameters
     ----------
-    obstacle : CircleObstacle or PolygonObstacle
+    obstacle : CircleObstacle, PolygonObstacle or OperatingArea
         The obstacle.
     north, east : ndarray
         Point coordinates [m] (broadcast together).
@@ -108,8 +149,9 @@ def distance_to_obstacle(
     Returns
     -------
     ndarray
-        :math:`\|p - c\| - R` for a circle; for a polygon the distance to the nearest edge,
-        negated inside.
+        :math:`\|p - c\| - R` for a circle; for a polygon the distance to the nearest edge
+        of any of its rings, negated inside (outside the holes); for an operating area the
+        distance to its boundary, negated outside the area.
 
     Examples
     --------
@@ -121,20 +163,17 @@ def distance_to_obstacle(
     )
     if isinstance(obstacle, CircleObstacle):
         return np.asarray(np.hypot(north - obstacle.north, east - obstacle.east) - obstacle.radius)
-    vertices = obstacle.vertices
+    if isinstance(obstacle, OperatingArea):
+        return -distance_to_obstacle(obstacle.region, north, east)
     distance = np.full(north.shape, np.inf)
-    for a, b in zip(vertices, np.roll(vertices, -1, axis=0), strict=True):
-        distance = np.minimum(distance, _point_segment_distance(north, east, a, b))
-    points = np.column_stack((north.ravel(), east.ravel()))
-    inside = MplPath(vertices).contains_points(points).reshape(north.shape)
-    return np.asarray(np.where(inside, -distance, distance))
+    for ring in obstacle.rings:
+        for a, b in zip(ring, np.roll(ring, -1, axis=0), strict=True):
+            distance = np.minimum(distance, _point_segment_distance(north, east, a, b))
+    return np.asarray(np.where(obstacle.contains(north, east), -distance, distance))
 
 
 def obstacle_mask(
-    geometry: GridGeometry,
-    obstacles: Iterable[CircleObstacle | PolygonObstacle],
-    *,
-    clearance: float = 0.0,
+    geometry: GridGeometry, obstacles: Iterable[Obstacle], *, clearance: float = 0.0
 ) -> BoolArray:
     """Cells of ``geometry`` that come within ``clearance`` of any obstacle.
 
@@ -142,7 +181,7 @@ def obstacle_mask(
     ----------
     geometry : GridGeometry
         The grid.
-    obstacles : iterable of CircleObstacle or PolygonObstacle
+    obstacles : iterable of CircleObstacle, PolygonObstacle or OperatingArea
         Obstacles in the grid's world frame.
     clearance : float
         Extra distance [m] to keep from every obstacle, ``>= 0``.
@@ -167,7 +206,15 @@ def obstacle_mask(
     if not (np.isfinite(clearance) and clearance >= 0.0):
         raise InputError(f"clearance must be finite and >= 0, got {clearance!r} m")
     mask = np.zeros(geometry.shape, dtype=np.bool_)
+    half_north, half_east = 0.5 * geometry.spacing_north, 0.5 * geometry.spacing_east
     for obstacle in obstacles:
+        if isinstance(obstacle, OperatingArea):  # every cell: the no-go region is unbounded
+            north, east = np.meshgrid(geometry.north, geometry.east, indexing="ij")
+            rim = _rings_rectangle_distance(
+                obstacle.region.rings, north, east, half_north, half_east
+            )
+            mask |= ~obstacle.region.contains(north, east) | (rim < clearance) | (rim == 0.0)
+            continue
         if isinstance(obstacle, CircleObstacle):
             low = np.array([obstacle.north, obstacle.east]) - obstacle.radius
             high = np.array([obstacle.north, obstacle.east]) + obstacle.radius
@@ -183,16 +230,14 @@ def obstacle_mask(
             continue
         north = geometry.north[rows][:, np.newaxis]
         east = geometry.east[cols][np.newaxis, :]
-        half_north, half_east = 0.5 * geometry.spacing_north, 0.5 * geometry.spacing_east
         if isinstance(obstacle, CircleObstacle):
             gap_north = np.maximum(np.abs(north - obstacle.north) - half_north, 0.0)
             gap_east = np.maximum(np.abs(east - obstacle.east) - half_east, 0.0)
             hit = np.hypot(gap_north, gap_east) < obstacle.radius + clearance
         else:
             north, east = np.broadcast_arrays(north, east)
-            distance = _polygon_rectangle_distance(
-                obstacle.vertices, north, east, half_north, half_east
-            )
+            distance = _rings_rectangle_distance(obstacle.rings, north, east, half_north, half_east)
+            distance[obstacle.contains(north, east)] = 0.0
             hit = (distance < clearance) | (distance == 0.0)
         mask[rows, cols] |= hit
     return mask
@@ -262,19 +307,19 @@ def _segment_hits_rectangle(
     return np.asarray(is_hit & (t_low <= t_high))
 
 
-def _polygon_rectangle_distance(
-    vertices: FloatArray,
+def _rings_rectangle_distance(
+    rings: tuple[FloatArray, ...],
     centre_north: FloatArray,
     centre_east: FloatArray,
     half_north: float,
     half_east: float,
 ) -> FloatArray:
-    """Distance [m] between a polygon (as a region) and each cell rectangle (0 if they meet).
+    """Distance [m] between a polygon's boundary (its rings) and each cell rectangle.
 
-    Two disjoint convex sets are closest at a vertex of one of them, so for each polygon edge
+    Two disjoint convex sets are closest at a vertex of one of them, so for each ring edge
     the distance to a rectangle is 0 if they intersect, else the least of the edge-endpoint to
-    rectangle and rectangle-corner to edge distances. A rectangle whose centre lies inside
-    the polygon meets it.
+    rectangle and rectangle-corner to edge distances. A rectangle that meets no edge lies
+    wholly inside or wholly outside the polygon (its centre tells which).
     """
     distance = np.full(centre_north.shape, np.inf)
     corners = [
@@ -282,7 +327,10 @@ def _polygon_rectangle_distance(
         for s_north in (-1.0, 1.0)
         for s_east in (-1.0, 1.0)
     ]
-    for a, b in zip(vertices, np.roll(vertices, -1, axis=0), strict=True):
+    edges = [
+        (a, b) for ring in rings for a, b in zip(ring, np.roll(ring, -1, axis=0), strict=True)
+    ]
+    for a, b in edges:
         edge = _point_rectangle_distance(
             a[0], a[1], centre_north, centre_east, half_north, half_east
         )
@@ -294,7 +342,4 @@ def _polygon_rectangle_distance(
             edge = np.minimum(edge, _point_segment_distance(corner_north, corner_east, a, b))
         edge[_segment_hits_rectangle(a, b, centre_north, centre_east, half_north, half_east)] = 0.0
         distance = np.minimum(distance, edge)
-    points = np.column_stack((centre_north.ravel(), centre_east.ravel()))
-    inside = MplPath(vertices).contains_points(points).reshape(centre_north.shape)
-    distance[inside] = 0.0
     return distance

@@ -18,8 +18,8 @@ from auvplan.errors import InfeasibleError, InputError
 from auvplan.planning.astar import plan_astar
 from auvplan.planning.belief import BeliefModel, search_belief
 from auvplan.planning.obstacles import (
-    CircleObstacle,
-    PolygonObstacle,
+    Obstacle,
+    OperatingArea,
     distance_to_obstacle,
     obstacle_mask,
 )
@@ -77,7 +77,7 @@ def blocked_cells(
     cost: FloatArray,
     geometry: GridGeometry,
     *,
-    obstacles: Sequence[CircleObstacle | PolygonObstacle] = (),
+    obstacles: Sequence[Obstacle] = (),
     clearance: float = 0.0,
 ) -> BoolArray:
     """No-go cells: non-finite cost (land, no data) or within ``clearance`` [m] of an obstacle.
@@ -88,7 +88,7 @@ def blocked_cells(
         Cost map; NaN/inf cells are no-go.
     geometry : GridGeometry
         Geometry of ``cost``.
-    obstacles : sequence of CircleObstacle or PolygonObstacle
+    obstacles : sequence of CircleObstacle, PolygonObstacle or OperatingArea
         Obstacles in world coordinates.
     clearance : float
         Extra distance [m] kept from obstacles.
@@ -101,6 +101,7 @@ def blocked_cells(
     --------
     >>> grid = GridGeometry(2, 3, 1.0, 1.0)
     >>> cost = np.array([[1.0, np.nan, 1.0], [1.0, 1.0, 1.0]])
+    >>> from auvplan.planning.obstacles import CircleObstacle
     >>> blocked_cells(cost, grid, obstacles=[CircleObstacle(1.0, 2.0, 0.3)]).astype(int)
     array([[0, 1, 0],
            [0, 0, 1]])
@@ -157,7 +158,7 @@ def plan_route(
     start: tuple[float, float],
     goal: tuple[float, float],
     *,
-    obstacles: Sequence[CircleObstacle | PolygonObstacle] = (),
+    obstacles: Sequence[Obstacle] = (),
     obstacle_names: Sequence[str] = (),
     clearance: float = 0.0,
     edge_model: EdgeModel = EdgeModel.PAPER,
@@ -176,7 +177,7 @@ def plan_route(
         Geometry of ``cost`` (the one owner of the cell <-> world mapping).
     start, goal : tuple of float
         ``(north, east)`` [m] in the grid's world frame.
-    obstacles : sequence of CircleObstacle or PolygonObstacle
+    obstacles : sequence of CircleObstacle, PolygonObstacle or OperatingArea
         Impassable regions; cells within ``clearance`` of them are blocked.
     obstacle_names : sequence of str
         Labels of the first obstacles in error messages; the others are ``"obstacle K"``
@@ -291,7 +292,7 @@ def _endpoint_cell(
     geometry: GridGeometry,
     blocked_nan: BoolArray,
     mask: BoolArray,
-    obstacles: Sequence[CircleObstacle | PolygonObstacle],
+    obstacles: Sequence[Obstacle],
     obstacle_names: Sequence[str],
     clearance: float,
     name: str,
@@ -322,10 +323,13 @@ def _endpoint_cell(
         ]
         nearest = int(np.argmin(distances))
         label = obstacle_names[nearest] if nearest < len(obstacle_names) else f"obstacle {nearest}"
+        area = isinstance(obstacles[nearest], OperatingArea)
         if distances[nearest] < 0.0:
-            raise InfeasibleError(f"{where} is inside obstacle {label!r}")
+            inside = f"outside the {label}" if area else f"inside obstacle {label!r}"
+            raise InfeasibleError(f"{where} is {inside}")
+        what = f"the boundary of the {label}" if area else f"obstacle {label!r}"
         raise InfeasibleError(
-            f"{where} is within the clearance {clearance:g} m of obstacle {label!r} "
+            f"{where} is within the clearance {clearance:g} m of {what} "
             f"({distances[nearest]:.3g} m from it; cell [{row}, {col}] is blocked)"
         )
     return row, col
