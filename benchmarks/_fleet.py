@@ -32,6 +32,7 @@ from auvplan.optimization import (
     ProntoOptions,
     StageBackend,
     project_guess,
+    solve_fatrop,
     solve_ipopt,
     solve_pronto,
 )
@@ -114,7 +115,9 @@ def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, An
     building the model: loading or compiling kernels). ``ipopt``/``ipopt-mx``: CasADi + IPOPT
     on the same discretised problem from PRONTO's projected initial trajectory, hard
     constraints, the NLP expanded to SX (fastest evaluation, memory grows with the horizon) or
-    kept as MX. ``max_iter`` caps PRONTO's iterations (for per-iteration timing).
+    kept as MX; ``fatrop``/``fatrop-c``: CasADi + FATROP alike (SX), on CasADi's virtual
+    machine or with the NLP's functions compiled to C (``solve_s``: the solve alone).
+    ``max_iter`` caps PRONTO's iterations (for per-iteration timing).
     """
     with tempfile.TemporaryDirectory() as scratch:
         assembled, options = build_case(case, Path(scratch))
@@ -126,11 +129,17 @@ def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, An
         "n_substeps": problem.n_substeps,
     }  # fmt: skip
     started = time.perf_counter()
-    if solver.startswith("ipopt"):
+    if solver.startswith(("ipopt", "fatrop")):
         initial, _ = project_guess(ModelCache().get(problem), guess, options)
         started = time.perf_counter()
-        result = solve_ipopt(problem, initial, expand=solver == "ipopt")
-        record.update(status=str(result.status), iterations=result.n_iter, cost=result.cost)
+        if solver.startswith("ipopt"):
+            result = solve_ipopt(problem, initial, expand=solver == "ipopt")
+        else:
+            result = solve_fatrop(problem, initial, compiled=solver == "fatrop-c")
+        record.update(
+            status=str(result.status), iterations=result.n_iter, cost=result.cost,
+            solve_s=result.solve_time,
+        )  # fmt: skip
     else:
         backend = StageBackend(stage_kernels=solver == "kernels")
         options = ProntoOptions(**{**options.__dict__, "stage_kernels": backend.stage_kernels})

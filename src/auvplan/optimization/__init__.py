@@ -2,7 +2,8 @@
 
 Build a :class:`TrajectoryProblem` from CasADi Functions (continuous dynamics, running-cost
 rate, terminal cost, path constraints ``c >= 0``) and call :func:`solve_pronto`;
-:func:`solve_ipopt` solves the identical discretised problem with CasADi + IPOPT.
+:func:`solve_ipopt` and :func:`solve_fatrop` solve the identical discretised problem with CasADi
++ IPOPT and CasADi + FATROP.
 The algorithm is documented in ``reference/pronto.md`` (§6, §7, §11).
 
 Modules, in the order of the data flow:
@@ -18,7 +19,7 @@ Modules, in the order of the data flow:
 - ``lq``: the LQ direction and its fallback ladder; ``steps``: :func:`compute_direction`;
 - ``linesearch``: :func:`try_step`, :func:`armijo_step`, :func:`converged`;
 - ``pronto``: :func:`solve_pronto`; ``result``: its records; ``numdiff``: derivative check;
-- ``ipopt``: the CasADi + IPOPT reference.
+- ``reference``: the CasADi + IPOPT and CasADi + FATROP references.
 """
 
 from __future__ import annotations
@@ -35,7 +36,6 @@ from auvplan.optimization.block_kernels import BlockKernels, block_kernels
 from auvplan.optimization.constraints import ConstraintModel, discretize_constraints
 from auvplan.optimization.discretization import DiscreteModel, StepModel, discretize_rk4
 from auvplan.optimization.integration import choose_substeps
-from auvplan.optimization.ipopt import IpoptResult, IpoptStatus, solve_ipopt
 from auvplan.optimization.linesearch import (
     ArmijoResult,
     StepTrial,
@@ -55,6 +55,7 @@ from auvplan.optimization.options import (
 from auvplan.optimization.problem import NodeCost, PathConstraint, Trajectory, TrajectoryProblem
 from auvplan.optimization.projection import design_regulator, project, project_guess
 from auvplan.optimization.pronto import solve_pronto
+from auvplan.optimization.reference import IpoptResult, IpoptStatus, solve_fatrop, solve_ipopt
 from auvplan.optimization.result import ProntoIteration, ProntoResult, ProntoStatus
 from auvplan.optimization.separable import BlockDiscreteModel, StageBlock, stack_blocks
 from auvplan.optimization.stages import (
@@ -124,6 +125,7 @@ __all__ = [
     "project",
     "project_guess",
     "second_order_weights",
+    "solve_fatrop",
     "solve_ipopt",
     "solve_lq_direction",
     "solve_pronto",

@@ -1,0 +1,289 @@
+"""CasADi reference solvers: IPOPT and FATROP on the identical discretised problem.
+
+The decision variables are all states ``x_0..x_N`` and inputs ``u_0..u_{N-1}`` on the same
+grid, ordered stage by stage ``(x_0, u_0, x_1, u_1, …, x_N)``; the defects
+``x_{k+1} − F(x_k, u_k, p_k) = 0`` (FATROP's sign) use the very same (substepped) RK4 step
+Function as PRONTO, the objective the same stage cost ``Σ L_k + m(x_N)`` (see
+:mod:`auvplan.optimization.problem`).
+Path constraints are hard inequalities ``c(x_k, u_k, p_k) / scale ≥ 0``; with
+``barrier=(ε, δ)`` the objective also carries the identical approximate-barrier term
+``ε dt Σ b(c / scale)`` so that costs are comparable with PRONTO at equal ``ε``. The
+constraint rows are ordered stage by stage too, each stage's defect first and then its path
+constraints, which is the layout FATROP's structure detection reads (a row of stage ``k``
+depends on ``x_k, u_k`` and ``x_{k+1}`` only).
+
+- :func:`solve_ipopt`: IPOPT with MUMPS and the exact Hessian of the Lagrangian, the
+  independent reference of the tests and benchmarks.
+- :func:`solve_fatrop`: FATROP (Vanroye et al., IROS 2023), the structure-exploiting interior
+  point method shipped in CasADi's wheel: a Riccati recursion over the stages, the same
+  exact Hessian; optionally with the NLP's functions compiled to C (``jit``), as a user
+  would run it for speed.
+"""
+
+from __future__ import annotations
+
+import enum
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from auvplan.errors import InputError
+from auvplan.optimization.barrier import BarrierKind, barrier_expression
+from auvplan.optimization.discretization import discretize_rk4
+from auvplan.optimization.problem import Trajectory, TrajectoryProblem
+
+__all__ = ["IpoptResult", "IpoptStatus", "solve_fatrop", "solve_ipopt"]
+
+
+class IpoptStatus(enum.Enum):
+    """Outcome of :func:`solve_ipopt` or :func:`solve_fatrop`."""
+
+    SOLVED = "solved"
+    ACCEPTABLE = "acceptable"
+    MAX_ITER = "max_iter"
+    FAILED = "failed"
+
+
+@dataclass(frozen=True)
+class IpoptResult:
+    """Result of :func:`solve_ipopt` or :func:`solve_fatrop` (the name is IPOPT's, the first).
+
+    Attributes
+    ----------
+    trajectory : Trajectory
+        States ``(N+1, n_x)`` and inputs ``(N, n_u)``.
+    status : IpoptStatus
+        Outcome; ``message`` is IPOPT's return status.
+    cost : float
+        ``Σ L_k + m(x_N)`` (no barrier).
+    barrier_cost : float
+        ``ε dt Σ b`` when ``barrier`` was given, else 0.
+    n_iter : int
+        IPOPT iterations.
+    wall_time : float
+        Seconds for the whole call (building the NLP included); ``solve_time`` only the solve
+        (for FATROP with ``compiled=True`` the C compilation is ``wall_time − solve_time``).
+    max_defect : float
+        Largest dynamics defect ``|x_{k+1} − F(x_k, u_k)|`` of the returned trajectory.
+    """
+
+    trajectory: Trajectory
+    status: IpoptStatus
+    message: str
+    cost: float
+    barrier_cost: float
+    n_iter: int
+    wall_time: float
+    solve_time: float
+    max_defect: float
+
+    @property
+    def success(self) -> bool:
+        """True when IPOPT solved the problem (to its tolerance or the acceptable level)."""
+        return self.status in (IpoptStatus.SOLVED, IpoptStatus.ACCEPTABLE)
+
+    @property
+    def objective(self) -> float:
+        """``cost + barrier_cost``."""
+        return self.cost + self.barrier_cost
+
+
+def solve_ipopt(
+    problem: TrajectoryProblem,
+    guess: Trajectory,
+    *,
+    barrier: tuple[float, float] | None = None,
+    hard_constraints: bool = True,
+    tol: float = 1e-10,
+    max_iter: int = 3000,
+    expand: bool = True,
+) -> IpoptResult:
+    """Solve the discretised problem with IPOPT (multiple shooting, MUMPS, exact Hessian).
+
+    Parameters
+    ----------
+    problem : TrajectoryProblem
+        The problem (same grid and models as for PRONTO).
+    guess : Trajectory
+        Initial values of all states and inputs (used as given, not projected).
+    barrier : tuple of float, optional
+        ``(ε, δ)``: add the approximate-barrier term of every path constraint to the objective.
+    hard_constraints : bool
+        Impose the path constraints ``c / scale ≥ 0`` as inequalities.
+    tol : float
+        IPOPT ``tol``.
+    max_iter : int
+        IPOPT ``max_iter``.
+    expand : bool
+        Expand the NLP to SX before solving (slow to build for long horizons, fast to
+        evaluate); ``False`` keeps CasADi's mapped MX graph (fast to build).
+
+    Returns
+    -------
+    IpoptResult
+        Trajectory, cost, iterations, timings and status.
+
+    Raises
+    ------
+    InputError
+        If the guess has the wrong shape, ``barrier`` is not ``(ε > 0, δ > 0)`` or the
+        problem has node costs (not CasADi expressions, so not in the NLP).
+    """
+    options: dict[str, Any] = {
+        "expand": expand,
+        "ipopt.print_level": 0,
+        "ipopt.sb": "yes",
+        "ipopt.linear_solver": "mumps",
+        "ipopt.hessian_approximation": "exact",
+        "ipopt.tol": tol,
+        "ipopt.max_iter": max_iter,
+    }
+    return _solve(problem, guess, "ipopt", options, barrier, hard_constraints)
+
+
+def solve_fatrop(
+    problem: TrajectoryProblem,
+    guess: Trajectory,
+    *,
+    barrier: tuple[float, float] | None = None,
+    hard_constraints: bool = True,
+    tol: float = 1e-8,
+    max_iter: int = 3000,
+    compiled: bool = False,
+) -> IpoptResult:
+    """Solve the discretised problem with FATROP (module notes), as :func:`solve_ipopt`.
+
+    The NLP is expanded to SX and FATROP detects its stage structure (``structure_detection
+    = "auto"``, the rows' ``equality`` flags); ``compiled=True`` has CasADi generate C for the
+    NLP's functions and compile them with the system compiler (``jit``, ``gcc -O1``) before
+    solving. ``tol`` is FATROP's ``tol``. Parameters, returns and errors otherwise as for
+    :func:`solve_ipopt`.
+    """
+    options: dict[str, Any] = {
+        "expand": True,
+        "structure_detection": "auto",
+        "debug": False,
+        "fatrop.print_level": 0,
+        "fatrop.tol": tol,
+        "fatrop.max_iter": max_iter,
+    }
+    if compiled:
+        options |= {
+            "jit": True,
+            "compiler": "shell",
+            "jit_options": {"flags": ["-O1"], "verbose": False},
+        }
+    return _solve(problem, guess, "fatrop", options, barrier, hard_constraints)
+
+
+#: IPOPT's return statuses by name (FATROP reports a number and ``success``).
+_STATUSES: dict[str, IpoptStatus] = {
+    "Solve_Succeeded": IpoptStatus.SOLVED,
+    "Solved_To_Acceptable_Level": IpoptStatus.ACCEPTABLE,
+    "Maximum_Iterations_Exceeded": IpoptStatus.MAX_ITER,
+}
+
+
+def _solve(
+    problem: TrajectoryProblem,
+    guess: Trajectory,
+    plugin: str,
+    options: dict[str, Any],
+    barrier: tuple[float, float] | None,
+    hard_constraints: bool,
+) -> IpoptResult:
+    """Build the stage-ordered NLP (module notes) and solve it with CasADi's ``plugin``."""
+    start = time.perf_counter()
+    if problem.node_costs:
+        raise InputError("the CasADi reference cannot include node costs (set them to none)")
+    n_x, n_u, n_steps = problem.n_states, problem.n_inputs, problem.n_steps
+    if guess.states.shape != (n_steps + 1, n_x) or guess.inputs.shape != (n_steps, n_u):
+        raise InputError(
+            f"guess must have states ({n_steps + 1}, {n_x}) and inputs ({n_steps}, {n_u})"
+        )
+    if barrier is not None and not (barrier[0] > 0 and barrier[1] > 0):
+        raise InputError(f"barrier must be (epsilon > 0, delta > 0), got {barrier!r}")
+    model = discretize_rk4(
+        problem.dynamics, problem.running_cost, problem.dt, n_substeps=problem.n_substeps
+    )
+    params = problem.parameters.T
+    state_symbols = [ca.MX.sym(f"x{k}", n_x) for k in range(n_steps + 1)]
+    input_symbols = [ca.MX.sym(f"u{k}", n_u) for k in range(n_steps)]
+    states, inputs = ca.horzcat(*state_symbols), ca.horzcat(*input_symbols)
+    current, following = states[:, :n_steps], states[:, 1:]
+    defects = following - model.step_function.map(n_steps, "serial")(current, inputs, params)
+    running = ca.sum2(model.cost_function.map(n_steps, "serial")(current, inputs, params))
+    terminal = problem.terminal_cost(states[:, n_steps])
+    barrier_term: ca.MX = ca.MX(0)
+    stage_rows: list[ca.MX] = [defects]  # (rows, N): column k holds stage k's rows
+    final_rows: list[ca.MX] = []
+    for constraint in problem.constraints:
+        slack = constraint.function.map(n_steps, "serial")(current, inputs, params)
+        slacks = [slack / constraint.scale]
+        final = np.flatnonzero(constraint.at_final_node).tolist()
+        if final:  # the components free of u also hold at x_N (last input and parameters)
+            at_end = constraint.function(
+                states[:, n_steps], inputs[:, n_steps - 1], params[:, n_steps - 1]
+            )
+            slacks.append(ca.vertcat(*[at_end[i] for i in final]) / constraint.scale)
+        if hard_constraints:
+            stage_rows.append(slacks[0])
+            final_rows.extend(slacks[1:])
+        if barrier is not None:
+            epsilon, delta = barrier
+            is_hockey = constraint.kind is BarrierKind.HOCKEY
+            for rows in slacks:
+                terms = barrier_expression(rows, delta, is_hockey=is_hockey)
+                barrier_term = barrier_term + epsilon * problem.dt * ca.sum1(ca.sum2(terms))
+    stacked = ca.vertcat(*stage_rows)
+    n_rows = stacked.size1()
+    equality = np.zeros((n_rows, n_steps), dtype=bool)
+    equality[:n_x] = True
+    n_final = sum(int(g.numel()) for g in final_rows)
+    constraints = ca.vertcat(ca.vec(stacked), *final_rows)
+    equality_flags = np.concatenate([equality.ravel(order="F"), np.zeros(n_final, dtype=bool)])
+    variables = ca.vertcat(
+        *[v for k in range(n_steps) for v in (state_symbols[k], input_symbols[k])],
+        state_symbols[n_steps],
+    )
+    nlp: dict[str, Any] = {"x": variables, "f": running + terminal + barrier_term, "g": constraints}
+    settings = {"print_time": False, **options}
+    if plugin == "fatrop":
+        settings["equality"] = equality_flags.tolist()
+    solver = ca.nlpsol(f"auvplan_{plugin}", plugin, nlp, settings)
+    lower = np.full(variables.numel(), -np.inf)
+    upper = np.full(variables.numel(), np.inf)
+    lower[:n_x] = upper[:n_x] = problem.initial_state
+    x_init = np.concatenate(
+        [np.hstack([guess.states[:-1], guess.inputs]).ravel(), guess.states[-1]]
+    )
+    x_init[:n_x] = problem.initial_state
+    lbg = np.zeros(constraints.numel())
+    ubg = np.where(equality_flags, 0.0, np.inf)
+    solve_start = time.perf_counter()
+    solution = solver(x0=x_init, lbx=lower, ubx=upper, lbg=lbg, ubg=ubg)
+    solve_time = time.perf_counter() - solve_start
+    stats = solver.stats()
+    values = np.asarray(solution["x"].full(), dtype=np.float64).ravel()
+    staged = values[: n_steps * (n_x + n_u)].reshape(n_steps, n_x + n_u)
+    result_states = np.vstack([staged[:, :n_x], values[None, n_steps * (n_x + n_u) :]])
+    result_inputs = staged[:, n_x:]
+    evaluate = ca.Function("evaluate", [variables], [running + terminal, barrier_term, defects])
+    cost, barrier_cost, defect = evaluate(values)
+    return_status = str(stats.get("return_status", "unknown"))
+    return IpoptResult(
+        trajectory=Trajectory(result_states, result_inputs),
+        status=_STATUSES.get(
+            return_status, IpoptStatus.SOLVED if stats.get("success") else IpoptStatus.FAILED
+        ),
+        message=return_status,
+        cost=float(cost),
+        barrier_cost=float(barrier_cost),
+        n_iter=int(stats.get("iter_count", -1)),
+        wall_time=time.perf_counter() - start,
+        solve_time=solve_time,
+        max_defect=float(np.max(np.abs(np.asarray(defect.full())))),
+    )
