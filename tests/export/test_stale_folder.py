@@ -23,8 +23,7 @@ def test_trajectories_of_an_earlier_run_are_refused(
 ) -> None:
     folder = tmp_path / "out"
     shutil.copytree(planned_folder, folder, ignore=shutil.ignore_patterns("export"))
-    mission = tmp_path / "mission.toml"
-    shutil.copy(folder / "mission.toml", mission)
+    mission = folder / "mission.toml"  # its grid is the folder's maps.nc
     assert main(["-q", "plan", str(mission), "--stage", "preplan", "--no-figures", "-o",
                  str(folder)]) == 0  # fmt: skip
     assert (folder / "trajectories.csv").is_file()  # kept by the rerun

@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from auvplan.cli.main import main
+from auvplan.io.text import file_sha256
 
 GOOD_START = "{ north = 10.0, east = 200.0, heading_deg = 0.0 }"
 LAND_START = "{ north = 280.0, east = 20.0 }"
@@ -23,30 +24,50 @@ def test_second_invocation_skips_finished_runs(
     tiny_mission: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out = tmp_path / "sweep"
-    assert (
-        _sweep(tiny_mission, out, "--vary", "planner.edge_model=paper,crossed", "--seeds", "3") == 0
-    )
+    assert _sweep(tiny_mission, out, "--vary", "weights.terrain=0,1") == 0
     first = pd.read_csv(out / "sweep.csv")
-    assert first["run_id"].tolist() == [
-        "planner.edge_model=paper__seed=3",
-        "planner.edge_model=crossed__seed=3",
-    ]
+    assert first["run_id"].tolist() == ["weights.terrain=0.0", "weights.terrain=1.0"]
     assert first["status"].tolist() == ["PREPLANNED", "PREPLANNED"]
-    assert first["seed"].tolist() == [3, 3]
     summaries = {path: path.stat().st_mtime_ns for path in out.glob("runs/*/summary.json")}
     assert len(summaries) == 2
     capsys.readouterr()
 
-    options = ("--vary", "planner.edge_model=paper,crossed", "--seeds", "3,4")
-    assert _sweep(tiny_mission, out, *options) == 0
-    assert "4 runs (2 ran, 2 skipped as finished before, 0 failed)" in capsys.readouterr().out
+    assert _sweep(tiny_mission, out, "--vary", "weights.terrain=0,1,2") == 0
+    assert "3 runs (1 ran, 2 skipped as finished before, 0 failed), 1 planned" in (
+        capsys.readouterr().out
+    )
     assert {path: path.stat().st_mtime_ns for path in summaries} == summaries  # not rewritten
     document = json.loads((out / "sweep.json").read_text())
     assert document["counts"]["skipped"] == 2
-    assert document["spec"]["seeds"] == [3, 4]
+    assert document["counts"]["planned"] == 1
     second = pd.read_csv(out / "sweep.csv")
-    assert len(second) == 4
-    pd.testing.assert_frame_equal(second.iloc[[0, 2]].reset_index(drop=True), first)
+    assert len(second) == 3
+    pd.testing.assert_frame_equal(second.iloc[[0, 1]].reset_index(drop=True), first)
+
+
+@pytest.mark.usefixtures("inprocess_cluster")
+def test_seeds_do_not_replan_a_mission_file(
+    tiny_mission: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    out = tmp_path / "sweep"
+    vary = ("--vary", "weights.terrain=0,1", "--vary", "planner.edge_model=paper,crossed")
+    assert _sweep(tiny_mission, out, *vary, "--seeds", "0..1") == 0
+    assert "4 runs (4 ran, 0 skipped as finished before, 0 failed), 4 planned" in (
+        capsys.readouterr().out
+    )  # was 8 runs, 8 plans: one per mission and seed
+    assert "--seeds 0..1 do not change a mission file's plan" in caplog.text
+    assert "each of its 4 missions is planned once" in caplog.text
+    table = pd.read_csv(out / "sweep.csv")
+    assert len(table) == 4
+    assert table["seed"].isna().all()
+    assert not table["run_id"].str.contains("seed").any()
+    assert len(list((out / "runs").iterdir())) == 4
+    document = json.loads((out / "sweep.json").read_text())
+    assert document["spec"]["seeds"] == [0, 1]
+    assert document["counts"]["planned"] == 4
 
 
 @pytest.mark.usefixtures("inprocess_cluster")
@@ -133,9 +154,11 @@ def test_scenario_family_seeds_are_missions(
     table = pd.read_csv(out / "sweep.csv")
     assert table["seed"].tolist() == [2, 3]
     assert (table["status"] == "PREPLANNED").all()
+    assert json.loads((out / "sweep.json").read_text())["counts"]["planned"] == 2
     for seed, folder in zip(table["seed"], table["folder"], strict=True):
         mission = out / "scenarios" / f"seed_{seed:04d}" / "mission.toml"
         summary = json.loads((Path(folder) / "summary.json").read_text())
-        assert summary["inputs"]["mission"]["path"] == str(mission.resolve())
+        assert summary["inputs"]["mission"]["path"] == "mission.toml"  # no folder
+        assert summary["inputs"]["mission"]["sha256"] == file_sha256(mission)
     assert len({json.loads((Path(f) / "summary.json").read_text())["terrain"]["name"]
                 for f in table["folder"]}) == 2  # fmt: skip

@@ -74,6 +74,24 @@ def _parse_propeller_table(text: str, origin: str) -> tuple[FloatArray, FloatArr
     return table[:, 0], table[:, 1:]
 
 
+def propeller_table_file(table: str | Path, base_dir: Path | None = None) -> Path | None:
+    """The CSV file a vehicle file's ``table`` names (``None``: a packaged table).
+
+    A relative path is taken from ``base_dir`` (the vehicle file's folder), when given.
+
+    Examples
+    --------
+    >>> propeller_table_file("wageningen_b4-70_pd1.4") is None
+    True
+    >>> propeller_table_file("props/mine.csv", Path("boats"))
+    PosixPath('boats/props/mine.csv')
+    """
+    if str(table) in packaged_propeller_tables():
+        return None
+    path = Path(table)
+    return path if path.is_absolute() or base_dir is None else base_dir / path
+
+
 def load_propeller_table(
     table: str | Path,
     *,
@@ -115,13 +133,11 @@ def load_propeller_table(
     30
     """
     name = str(table)
-    if name in packaged_propeller_tables():
+    path = propeller_table_file(table, base_dir)
+    if path is None:
         text = read_text(data_dir("propellers").joinpath(f"{name}.csv"), what="propeller table")
         source = f"packaged table {name}"
     else:
-        path = Path(table)
-        if not path.is_absolute() and base_dir is not None:
-            path = base_dir / path
         if not path.is_file():
             raise InputError(
                 f"propeller table {name!r} is neither packaged "
@@ -152,4 +168,5 @@ __all__ = [
     "data_dir",
     "load_propeller_table",
     "packaged_propeller_tables",
+    "propeller_table_file",
 ]

@@ -21,6 +21,25 @@ from auvplan.errors import DataFormatError
 from auvplan.io.writing import writing
 
 
+def read_bytes(path: Path | Traversable, *, what: str) -> bytes:
+    """The bytes of a file; a missing, unreadable file or a folder is one line naming it.
+
+    Raises
+    ------
+    DataFormatError
+        If the file is missing, a folder or unreadable; the message names ``what`` and the
+        file.
+    """
+    try:
+        return path.read_bytes()
+    except FileNotFoundError:
+        raise DataFormatError(f"{what} {path}: file not found") from None
+    except IsADirectoryError:
+        raise DataFormatError(f"{what} {path}: is a folder, not a file") from None
+    except OSError as error:
+        raise DataFormatError(f"{what} {path}: cannot read ({error.strerror or error})") from None
+
+
 def read_text(path: Path | Traversable, *, what: str) -> str:
     """The content of a UTF-8 text file (a leading byte-order mark is dropped).
 
@@ -49,14 +68,7 @@ def read_text(path: Path | Traversable, *, what: str) -> str:
     ...
     auvplan.errors.DataFormatError: vehicle file no/such/file.toml: file not found
     """
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise DataFormatError(f"{what} {path}: file not found") from None
-    except IsADirectoryError:
-        raise DataFormatError(f"{what} {path}: is a folder, not a file") from None
-    except OSError as error:
-        raise DataFormatError(f"{what} {path}: cannot read ({error.strerror or error})") from None
+    data = read_bytes(path, what=what)
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
@@ -114,16 +126,28 @@ def read_json(path: Path, *, what: str) -> Any:
         raise DataFormatError(f"{what} {path}: not valid JSON ({error})") from None
 
 
-def write_toml(document: Mapping[str, Any], path: Path, *, header: str = "") -> None:
-    """Write ``document`` (plain TOML values: no ``None``) as a UTF-8 TOML file (tomli-w).
+def toml_text(document: Mapping[str, Any], *, header: str = "") -> str:
+    """``document`` (plain TOML values: no ``None``) as TOML text (tomli-w).
 
-    ``header`` lines are written first, as ``#`` comments.
+    ``header`` lines come first, as ``#`` comments.
+
+    Examples
+    --------
+    >>> print(toml_text({"fleet": {"horizon_s": 60.0}}, header="a mission"), end="")
+    # a mission
+    [fleet]
+    horizon_s = 60.0
     """
     import tomli_w
 
     comments = "".join(f"# {line}\n" for line in header.splitlines())
+    return comments + tomli_w.dumps(document)
+
+
+def write_toml(document: Mapping[str, Any], path: Path, *, header: str = "") -> None:
+    """Write ``document`` as a UTF-8 TOML file (:func:`toml_text`)."""
     with writing(path):
-        path.write_text(comments + tomli_w.dumps(document), encoding="utf-8")
+        path.write_text(toml_text(document, header=header), encoding="utf-8")
 
 
 def file_sha256(path: Path | Traversable) -> str:
@@ -142,4 +166,12 @@ def file_sha256(path: Path | Traversable) -> str:
     return digest.hexdigest()
 
 
-__all__ = ["file_sha256", "read_json", "read_text", "read_toml", "write_toml"]
+__all__ = [
+    "file_sha256",
+    "read_bytes",
+    "read_json",
+    "read_text",
+    "read_toml",
+    "toml_text",
+    "write_toml",
+]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import platform
 from collections.abc import Sequence
+from datetime import UTC, datetime
 from enum import Enum
 from importlib import metadata
 from importlib.resources.abc import Traversable
@@ -18,13 +19,13 @@ from auvplan.io.results import json_values
 from auvplan.io.text import file_sha256
 from auvplan.io.vehicles import vehicle_file
 from auvplan.mission.assembly import integration_substeps
-from auvplan.mission.config import MissionConfig
+from auvplan.mission.config import CurrentConfig, MissionConfig
 from auvplan.mission.evaluation import CHECK_REFINEMENT, OptimizedPlan
 from auvplan.mission.pipeline import MissionResult
 from auvplan.mission.preplan import PreplanStage
 from auvplan.mission.still_water import CurrentComparison
 from auvplan.navigation.prediction import ErrorPrediction
-from auvplan.planning import CircleObstacle, path_length
+from auvplan.planning import CircleObstacle, OperatingArea, path_length
 from auvplan.record import PlanSummary, parse_summary
 from auvplan.terrain import LocalProjection
 from auvplan.vehicle import positions, top_speed
@@ -49,7 +50,24 @@ def _predicted(prediction: ErrorPrediction, settle_s: float) -> dict[str, float]
     }
 
 
-def _plan_summary(plan: OptimizedPlan, names: tuple[str, ...], settle_s: float) -> dict[str, Any]:
+def _battery(energy: float, capacity: float | None) -> dict[str, float | None]:
+    """What a plan of ``energy`` [J] leaves in a battery of ``capacity`` [J] (None: unknown).
+
+    ``energy_remaining_J`` = ``C − E`` [J], ``energy_remaining_fraction`` = ``(C − E) / C``.
+    """
+    if capacity is None:
+        return {"energy_remaining_J": None, "energy_remaining_fraction": None}
+    remaining = capacity - energy
+    return {"energy_remaining_J": remaining, "energy_remaining_fraction": remaining / capacity}
+
+
+def _plan_summary(
+    plan: OptimizedPlan,
+    names: tuple[str, ...],
+    settle_s: float,
+    capacities: tuple[float | None, ...],
+) -> dict[str, Any]:
+    """A plan's record; ``capacities`` [J] are the vehicles' batteries (None: unknown)."""
     result = plan.result
     return {
         "terrain_weight": plan.terrain_weight,
@@ -64,6 +82,7 @@ def _plan_summary(plan: OptimizedPlan, names: tuple[str, ...], settle_s: float) 
         "vehicles": {
             name: {
                 "energy_J": float(plan.energy[i]),
+                **_battery(float(plan.energy[i]), capacities[i]),
                 "mean_terrain_information": float(plan.terrain_information[i]),
                 "arrival_error_m": float(plan.arrival_error[i]),
                 "tracking_error_m": float(plan.tracking_error[i]),
@@ -95,7 +114,11 @@ def _place(projection: LocalProjection | None, north: float, east: float) -> dic
 
 
 def _obstacles(preplan: PreplanStage) -> list[dict[str, Any]]:
-    """The obstacles in the map frame (and lat/lon), as the planners saw them."""
+    """The obstacles in the map frame (and lat/lon), as the planners saw them.
+
+    A polygon's ``holes`` (free water) and the operating area (``shape = "area"``: the
+    region every vehicle stays inside) are listed when the mission has them.
+    """
     projection = preplan.bathymetry.projection
     shapes: list[dict[str, Any]] = []
     for name, obstacle in zip(preplan.obstacle_names, preplan.obstacles, strict=True):
@@ -109,14 +132,22 @@ def _obstacles(preplan: PreplanStage) -> list[dict[str, Any]]:
                 }
             )
         else:
-            vertices = [_place(projection, north, east) for north, east in obstacle.vertices]
-            shapes.append({"name": name, "shape": "polygon", "vertices": vertices})
+            area = isinstance(obstacle, OperatingArea)
+            polygon = obstacle.region if isinstance(obstacle, OperatingArea) else obstacle
+            shape: dict[str, Any] = {
+                "name": name,
+                "shape": "area" if area else "polygon",
+                "vertices": [_place(projection, n, e) for n, e in polygon.vertices],
+            }
+            if polygon.holes:
+                shape["holes"] = [[_place(projection, n, e) for n, e in h] for h in polygon.holes]
+            shapes.append(shape)
     return shapes
 
 
 def _fingerprint(path: Path | Traversable) -> dict[str, str]:
-    location = str(path.resolve()) if isinstance(path, Path) else str(path)
-    return {"path": location, "sha256": file_sha256(path)}
+    """A file the run read: its name (an output folder holds no absolute path) and SHA-256."""
+    return {"path": path.name, "sha256": file_sha256(path)}
 
 
 #: The distributions whose versions decide a plan's numbers (recorded in ``summary.json``).
@@ -144,8 +175,11 @@ def environment() -> dict[str, Any]:
     }
 
 
-def _inputs(config: MissionConfig) -> dict[str, Any]:
-    """Path and SHA-256 of every file the run read: mission, bathymetry, vehicle files."""
+def _inputs(config: MissionConfig, vehicle_types: Sequence[str]) -> dict[str, Any]:
+    """Name and SHA-256 of every file the run read: mission, bathymetry, current, vehicles.
+
+    The vehicle files by their ``vehicle_types`` (as the folder's ``mission.toml`` names them).
+    """
     return {
         "mission": None if config.source is None else _fingerprint(config.source),
         "bathymetry": None if config.terrain.path is None else _fingerprint(config.terrain.path),
@@ -153,9 +187,18 @@ def _inputs(config: MissionConfig) -> dict[str, Any]:
         if config.current is None or config.current.file is None
         else _fingerprint(config.current.file),
         "vehicles": {
-            vehicle.type: _fingerprint(vehicle_file(vehicle.type)) for vehicle in config.vehicles
+            kind: _fingerprint(vehicle_file(vehicle.type))
+            for kind, vehicle in zip(vehicle_types, config.vehicles, strict=True)
         },
     }
+
+
+def _current(current: CurrentConfig) -> dict[str, Any]:
+    """The ``[current]`` table, a file by its name."""
+    table: dict[str, Any] = current.model_dump(mode="json", exclude_none=True)
+    if current.file is not None:
+        table["file"] = current.file.name
+    return table
 
 
 def _max_current(result: MissionResult) -> float:
@@ -182,11 +225,15 @@ def _plans(result: MissionResult) -> list[tuple[MissionResult, OptimizedPlan]]:
     return plans
 
 
-def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> PlanSummary:
+def mission_summary(
+    result: MissionResult, *, vehicle_types: Sequence[str], warnings: Sequence[str] = ()
+) -> PlanSummary:
     """Build the ``summary.json`` document of a mission run (without its ``digest``).
 
-    ``warnings`` are the warnings logged during the run (one line each), kept under
-    ``"warnings"``.
+    ``vehicle_types`` are the vehicles' ``type`` as the output folder's ``mission.toml``
+    names them (a packaged type or a carried file, :mod:`auvplan.mission.carry`): no path
+    outside the folder. ``warnings`` are the warnings logged during the run (one line each),
+    kept under ``"warnings"``.
     """
     config = result.config
     preplan = result.preplan
@@ -197,9 +244,10 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> P
     method = config.deconfliction.method if stage2 is None else stage2.coordination.method
     summary: dict[str, Any] = {
         "auvplan_version": __version__,
+        "created": datetime.now(UTC).isoformat(timespec="seconds"),
         "environment": environment(),
-        "mission": None if config.source is None else str(config.source),
-        "inputs": _inputs(config),
+        "mission": None if config.source is None else config.source.name,
+        "inputs": _inputs(config, vehicle_types),
         "start_time": config.mission.start_time.isoformat(),
         "stage": result.stage.value,
         "terrain": {
@@ -215,9 +263,7 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> P
             "origin": _place(preplan.bathymetry.projection, 0.0, 0.0),
         },
         "obstacles": _obstacles(preplan),
-        "current": None
-        if config.current is None
-        else config.current.model_dump(mode="json", exclude_none=True),
+        "current": None if config.current is None else _current(config.current),
         "fleet": {
             "safety_radius_m": config.fleet.safety_radius,
             "edge_model": config.planner.edge_model,
@@ -233,7 +279,7 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> P
         route = preplan.routes[i]
         vehicle: dict[str, Any] = {
             "name": name,
-            "type": config.vehicles[i].type,
+            "type": vehicle_types[i],
             "start": _pose(preplan.starts[i]),
             "goal": _pose(preplan.goals[i]),
             "preplan": {
@@ -277,16 +323,22 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> P
                 state_names=model.state_names,
                 input_names=model.input_names,
                 top_speed_m_s=top_speed(model),
+                battery_capacity_J=model.vehicle.battery_capacity,
             )
     if result.failure is not None:
         summary["optimization"] = {"plan_status": "FAILED", "verdict": result.failure}
+    capacities = (
+        () if stage2 is None else tuple(m.vehicle.battery_capacity for m in stage2.layout.models)
+    )
     if result.plan is not None:
-        summary["optimization"] = _plan_summary(result.plan, preplan.names, settle_s)
+        summary["optimization"] = _plan_summary(result.plan, preplan.names, settle_s, capacities)
     if result.energy_only is not None:
-        summary["energy_only"] = _plan_summary(result.energy_only, preplan.names, settle_s)
+        summary["energy_only"] = _plan_summary(
+            result.energy_only, preplan.names, settle_s, capacities
+        )
     if result.paper is not None and result.paper.plan is not None:
         summary["paper"] = {
-            **_plan_summary(result.paper.plan, preplan.names, settle_s),
+            **_plan_summary(result.paper.plan, preplan.names, settle_s, capacities),
             "edge_model": result.paper.config.planner.edge_model,
             "smoothed_length_m": {
                 name: path_length(path)
@@ -295,13 +347,16 @@ def mission_summary(result: MissionResult, *, warnings: Sequence[str] = ()) -> P
         }
     if result.current_comparison is not None:
         summary["current_comparison"] = _comparison_summary(
-            result.current_comparison, preplan.names, settle_s
+            result.current_comparison, preplan.names, settle_s, capacities
         )
     return parse_summary(json_values(summary), source="the run's summary")
 
 
 def _comparison_summary(
-    comparison: CurrentComparison, names: tuple[str, ...], settle_s: float
+    comparison: CurrentComparison,
+    names: tuple[str, ...],
+    settle_s: float,
+    capacities: tuple[float | None, ...],
 ) -> dict[str, Any]:
     """``--compare-no-current``: both plans flown in the current (:mod:`.still_water`)."""
     using, still = comparison.using_current, comparison.still_water
@@ -313,7 +368,7 @@ def _comparison_summary(
         "total_energy_still_water_plan_J": total_still,
         "saving_J": comparison.saving,
         "saving_percent": 100.0 * comparison.saving / total_still if total_still > 0 else 0.0,
-        "still_water_plan": _plan_summary(comparison.still_water_plan, names, settle_s),
+        "still_water_plan": _plan_summary(comparison.still_water_plan, names, settle_s, capacities),
         "vehicles": {
             name: {
                 "energy_using_current_J": float(using.energy[i]),

@@ -21,6 +21,9 @@ PATHS_FILE: Final = "paths.geojson"
 DESIRED_FILE: Final = "desired.csv"
 #: The self-contained report page.
 REPORT_FILE: Final = "report.html"
+#: The sub-folder of the input files the folder carries (vehicle files, propeller tables,
+#: current file), which ``mission.toml`` names relative to itself (:mod:`auvplan.mission.carry`).
+INPUTS_FOLDER: Final = "inputs"
 #: The sub-folder of the exports (``plan --export``, ``auvplan export``).
 EXPORT_FOLDER: Final = "export"
 #: The navigation evaluation (``auvplan evaluate``, ``sweep --evaluate``).
@@ -67,6 +70,7 @@ MAIN_PLAN: Final = "terrain_aware"
 __all__ = [
     "DESIRED_FILE",
     "EXPORT_FOLDER",
+    "INPUTS_FOLDER",
     "MAIN_PLAN",
     "MAPS_FILE",
     "MISSION_FILE",

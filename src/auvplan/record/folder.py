@@ -1,8 +1,9 @@
 """The output folder as one record in memory: :class:`PlanRecord`, its one writer and reader.
 
 :func:`write_record` writes every data file of a run (``summary.json``, ``mission.toml``,
-``maps.nc``, ``paths.geojson``, ``desired.csv``, each plan's ``trajectories*.csv``/``.nc``);
-:func:`read_record` reads a folder back into the same :class:`PlanRecord`. The CLI,
+``maps.nc``, ``paths.geojson``, ``desired.csv``, each plan's ``trajectories*.csv``/``.nc``,
+the input files ``mission.toml`` names in ``inputs/``, so the folder reruns wherever it is
+copied); :func:`read_record` reads a folder back into the same :class:`PlanRecord`. The CLI,
 :func:`auvplan.load`, the exports, ``auvplan evaluate``, the sweep and the report all work on a
 record, so a plan made in memory and the same plan read back from its folder answer alike.
 
@@ -46,7 +47,11 @@ from auvplan.record.files import (
     SUMMARY_FILE,
 )
 from auvplan.record.summary import PlanSummary, parse_summary
-from auvplan.record.trajectories import VehicleTrajectory, read_trajectory_tables
+from auvplan.record.trajectories import (
+    VehicleTrajectory,
+    depth_profiles,
+    read_trajectory_tables,
+)
 from auvplan.terrain import TerrainMaps
 
 
@@ -66,6 +71,9 @@ class RunLayers:
         The deconflicted time grid [s] (``desired.csv``; ``None`` before stage 2).
     desired_poses : tuple of ndarray of shape (n_t, 3)
         Each vehicle's desired ``north, east`` [m], ``psi`` [rad].
+    inputs : dict of str to bytes
+        The input files the folder carries: path relative to the folder (POSIX, under
+        :data:`~auvplan.record.files.INPUTS_FOLDER`) -> content; ``mission.toml`` names them.
     """
 
     mission_header: str
@@ -73,6 +81,7 @@ class RunLayers:
     path_properties: tuple[dict[str, Any], ...]
     desired_time: FloatArray | None = None
     desired_poses: tuple[FloatArray, ...] = ()
+    inputs: Mapping[str, bytes] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -137,6 +146,7 @@ def trajectories_csv_text(tables: tuple[VehicleTrajectory, ...]) -> str:
         [table.power for table in tables],
         state_names=[table.state_names for table in tables],
         input_names=[table.input_names for table in tables],
+        profiles=depth_profiles(tables),
     )
     return buffer.getvalue()
 
@@ -180,7 +190,8 @@ def write_record(record: PlanRecord, directory: Path) -> list[Path]:
 
     ``summary.json``, ``mission.toml``, ``maps.nc``, ``paths.geojson``; after
     deconfliction ``desired.csv``; per optimised plan its ``.csv`` and ``.nc`` trajectories
-    (:data:`~auvplan.record.files.PLAN_FILES`).
+    (:data:`~auvplan.record.files.PLAN_FILES`); the carried input files
+    (:attr:`RunLayers.inputs`).
 
     Raises
     ------
@@ -209,6 +220,11 @@ def write_record(record: PlanRecord, directory: Path) -> list[Path]:
         with writing(netcdf_path):
             trajectories_dataset_of(record, label).to_netcdf(netcdf_path)
         written += [csv_path, netcdf_path]
+    for name, content in layers.inputs.items():
+        written.append(directory / name)
+        written[-1].parent.mkdir(parents=True, exist_ok=True)
+        with writing(written[-1]):
+            written[-1].write_bytes(content)
     return written
 
 

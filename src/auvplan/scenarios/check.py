@@ -40,7 +40,7 @@ from auvplan.errors import DataFormatError, InputError
 from auvplan.io.currents import read_current
 from auvplan.io.results import read_trajectories_csv
 from auvplan.ocean import CurrentField, UniformCurrent
-from auvplan.record.files import MAIN_PLAN, MAPS_FILE, PLAN_FILES, SUMMARY_FILE
+from auvplan.record.files import MAIN_PLAN, MAPS_FILE, MISSION_FILE, PLAN_FILES, SUMMARY_FILE
 from auvplan.record.labels import Pair
 from auvplan.scenarios._model import ReferenceModel, step_defects
 from auvplan.scenarios._vehicle_file import read_reference_model
@@ -144,7 +144,8 @@ def check(
     output_dir : Path or str
         Folder written by ``auvplan plan`` (``summary.json``, ``trajectories.csv``).
     mission : Path or str, optional
-        The mission file; default: the one recorded in ``summary.json``.
+        The mission file; default: the folder's own ``mission.toml`` (whose files are the
+        folder's, :mod:`auvplan.mission.carry`).
     refinement : int
         Interpolation points per plan step for the constraint checks.
     defect_tolerance_m, arrival_tolerance_m : float
@@ -165,13 +166,17 @@ def check(
     summary = json.loads((output_dir / SUMMARY_FILE).read_text(encoding="utf-8"))
     if "optimization" not in summary:
         raise DataFormatError(f"{output_dir}/summary.json has no optimisation result")
-    mission_path = Path(mission) if mission is not None else _recorded_mission(summary)
+    mission_path = Path(mission) if mission is not None else output_dir / MISSION_FILE
+    if not mission_path.is_file():
+        raise InputError(f"mission file {mission_path} not found; pass it")
     document = tomllib.loads(mission_path.read_text(encoding="utf-8"))
     vehicles = {vehicle["name"]: vehicle for vehicle in summary["vehicles"]}
     order = summary["solver"].get("propeller_order")
     models = {
         name: read_reference_model(
-            vehicle["type"], propeller_order=order, base_dirs=(mission_path.parent, Path())
+            vehicle["type"],
+            propeller_order=order,
+            base_dirs=(mission_path.parent, output_dir, Path()),
         )
         for name, vehicle in vehicles.items()
     }
@@ -302,13 +307,6 @@ def _limit_fractions(model: ReferenceModel, states: FloatArray) -> dict[str, flo
         state: float(np.max(np.abs(states[:, model.state_names.index(state)])) / limit)
         for state, limit in model.limits.items()
     }
-
-
-def _recorded_mission(summary: Mapping[str, Any]) -> Path:
-    recorded = summary.get("mission")
-    if not recorded or not Path(recorded).is_file():
-        raise InputError(f"mission file {recorded!r} recorded in summary.json not found; pass it")
-    return Path(recorded)
 
 
 def _pair_distances(fine: Mapping[str, FloatArray], names: list[str]) -> dict[str, FloatArray]:
