@@ -7,8 +7,9 @@ from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
+import pytest
 
-from auvplan.mission.checks import ARRIVAL_TOLERANCE, PlanStatus, judge_plan
+from auvplan.mission.checks import ARRIVAL_TOLERANCE, BatteryUse, PlanStatus, judge_plan
 from auvplan.mission.config import parse_mission
 from auvplan.record.labels import Pair
 
@@ -102,3 +103,25 @@ def test_not_converged_wins_over_violations_and_names_them() -> None:
     assert verdict.status is PlanStatus.NOT_CONVERGED
     assert "MAX_ITER" in verdict.message
     assert "separation" in verdict.message
+
+
+def test_only_vehicles_of_known_capacity_are_checked_against_their_reserve() -> None:
+    """None is never flagged; a capacity C when E > C (1 − f), f = reserve_fraction = 0.2."""
+    config = parse_mission(tomllib.loads(MISSION))
+    used = np.stack([1e9 * TIME, 10.0 * TIME])  # J drawn so far: b draws 10 W
+
+    def judge(capacity: tuple[float | None, ...]) -> Any:
+        return judge_plan(
+            config, ("a", "b"), _result(), TIME, _distances(), np.zeros(2),
+            battery=BatteryUse(TIME, used, capacity),
+        )  # fmt: skip
+
+    assert judge((None, 1250.0)).success  # b uses exactly C (1 - f) = 1000 J
+    verdict = judge((None, 750.0))  # b may use 600 J, drawn after 60 s at 10 W
+    assert verdict.status is PlanStatus.CONSTRAINT_VIOLATED
+    (violation,) = verdict.violations
+    assert (violation.kind, violation.who, violation.unit) == ("battery reserve", "b", "J")
+    assert (violation.value, violation.limit) == (1000.0, 600.0)
+    assert violation.time == TIME[np.argmax(used[1] > 600.0)] == pytest.approx(60.1)
+    assert "b needs 1000.0 J, 400.0 J (0.11 Wh) more than the 600.0 J" in verdict.message
+    assert "mission.reserve_fraction 0.2" in verdict.message

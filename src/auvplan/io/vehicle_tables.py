@@ -32,6 +32,7 @@ from auvplan.vehicle.params import (
     DEFAULT_EPS_SIGN_N,
     CurrentModel,
 )
+from auvplan.vehicle.vertical import DEFAULT_MIN_ALTITUDE, DEFAULT_VERTICAL_RATE
 
 #: Canonical unit -> accepted spellings and the factor to the canonical unit.
 UNITS: Final[dict[str, dict[str, float]]] = {
@@ -50,6 +51,7 @@ UNITS: Final[dict[str, dict[str, float]]] = {
     "V": {"V": 1.0},
     "A": {"A": 1.0},
     "W": {"W": 1.0},
+    "J": {"J": 1.0, "kJ": 1e3, "MJ": 1e6, "Wh": 3600.0, "kWh": 3.6e6},
     "m/s": {"m/s": 1.0},
     "rad/s": {"rad/s": 1.0, "deg/s": math.pi / 180.0},
     "rad": {"rad": 1.0, "deg": math.pi / 180.0},
@@ -271,9 +273,36 @@ class ControlSurfaceTable(VehicleTable):
 
 
 class PowerTable(VehicleTable):
-    """The power drawn besides propulsion."""
+    """The power drawn besides propulsion, and the battery that supplies all of it.
+
+    ``battery_capacity`` is the energy of a full battery (a vehicle of 0.1 kg carries more than
+    1 J; a submarine's battery a few 10¹¹ J). Absent, the capacity is unknown and no plan is
+    checked against it: the packaged types give none, since no published figure was found
+    for either (``reference/vehicle.md`` and ``reference/navigation-fleets-formats.md`` give
+    only MEDUSA's assumed 24 V bus and no REMUS 100 battery).
+    """
 
     hotel: float = _quantity("W", 0.0, 1e7, "hotel load (computers, sensors, radios)")
+    battery_capacity: float | None = _quantity(
+        "J", 1.0, 1e13, "energy of a full battery (absent: unknown, no reserve check)", None
+    )
+
+
+class VerticalTable(VehicleTable):
+    """The depth profile's limits (:class:`auvplan.vehicle.DepthLimits`); absent: its defaults.
+
+    Rates must be > 0: a vehicle that cannot change depth flies ``[mission] depth_m``.
+    """
+
+    climb_rate: float = _quantity(
+        "m/s", 1e-3, 20.0, "largest rate of ascent", DEFAULT_VERTICAL_RATE
+    )
+    dive_rate: float = _quantity(
+        "m/s", 1e-3, 20.0, "largest rate of descent", DEFAULT_VERTICAL_RATE
+    )
+    min_altitude: float = _quantity(
+        "m", 0.0, 1e3, "smallest height above the seabed (hard bound)", DEFAULT_MIN_ALTITUDE
+    )
 
 
 class SmoothingTable(VehicleTable):
@@ -302,6 +331,9 @@ class VehicleFile(VehicleTable):
     hull: HullTable
     power: PowerTable
     smoothing: SmoothingTable = Field(default_factory=SmoothingTable)
+    vertical: VerticalTable = Field(
+        default_factory=VerticalTable, description="climb/dive rates and minimum altitude"
+    )
     propulsion: PropulsionTable | None = Field(None, description="twin-thruster shorthand")
     propeller: PropellerTable | None = Field(None, description="twin-thruster shorthand")
     motor: MotorTable | None = Field(None, description="twin-thruster shorthand")

@@ -13,8 +13,9 @@ a TOML file. Its actuators are given either by the twin-thruster shorthand (MEDU
                   diameter, c_T, c_Q, order (optional integer)
     [motor]       R_a, K_e, V_bus, I_0 (optional), current_model (optional),
                   [motor.current_curve] n, current (optional)
-    [power]       hotel
+    [power]       hotel, battery_capacity (optional; absent: unknown)
     [smoothing]   inflow, abs_speed, abs_rate, sign_n (all optional)
+    [vertical]    climb_rate, dive_rate, min_altitude (all optional; the depth profile's limits)
 
 or by a list of actuators (any layout; :mod:`auvplan.vehicle.actuators`)::
 
@@ -69,6 +70,7 @@ from auvplan.vehicle.params import (
     Propeller,
     VehicleParams,
 )
+from auvplan.vehicle.vertical import DepthLimits
 
 #: Validation errors of a value outside its range or set (InputError); the others are
 #: errors of the file's layout (DataFormatError).
@@ -161,6 +163,8 @@ def _vehicle(tables: VehicleFile, base_dir: Path | None) -> VehicleParams | Actu
             crossflow=None if crossflow is None else CrossFlowParams(**crossflow.model_dump()),
         ),
         "hotel_power": tables.power.hotel,
+        "battery_capacity": tables.power.battery_capacity,
+        "depth_limits": DepthLimits(**tables.vertical.model_dump()),
         **{f"eps_{key}": value for key, value in tables.smoothing.model_dump().items()},
         "description": tables.description,
     }

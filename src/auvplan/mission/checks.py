@@ -3,10 +3,13 @@
 The optimiser imposes its constraints at the solver nodes; here they are checked on the plan
 flown with its tracking regulator on a grid ``CHECK_REFINEMENT`` times finer
 (:mod:`auvplan.mission.evaluation`): separation ``>= 2 r_c`` between vehicles, clearance
-``>= r_c`` from every obstacle's edge, communication ranges, arrival within
-``ARRIVAL_TOLERANCE`` of the goal and, with an explicit ``navigation.max_error_m``, the
-predicted TAN error along the flown track within the budget after ``settle_s`` (with
-``NAVIGATION_TOLERANCE`` for the pre-planner's quantisation of the error and the tracking).
+``>= r_c`` from every obstacle's edge (and inside the operating area, from its boundary),
+communication ranges, arrival within ``ARRIVAL_TOLERANCE`` of the goal and, with an
+explicit ``navigation.max_error_m``, the predicted TAN error along the flown track within
+the budget after ``settle_s`` (with ``NAVIGATION_TOLERANCE`` for the pre-planner's
+quantisation of the error and the tracking), and, for a vehicle whose battery capacity
+``C`` is known, the plan's energy ``E = ∫ P dt ≤ C (1 − f)`` with
+``f`` = ``mission.reserve_fraction``.
 Each violation names the vehicles or obstacle, the worst value and when, and a change to the
 mission that would help.
 """
@@ -20,7 +23,7 @@ from typing import Final
 import numpy as np
 
 from auvplan._typing import FloatArray
-from auvplan.mission.config import MissionConfig
+from auvplan.mission.config import AREA_NAME, MissionConfig
 from auvplan.mission.navigation import NavigationChoice, budget_of, smallest_budget
 from auvplan.navigation.prediction import ErrorPrediction
 from auvplan.optimization import ProntoResult
@@ -46,9 +49,18 @@ class PlanStatus(enum.Enum):
     """The optimiser stopped early; the best plan found is reported."""
 
 
+#: Joules in a watt-hour [J/Wh].
+JOULES_PER_WH: Final = 3600.0
+
+
 @dataclass(frozen=True)
 class Violation:
-    """One constraint that does not hold: ``kind`` of constraint, who, worst value, when."""
+    """One constraint that does not hold: ``kind`` of constraint, who, worst value, when.
+
+    ``value`` and ``limit`` are in ``unit``: metres for distances, joules for the energy of
+    a ``"battery reserve"`` violation (``value`` the plan's energy, ``limit`` the usable
+    energy ``C (1 − f)``, ``time`` when the plan has used it up).
+    """
 
     kind: str
     who: str
@@ -56,9 +68,17 @@ class Violation:
     limit: float
     time: float
     advice: str
+    unit: str = "m"
 
     def describe(self) -> str:
         """One line for the user."""
+        if self.unit == "J":
+            deficit = self.value - self.limit
+            return (
+                f"{self.kind}: {self.who} needs {self.value:.1f} J, {deficit:.1f} J "
+                f"({deficit / JOULES_PER_WH:.2f} Wh) more than the {self.limit:.1f} J it may "
+                f"use (used up at t = {self.time:.0f} s); {self.advice}"
+            )
         relation = ">" if self.kind in ("communication", "navigation error") else "<"
         return (
             f"{self.kind}: {self.who} at {self.value:.2f} m {relation} {self.limit:g} m "
@@ -80,7 +100,25 @@ class PlanVerdict:
         return self.status is PlanStatus.CONVERGED
 
 
+@dataclass(frozen=True)
+class BatteryUse:
+    """The energy each vehicle has drawn from its battery over a plan, and the capacities.
+
+    ``used[i, k]`` = ``∫₀^{time[k]} P_i dt`` [J] on the solver grid ``time`` ``(n_t,)`` [s]
+    (its last column is the plan's energy); ``capacity[i]`` [J], None when unknown.
+    """
+
+    time: FloatArray
+    used: FloatArray
+    capacity: tuple[float | None, ...]
+
+
 _TIMING_ADVICE: Final = "try a longer fleet.horizon_s or a smaller solver.dt_s"
+#: The optimiser keeps inside the operating area by tracking routes planned inside it.
+_AREA_ADVICE: Final = (
+    "the plan leaves the area or comes within r_c of its boundary: raise weights.terrain "
+    "(the plan tracks routes planned inside the area) or widen the area"
+)
 
 
 def _worst(distance: FloatArray, time: FloatArray, *, largest: bool) -> tuple[float, float]:
@@ -97,6 +135,7 @@ def judge_plan(
     arrival_error: FloatArray,
     predicted: tuple[ErrorPrediction, ...] = (),
     routes: tuple[NavigationChoice, ...] | None = None,
+    battery: BatteryUse | None = None,
 ) -> PlanVerdict:
     """Check a plan's constraints on the fine replay and give its verdict.
 
@@ -104,17 +143,21 @@ def judge_plan(
     and an obstacle);
     ``arrival_error`` ``(n_vehicles,)`` [m]; ``predicted`` the predicted TAN error of each
     vehicle along its replayed track, ``routes`` how each route was chosen (the smallest
-    feasible budget, when the mission's cannot be met).
+    feasible budget, when the mission's cannot be met); ``battery`` the energy each vehicle
+    has used over time and its capacity (None: no battery check).
     """
     radius = config.fleet.safety_radius
-    obstacles = set(config.obstacle_names)
     violations: list[Violation] = []
     for pair, distance in fine_distances.items():
-        limit = radius if pair.second in obstacles else 2.0 * radius
+        obstacle = pair.second not in names  # else two vehicles
+        limit = radius if obstacle else 2.0 * radius
         value, when = _worst(distance, fine_time, largest=False)
         if value < limit - DISTANCE_TOLERANCE:
-            kind = "obstacle clearance" if pair.second in obstacles else "separation"
-            violations.append(Violation(kind, str(pair), value, limit, when, _TIMING_ADVICE))
+            kind = "obstacle clearance" if obstacle else "separation"
+            advice = _TIMING_ADVICE
+            if pair.second == AREA_NAME:  # its distance is negative outside the area
+                kind, advice = AREA_NAME, _AREA_ADVICE
+            violations.append(Violation(kind, str(pair), value, limit, when, advice))
     for comm in config.comms:
         pair = Pair.of_vehicles(names, *comm.pair)
         value, when = _worst(fine_distances[pair], fine_time, largest=True)
@@ -139,6 +182,8 @@ def judge_plan(
     budget = budget_of(config)
     if budget is not None:
         violations += _navigation_violations(config, names, budget, predicted, routes)
+    if battery is not None:
+        violations += _battery_violations(config, names, battery)
     if not result.success:
         status = PlanStatus.NOT_CONVERGED
         message = (
@@ -152,6 +197,32 @@ def judge_plan(
     else:
         status, message = PlanStatus.CONVERGED, "every constraint holds between samples"
     return PlanVerdict(status, tuple(violations), message)
+
+
+def _battery_violations(
+    config: MissionConfig, names: tuple[str, ...], battery: BatteryUse
+) -> list[Violation]:
+    """Vehicles whose energy exceeds ``C (1 − f)``, ``f`` = ``mission.reserve_fraction``."""
+    reserve = config.mission.reserve_fraction
+    violations = []
+    for i, capacity in enumerate(battery.capacity):
+        if capacity is None:
+            continue
+        usable = capacity * (1.0 - reserve)
+        used = battery.used[i]
+        if used[-1] <= usable:
+            continue
+        when = float(battery.time[int(np.argmax(used > usable))])
+        advice = (
+            f"that is battery_capacity {capacity:.1f} J x (1 - mission.reserve_fraction "
+            f"{reserve:g}); to fit, fly nearer the energy-optimal cruise speed (auvplan vehicle "
+            f"{config.vehicles[i].type}) by changing fleet.horizon_s, lower "
+            "mission.reserve_fraction or give the vehicle a larger [power] battery_capacity"
+        )
+        violations.append(
+            Violation("battery reserve", names[i], float(used[-1]), usable, when, advice, "J")
+        )
+    return violations
 
 
 def _navigation_violations(

@@ -11,12 +11,14 @@ from dataclasses import dataclass
 from typing import Final
 
 import numpy as np
+from scipy.integrate import cumulative_trapezoid
 from scipy.interpolate import RegularGridInterpolator
 
 from auvplan._typing import FloatArray
-from auvplan.mission.checks import PlanVerdict, judge_plan
+from auvplan.mission.checks import BatteryUse, PlanVerdict, judge_plan
 from auvplan.mission.config import MissionConfig
 from auvplan.mission.costs import CostBreakdown, constraint_slack, cost_breakdown
+from auvplan.mission.depth_profile import DepthProfile, fleet_depth_profiles
 from auvplan.mission.fleet import FleetProblemFunctions
 from auvplan.mission.navigation import predict_tracks
 from auvplan.mission.preplan import PreplanStage
@@ -48,7 +50,9 @@ class OptimizedPlan:
     ``fine_time``;
     ``tracking_error`` ``(n_vehicles,)`` is that replay's largest distance [m] from the plan at
     the solver nodes. ``predicted_navigation`` is the predicted TAN error along each replayed
-    track (:func:`auvplan.mission.navigation.predict_tracks`). ``verdict`` says whether every
+    track (:func:`auvplan.mission.navigation.predict_tracks`), flown at each vehicle's depth
+    profile ``depth_profiles`` for ``[mission] altitude_m`` (``None``: the constant
+    ``depth_m``; :mod:`auvplan.mission.depth_profile`). ``verdict`` says whether every
     constraint holds between samples (:func:`auvplan.mission.checks.judge_plan`). ``costs`` is
     the objective by named term and ``constraint_slack[block][pair]`` the smallest value of
     each constraint row at the solver nodes (:mod:`auvplan.mission.costs`).
@@ -67,6 +71,7 @@ class OptimizedPlan:
     fine_distances: dict[Pair, FloatArray]
     tracking_error: FloatArray
     predicted_navigation: tuple[ErrorPrediction, ...]
+    depth_profiles: tuple[DepthProfile, ...] | None
     verdict: PlanVerdict
     costs: CostBreakdown
     constraint_slack: dict[str, dict[str, float]]
@@ -95,7 +100,8 @@ def evaluate_plan(
     held = np.vstack([flat_inputs, flat_inputs[-1:]])
     power_map = functions.power.map(time.size, "serial")
     power = np.asarray(power_map(flat_states.T, held.T)).reshape(layout.n_vehicles, time.size)
-    energy = np.asarray(np.trapezoid(power, time, axis=1), dtype=np.float64)
+    used = np.asarray(cumulative_trapezoid(power, time, axis=1, initial=0.0), dtype=np.float64)
+    energy = np.ascontiguousarray(used[:, -1])
     planned = np.stack([positions(model, states[i]) for i, model in enumerate(models)])
     arrival = np.hypot(*(planned[:, -1] - preplan.goals[:, :2]).T)
     information = information_along(preplan.maps, planned)
@@ -116,10 +122,17 @@ def evaluate_plan(
     fine_time = dt / CHECK_REFINEMENT * np.arange(fine.shape[1], dtype=np.float64)
     tracking_error = np.max(np.linalg.norm(fine[:, ::CHECK_REFINEMENT] - planned, axis=-1), axis=1)
     fine_distances, separations = pairwise_distances(preplan, fine)
+    profiles = fleet_depth_profiles(
+        config.mission.altitude, preplan.bathymetry, time, planned,
+        tuple(model.vehicle.depth_limits for model in models),
+    )  # fmt: skip
     predicted = predict_tracks(
         config.navigation, preplan.bathymetry, fine_time, fine,
         np.stack([headings(model, flown[i]) for i, model in enumerate(models)]),
         vehicle_depth=config.mission.depth,
+        depths=None if profiles is None else tuple(
+            np.interp(fine_time, time, profile.depth) for profile in profiles
+        ),
     )  # fmt: skip
     return OptimizedPlan(
         result=result,
@@ -135,6 +148,7 @@ def evaluate_plan(
         fine_distances=fine_distances,
         tracking_error=tracking_error,
         predicted_navigation=predicted,
+        depth_profiles=profiles,
         costs=cost_breakdown(problem, functions, result.trajectory),
         constraint_slack=constraint_slack(problem, functions, result.trajectory),
         verdict=judge_plan(
@@ -146,6 +160,7 @@ def evaluate_plan(
             arrival,
             predicted,
             preplan.navigation,
+            BatteryUse(time, used, tuple(model.vehicle.battery_capacity for model in models)),
         ),
     )
 

@@ -12,7 +12,14 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Final, Literal
 
-from pydantic import Field, Strict, field_validator, model_validator
+from pydantic import (
+    Field,
+    SerializerFunctionWrapHandler,
+    Strict,
+    field_validator,
+    model_serializer,
+    model_validator,
+)
 
 from auvplan.errors import InputError
 from auvplan.io.samples import SampleName, sample_path
@@ -214,8 +221,23 @@ class VehicleConfig(TableModel):
         return self
 
 
+#: A polygon vertex: ``[north, east]`` [m], or a table ``{ lat = .., lon = .. }`` [deg]
+#: (``{ north = .., east = .. }`` too); every vertex of a polygon in the same frame.
+Vertex = tuple[Number, Number] | Position
+
+#: Description of the ``file`` key of ``[[obstacle]]`` and ``[area]``.
+_GIS_FILE: Final = (
+    "GIS file of polygons (holes kept), relative to the mission: GeoJSON, or with the gis "
+    "extra a Shapefile, GeoPackage or KML (any CRS)"
+)
+
+
 class ObstacleConfig(TableModel):
-    """A circular (``center``, ``radius_m``) or polygonal (``polygon`` [[n, e], ...]) obstacle."""
+    """A no-go zone: a circle (``center``, ``radius_m``), a ``polygon`` or a GIS ``file``.
+
+    A ``file``'s every polygon and multipolygon part is a zone of its own, labelled
+    ``"<name> feature K"`` (``K`` the feature's index in the file, ``K.P`` for part ``P``).
+    """
 
     name: Text | None = Field(None, min_length=1, max_length=40, description="label (unique)")
     center: Position | None = None
@@ -227,8 +249,12 @@ class ObstacleConfig(TableModel):
         description="radius of a circle",
         json_schema_extra=_unit("m"),
     )
-    polygon: tuple[tuple[Number, Number], ...] | None = Field(
-        None, description="vertices [north, east]", json_schema_extra=_unit("m")
+    polygon: tuple[Vertex, ...] | None = Field(
+        None, description="vertices [north, east] (m) or { lat, lon } (deg)"
+    )
+    file: Path | None = Field(None, description=_GIS_FILE)
+    layer: Text | None = Field(
+        None, min_length=1, description="layer of a multi-layer GIS file (default: the first)"
     )
 
     @property
@@ -242,21 +268,74 @@ class ObstacleConfig(TableModel):
     def _shape(self) -> ObstacleConfig:
         if self.name is not None:
             _check_name(self.name)
+        circle = self.center is not None or self.radius is not None
+        if [circle, self.polygon is not None, self.file is not None].count(True) > 1:
+            raise ValueError("give center and radius_m, a polygon or a file (one of them)")
+        _check_layer(self.file, self.layer)
         if self.polygon is not None:
-            if self.center is not None or self.radius is not None:
-                raise ValueError("give center and radius_m, or polygon, not both")
             _check_polygon(self.polygon)
-        elif self.center is None or self.radius is None:
-            raise ValueError("a circle needs center and radius_m (or give a polygon)")
+        elif self.file is None and (self.center is None or self.radius is None):
+            raise ValueError("a circle needs center and radius_m (or give a polygon or a file)")
         return self
 
 
-def _check_polygon(vertices: tuple[tuple[float, float], ...]) -> None:
+class AreaConfig(TableModel):
+    """The operating area: every vehicle stays inside it, ``r_c`` from its boundary.
+
+    A ``polygon`` or a GIS ``file`` holding one polygon (its holes are islands: no-go).
+    """
+
+    polygon: tuple[Vertex, ...] | None = Field(
+        None, description="vertices [north, east] (m) or { lat, lon } (deg)"
+    )
+    file: Path | None = Field(None, description=_GIS_FILE)
+    layer: Text | None = Field(
+        None, min_length=1, description="layer of a multi-layer GIS file (default: the first)"
+    )
+
+    @model_validator(mode="after")
+    def _one_source(self) -> AreaConfig:
+        if (self.polygon is None) == (self.file is None):
+            raise ValueError("give a polygon or a file (one of them)")
+        _check_layer(self.file, self.layer)
+        if self.polygon is not None:
+            _check_polygon(self.polygon)
+        return self
+
+
+def _check_layer(file: Path | None, layer: str | None) -> None:
+    if layer is not None and file is None:
+        raise ValueError("layer needs a file")
+
+
+def polygon_frame(vertices: tuple[Vertex, ...]) -> tuple[bool, tuple[tuple[float, float], ...]]:
+    """Whether ``vertices`` are geographic, and their ``(north, east)`` or ``(lat, lon)``.
+
+    Raises ValueError when the vertices mix the local and the geographic frame.
+    """
+    pairs = [
+        (False, vertex) if isinstance(vertex, tuple) else (vertex.is_geographic, vertex.coordinates)
+        for vertex in vertices
+    ]
+    frames = {geographic for geographic, _ in pairs}
+    if len(frames) > 1:
+        raise ValueError("give every vertex as [north, east] or every one as { lat, lon }")
+    return frames == {True}, tuple(pair for _, pair in pairs)
+
+
+def _check_polygon(vertices: tuple[Vertex, ...]) -> None:
+    if len(vertices) < 3:
+        raise ValueError(f"polygon needs at least 3 vertices, got {len(vertices)}")
+    geographic, pairs = polygon_frame(vertices)
+    if not geographic:  # lat/lon polygons are checked in the map frame (mission.zones)
+        check_simple_polygon(pairs)
+
+
+def check_simple_polygon(vertices: tuple[tuple[float, float], ...]) -> None:
+    """Raise ValueError unless ``[north, east]`` ``vertices`` [m] bound a simple polygon."""
     from shapely import Polygon
     from shapely.validation import explain_validity
 
-    if len(vertices) < 3:
-        raise ValueError(f"polygon needs at least 3 [north, east] vertices, got {len(vertices)}")
     shape = Polygon([(east, north) for north, east in vertices])
     if not shape.is_valid or shape.area <= 0.0:
         reason = explain_validity(shape) if not shape.is_valid else "zero area"
@@ -521,7 +600,15 @@ class ExecutionConfig(TableModel):
 
     ``start_time`` is an ISO 8601 date and time with its time zone (a TOML offset date-time
     or a string such as ``"2026-05-01T08:00:00Z"``), kept in UTC; the plan's time ``t`` [s] is
-    flown at ``start_time + t``. ``depth_m`` is the constant depth of the planar plan.
+    flown at ``start_time + t``. ``depth_m`` is the constant depth of the planar plan;
+    ``altitude_m`` instead asks for a constant height above the seabed, flown within each
+    vehicle type's climb and dive rates and minimum altitude (``[vertical]`` of its file;
+    :mod:`auvplan.mission.depth_profile`); the horizontal plan stays planar (3-DOF).
+    ``reserve_fraction`` ``f`` is the share of each battery a plan must leave unused: a
+    vehicle whose file gives ``battery_capacity`` ``C`` may use ``E = ∫ P dt ≤ C (1 − f)``
+    (:mod:`auvplan.mission.checks`). The default 0.2 keeps a fifth for what the plan does
+    not model (battery ageing and cold, currents stronger than planned, a recovery
+    transit); vehicles of unknown capacity are not checked.
     """
 
     start_time: datetime = Field(
@@ -532,6 +619,32 @@ class ExecutionConfig(TableModel):
         0.0, alias="depth_m", ge=0.0, le=11_000.0, description="constant depth of the plan",
         json_schema_extra=_unit("m"),
     )  # fmt: skip
+    reserve_fraction: Number = Field(
+        0.2, ge=0.0, lt=1.0,
+        description="share of each battery_capacity a plan must leave unused",
+    )  # fmt: skip
+    altitude: Number | None = Field(
+        None, alias="altitude_m", gt=0.0, le=11_000.0,
+        description="height above the seabed to follow instead of depth_m (terrain following)",
+        json_schema_extra=_unit("m"),
+    )  # fmt: skip
+
+    @model_validator(mode="after")
+    def _one_vertical_mode(self) -> ExecutionConfig:
+        if self.altitude is not None and "depth" in self.model_fields_set:
+            raise ValueError(
+                "give depth_m (constant depth) or altitude_m (above the seabed), not both"
+            )
+        return self
+
+    @model_serializer(mode="wrap")
+    def _without_unused_depth(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """With ``altitude_m`` the document has no ``depth_m`` (they are mutually exclusive)."""
+        document: dict[str, Any] = handler(self)
+        if self.altitude is not None:
+            document.pop("depth_m", None)
+            document.pop("depth", None)
+        return document
 
     @field_validator("start_time", mode="before")
     @classmethod
@@ -557,3 +670,59 @@ class ExecutionConfig(TableModel):
         if not START_YEARS[0] <= value.year <= START_YEARS[1]:
             raise ValueError(f"year {value.year} is outside {START_YEARS[0]}-{START_YEARS[1]}")
         return value.astimezone(UTC)
+
+
+#: A line of metadata: printable text on one line.
+MetadataText = Annotated[str, Strict(), Field(min_length=1, max_length=500, pattern=r"^[^\n\r]*$")]
+#: The kinds of creator and publisher ACDD-1.3 names.
+PartyType = Literal["person", "group", "institution", "position"]
+
+
+class MetadataConfig(TableModel):
+    """Who made the plan, for the discovery attributes of ``trajectories.nc`` (ACDD-1.3).
+
+    Each key given becomes the global attribute of the same name (ACDD-1.3 and the NCEI
+    trajectory template v2.0 recommend them); the attributes computed from the plan (extent,
+    times, id, version) need no key. ``publisher_*`` default to ``creator_*`` (the operator
+    publishes their own plan); ``naming_authority`` is the reverse-DNS name of the organisation
+    (``"org.example"``) under which the file's ``id`` (``auvplan-`` and a digest of the
+    positions) is unique; ``license`` is the terms of use of the plan.
+    """
+
+    creator_name: MetadataText | None = Field(None, description="who made the plan")
+    creator_email: MetadataText | None = Field(None, description="the creator's e-mail address")
+    creator_url: MetadataText | None = Field(None, description="the creator's web address")
+    creator_type: PartyType | None = Field(None, description="what the creator is")
+    institution: MetadataText | None = Field(None, description="the creator's institution")
+    project: MetadataText | None = Field(None, description="project the plan is made for")
+    program: MetadataText | None = Field(None, description="programme the project is part of")
+    publisher_name: MetadataText | None = Field(
+        None, description="who distributes the plan (default: creator_name)"
+    )
+    publisher_email: MetadataText | None = Field(
+        None, description="the publisher's e-mail address (default: creator_email)"
+    )
+    publisher_url: MetadataText | None = Field(
+        None, description="the publisher's web address (default: creator_url)"
+    )
+    license: MetadataText | None = Field(None, description="terms of use of the plan")
+    naming_authority: MetadataText | None = Field(
+        None, description="reverse-DNS name of the organisation that issues the file's id"
+    )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _publisher_is_the_creator(cls, data: Any) -> Any:
+        """Each ``publisher_*`` not given is the ``creator_*`` of the same part, if given."""
+        if not isinstance(data, dict):
+            return data
+        defaults = {
+            f"publisher_{part}": data[f"creator_{part}"]
+            for part in ("name", "email", "url")
+            if data.get(f"creator_{part}") is not None
+        }
+        return {**defaults, **{key: value for key, value in data.items() if value is not None}}
+
+    def attributes(self) -> dict[str, str]:
+        """The global attributes: each key given (or defaulted), by its name."""
+        return {key: value for key, value in self.model_dump().items() if value is not None}

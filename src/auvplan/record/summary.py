@@ -77,14 +77,24 @@ class CircleObstacle(_Entry):
 
 
 class PolygonObstacle(_Entry):
-    """A polygonal keep-out zone: its ``vertices``."""
+    """A polygonal keep-out zone: its ``vertices`` and ``holes`` (rings of free water)."""
 
     name: str
     shape: Literal["polygon"]
     vertices: list[Place]
+    holes: list[list[Place]] = []
 
 
-Obstacle = Annotated[CircleObstacle | PolygonObstacle, Field(discriminator="shape")]
+class AreaObstacle(_Entry):
+    """The operating area, kept in: its ``vertices`` and ``holes`` (rings of no-go islands)."""
+
+    name: str
+    shape: Literal["area"]
+    vertices: list[Place]
+    holes: list[list[Place]] = []
+
+
+Obstacle = Annotated[CircleObstacle | PolygonObstacle | AreaObstacle, Field(discriminator="shape")]
 
 
 class FleetSummary(_Entry):
@@ -102,7 +112,7 @@ class VehicleSummary(_Entry):
     After deconfliction also ``type_name`` (the name its vehicle file gives the type), the
     vehicle's own ``state_names`` and ``input_names`` (the columns of its rows in
     ``trajectories.csv``) and its ``top_speed_m_s`` [m/s], with which the reader bounds the
-    rows' speeds and steps.
+    rows' speeds and steps, and its ``battery_capacity_J`` [J] (None: unknown).
     """
 
     name: str
@@ -115,13 +125,20 @@ class VehicleSummary(_Entry):
     state_names: tuple[str, ...] | None = None
     input_names: tuple[str, ...] | None = None
     top_speed_m_s: float | None = Field(default=None, gt=0.0)
+    battery_capacity_J: float | None = Field(default=None, gt=0.0)
 
 
 class VehicleOutcome(_Entry):
-    """A vehicle's figures in a plan record: energy [J], mean terrain information [-]."""
+    """A vehicle's figures in a plan record: energy [J], mean terrain information [-].
+
+    With a known battery capacity ``C``, ``energy_remaining_J`` = ``C − energy_J`` [J] and
+    ``energy_remaining_fraction`` = ``(C − energy_J) / C`` [-] (None: capacity unknown).
+    """
 
     energy_J: float
     mean_terrain_information: float | None
+    energy_remaining_J: float | None = None
+    energy_remaining_fraction: float | None = None
 
 
 class PlanOutcome(_Entry):
@@ -148,9 +165,12 @@ class PlanSummary(_Entry):
 
     ``digest`` maps each data file of the run to the SHA-256 of its content
     (:func:`auvplan.record.files_digest`): the reader refuses files that another run wrote.
+    ``created`` is the UTC time the run made its record (ISO 8601; ``None`` in folders written
+    before it was recorded).
     """
 
     auvplan_version: str
+    created: Annotated[str, AfterValidator(_iso_time)] | None = None
     mission: str | None
     inputs: dict[str, Any]
     start_time: Annotated[str, AfterValidator(_iso_time)]
@@ -182,6 +202,11 @@ class PlanSummary(_Entry):
     def start(self) -> datetime:
         """UTC time of ``t = 0`` of the plan."""
         return datetime.fromisoformat(self.start_time)
+
+    @property
+    def created_at(self) -> datetime | None:
+        """UTC time the run made its record, if recorded."""
+        return None if self.created is None else datetime.fromisoformat(self.created)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -226,6 +251,7 @@ def parse_summary(document: object, *, source: str) -> PlanSummary:
 
 
 __all__ = [
+    "AreaObstacle",
     "CircleObstacle",
     "FleetSummary",
     "Obstacle",

@@ -40,6 +40,7 @@ from auvplan.vehicle.params import (
     VehicleParams,
     check_common_fields,
 )
+from auvplan.vehicle.vertical import DepthLimits
 
 #: Actuator names become parts of state and input names: lowercase letters, digits, ``_``.
 ACTUATOR_NAME: Final = re.compile(r"[a-z][a-z0-9_]*")
@@ -202,6 +203,10 @@ class ActuatedVehicleParams:
     """Smoothing of ``|r| ≈ sqrt(r² + ε²)`` [rad/s]."""
     eps_sign_n: float = DEFAULT_EPS_SIGN_N
     """Smoothing of ``sgn(n)`` and ``|n|`` (motor current, open-water propellers) [rev/s]."""
+    battery_capacity: float | None = None
+    """Energy of a full battery, None when unknown (no reserve check) [J]."""
+    depth_limits: DepthLimits = field(default_factory=DepthLimits)
+    """Climb and dive rates [m/s] and minimum altitude [m] of the depth profile."""
     description: str = ""
     """Free text (origin of the parameter set) [-]."""
     metadata: dict[str, str] = field(default_factory=dict)
@@ -262,6 +267,8 @@ def actuated_vehicle(params: VehicleParams | ActuatedVehicleParams) -> ActuatedV
         eps_abs_speed=params.eps_abs_speed,
         eps_abs_rate=params.eps_abs_rate,
         eps_sign_n=params.eps_sign_n,
+        battery_capacity=params.battery_capacity,
+        depth_limits=params.depth_limits,
         description=params.description,
         metadata=params.metadata,
     )

@@ -24,6 +24,7 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
+from auvplan.vehicle.vertical import DepthLimits
 
 #: Default smoothing speed of the propeller inflow ``V_r = sqrt(v_a² + v_p² + ε_V²)`` [m/s].
 DEFAULT_EPS_INFLOW: Final = 0.02
@@ -373,6 +374,10 @@ class VehicleParams:
     """Smoothing of ``|r| ≈ sqrt(r² + ε²)`` [rad/s]."""
     eps_sign_n: float = DEFAULT_EPS_SIGN_N
     """Smoothing of ``sgn(n) ≈ n / sqrt(n² + ε²)`` in the motor current, and of ``|n|`` [rev/s]."""
+    battery_capacity: float | None = None
+    """Energy of a full battery, None when unknown (no reserve check) [J]."""
+    depth_limits: DepthLimits = field(default_factory=DepthLimits)
+    """Climb and dive rates [m/s] and minimum altitude [m] of the depth profile."""
     description: str = ""
     """Free text (origin of the parameter set) [-]."""
     metadata: dict[str, str] = field(default_factory=dict)
@@ -412,9 +417,13 @@ class CommonVehicleFields(Protocol):
     def eps_sign_n(self) -> float:
         """Smoothing of ``sgn(n)``, ``|n|`` [rev/s]."""
 
+    @property
+    def battery_capacity(self) -> float | None:
+        """Energy of a full battery, None when unknown [J]."""
+
 
 def check_common_fields(params: CommonVehicleFields) -> None:
-    """Validate the name, hotel load and smoothing constants of a vehicle parameter set.
+    """Validate the name, hotel load, battery and smoothing constants of a parameter set.
 
     Raises
     ------
@@ -422,6 +431,8 @@ def check_common_fields(params: CommonVehicleFields) -> None:
         Naming the first offending field.
     """
     _finite("hotel_power", params.hotel_power, nonnegative=True)
+    if params.battery_capacity is not None:
+        _finite("battery_capacity", params.battery_capacity, positive=True)
     for name in ("eps_inflow", "eps_abs_speed", "eps_abs_rate", "eps_sign_n"):
         _finite(name, getattr(params, name), positive=True)
     if not params.name:

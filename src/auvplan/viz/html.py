@@ -3,10 +3,10 @@
 The page is built from the folder's ``summary.json`` document and its rendered figures, which
 are embedded as base64 ``data:`` URIs (PNG or SVG; a PDF figure is shown by its PNG preview),
 so the file can be mailed or archived alone. Every text from the summary is escaped with
-:func:`html.escape`. Sections: status and warnings, vehicles (energy, terrain information,
-arrival error, closest approach, timing), constraint violations, optimiser (status,
-iterations, per-iteration history), energy-only comparison, deconfliction, wall times,
-settings, figures and the folder's files.
+:func:`html.escape`. Sections: status and warnings, vehicles (energy, battery capacity and
+what the plan leaves in it, terrain information, arrival error, closest approach, timing),
+constraint violations, optimiser (status, iterations, per-iteration history), energy-only
+comparison, deconfliction, wall times, settings, figures and the folder's files.
 """
 
 from __future__ import annotations
@@ -141,7 +141,10 @@ def _vehicles(summary: Mapping[str, Any]) -> str:
             (
                 name,
                 vehicle.get("type"),
-                None if "energy_J" not in plan else plan["energy_J"] / 1e3,
+                _kilo(plan.get("energy_J")),
+                _kilo(vehicle.get("battery_capacity_J")),
+                _kilo(plan.get("energy_remaining_J")),
+                _percent(plan.get("energy_remaining_fraction")),
                 plan.get("mean_terrain_information"),
                 plan.get("arrival_error_m"),
                 plan.get("tracking_error_m"),
@@ -153,13 +156,23 @@ def _vehicles(summary: Mapping[str, Any]) -> str:
             )
         )
     headers = (
-        "vehicle", "type", "energy [kJ]", "mean information [-]", "arrival error [m]",
-        "tracking error [m]", "closest approach [m]", "arrival [s]", "delay [s]",
-        "A* cost [-]", "path length [m]",
+        "vehicle", "type", "energy [kJ]", "battery [kJ]", "remaining [kJ]", "remaining [%]",
+        "mean information [-]", "arrival error [m]", "tracking error [m]",
+        "closest approach [m]", "arrival [s]", "delay [s]", "A* cost [-]", "path length [m]",
     )  # fmt: skip
-    formats = (str, str, _fixed(2), _fixed(3), _fixed(2), _fixed(2), str, _fixed(1), _fixed(1),
-               _fixed(1), _fixed(1))  # fmt: skip
+    formats = (str, str, _fixed(2), _fixed(2), _fixed(2), _fixed(1), _fixed(3), _fixed(2),
+               _fixed(2), str, _fixed(1), _fixed(1), _fixed(1), _fixed(1))  # fmt: skip
     return _table(headers, rows, formats)
+
+
+def _kilo(value: float | None) -> float | None:
+    """An energy [J] in kJ (None stays None: shown as n/a)."""
+    return None if value is None else value / 1e3
+
+
+def _percent(value: float | None) -> float | None:
+    """A fraction [-] in % (None stays None)."""
+    return None if value is None else 100.0 * value
 
 
 def _closest(separations: Mapping[str, float | None]) -> str | None:
@@ -185,9 +198,7 @@ def _optimizer(record: Mapping[str, Any] | None, title: str) -> list[str]:
                 "iterations": record.get("n_iter"),
                 "final cost h": record.get("cost"),
                 "terrain weight": record.get("terrain_weight"),
-                "total energy [kJ]": None
-                if record.get("total_energy_J") is None
-                else record["total_energy_J"] / 1e3,
+                "total energy [kJ]": _kilo(record.get("total_energy_J")),
             }
         ),
     ]
@@ -196,10 +207,10 @@ def _optimizer(record: Mapping[str, Any] | None, title: str) -> list[str]:
         parts += [
             "<h3>Constraint violations</h3>",
             _table(
-                ("kind", "who", "value [m]", "limit [m]", "time [s]", "advice"),
-                [tuple(v.get(k) for k in ("kind", "who", "value", "limit", "time", "advice"))
-                 for v in violations],
-                (str, str, _fixed(2), _fixed(2), _fixed(1), str),
+                ("kind", "who", "value", "limit", "unit", "time [s]", "advice"),
+                [(v.get("kind"), v.get("who"), v.get("value"), v.get("limit"),
+                  v.get("unit", "m"), v.get("time"), v.get("advice")) for v in violations],
+                (str, str, _fixed(2), _fixed(2), str, _fixed(1), str),
             ),
         ]  # fmt: skip
     history = record.get("history", [])
