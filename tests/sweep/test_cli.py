@@ -43,6 +43,10 @@ def test_second_invocation_skips_finished_runs(
     second = pd.read_csv(out / "sweep.csv")
     assert len(second) == 3
     pd.testing.assert_frame_equal(second.iloc[[0, 1]].reset_index(drop=True), first)
+    # no file of the sweep names a path outside it (the tables' folders are relative)
+    assert second["folder"].tolist() == [f"runs/{run_id}" for run_id in second["run_id"]]
+    for path in (path for path in out.rglob("*") if path.is_file()):
+        assert str(tmp_path).encode() not in path.read_bytes(), path
 
 
 @pytest.mark.usefixtures("inprocess_cluster")
@@ -157,8 +161,8 @@ def test_scenario_family_seeds_are_missions(
     assert json.loads((out / "sweep.json").read_text())["counts"]["planned"] == 2
     for seed, folder in zip(table["seed"], table["folder"], strict=True):
         mission = out / "scenarios" / f"seed_{seed:04d}" / "mission.toml"
-        summary = json.loads((Path(folder) / "summary.json").read_text())
+        summary = json.loads((out / folder / "summary.json").read_text())
         assert summary["inputs"]["mission"]["path"] == "mission.toml"  # no folder
         assert summary["inputs"]["mission"]["sha256"] == file_sha256(mission)
-    assert len({json.loads((Path(f) / "summary.json").read_text())["terrain"]["name"]
+    assert len({json.loads((out / f / "summary.json").read_text())["terrain"]["name"]
                 for f in table["folder"]}) == 2  # fmt: skip

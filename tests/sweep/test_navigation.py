@@ -37,13 +37,13 @@ def test_sweep_evaluates_every_plan_once_and_draws_the_trade_off(
     assert (table["tan_rmse_m"] > 0.0).all()
     assert (table["tan_pcrb_m"] > 0.0).all()
     for _, row in table.iterrows():
-        document = json.loads((Path(row["folder"]) / "navigation.json").read_text())
+        document = json.loads((out / row["folder"] / "navigation.json").read_text())
         assert document["settings"]["n_runs"] == 3
         assert document["settings"]["seed"] == 5  # the row's seed
         assert document["plans"]["terrain_aware"]["rmse_m"] == pytest.approx(row["tan_rmse_m"])
 
     # the same numbers as `auvplan evaluate` on the run folder with the same settings
-    folder = Path(table.loc[1, "folder"])
+    folder = out / table.loc[1, "folder"]
     copy = tmp_path / "copy"
     copy.mkdir()
     for name in ("maps.nc", "trajectories.csv", "summary.json"):
@@ -85,6 +85,39 @@ def test_sweep_evaluates_every_plan_once_and_draws_the_trade_off(
     assert "update period" in failed.navigation_error
     assert (folder / "trajectories.csv").is_file()
     assert _modified(out, "navigation.json") == changed
+
+
+@pytest.mark.usefixtures("inprocess_cluster")
+def test_seeds_evaluate_one_plan_per_mission(
+    tiny_full_mission: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    out = tmp_path / "sweep"
+    command = ["sweep", str(tiny_full_mission), "-o", str(out), "--vary", "weights.terrain=0,1",
+               "--seeds", "5,6", "--evaluate", *FAST_NAVIGATION]  # fmt: skip
+    assert main(command) == 0
+    assert "4 runs (4 ran, 0 skipped as finished before, 0 failed), 2 planned" in (
+        capsys.readouterr().out
+    )  # was 4 plans: one per mission and seed
+    assert "2 plans, each evaluated with every seed (4 rows)" in caplog.text
+    table = pd.read_csv(out / "sweep.csv")
+    assert table["seed"].tolist() == [5, 6, 5, 6]
+    assert (table["status"] == "CONVERGED").all()
+    for mission in (0, 2):  # the two seeds of a mission: one plan, two evaluations
+        pair = table.iloc[[mission, mission + 1]]
+        assert pair["energy_J"].nunique() == 1
+        assert pair["tan_rmse_m"].nunique() == 2
+        seeds = [
+            json.loads((out / folder / "navigation.json").read_text())["settings"]["seed"]
+            for folder in pair["folder"]
+        ]
+        assert seeds == [5, 6]
+        first, second = (out / folder / "trajectories.csv" for folder in pair["folder"])
+        assert first.samefile(second)
+    plans = [out / folder / "trajectories.csv" for folder in table["folder"]]
+    assert not plans[0].samefile(plans[2])  # each mission its own plan
 
 
 def test_evaluate_needs_the_full_stage(

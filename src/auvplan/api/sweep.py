@@ -6,10 +6,17 @@ dask (:func:`auvplan.sweep.run_sweep`: each into ``DIR/runs/<run-id>/``, runs fi
 earlier sweep skipped, failed runs kept as rows), and writes ``sweep.csv``/``sweep.json``
 (:func:`auvplan.sweep.write_sweep_files`) and, when the runs allow an energy/navigation
 trade-off (:func:`auvplan.sweep.pareto_view`), ``pareto.png`` and the Pareto table.
+
+The seeds multiply the runs only where they change something: with ``"scenarios"`` each seed
+is a mission, and with a navigation evaluation each seed is a row's Monte-Carlo seed (the
+runs of one mission then share its plan, :mod:`auvplan.sweep.runner`). A mission file's plan
+does not depend on the seed, so without an evaluation its missions are planned once each, one
+row each without a seed; a log line says so.
 """
 
 from __future__ import annotations
 
+import logging
 import time
 from collections import Counter
 from collections.abc import Callable, Iterator, Sequence
@@ -28,6 +35,7 @@ from auvplan.sweep import (
     RunOptions,
     RunRecord,
     SweepProgress,
+    SweepRun,
     add_run_columns,
     build_runs,
     json_rows,
@@ -43,6 +51,7 @@ from auvplan.sweep import (
     write_pareto_table,
     write_sweep_files,
 )
+from auvplan.sweep.table import relative_to
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -53,6 +62,8 @@ if TYPE_CHECKING:
 SCENARIOS: Final = "scenarios"
 #: Resolution of ``pareto.png`` [dots per inch].
 PARETO_DPI: Final = 150
+
+logger = logging.getLogger(__name__)
 
 #: Opens the progress display of ``n`` runs and gives its callback (None: no progress).
 SweepDisplay = Callable[[int], AbstractContextManager[Callable[[SweepProgress], None] | None]]
@@ -65,7 +76,9 @@ class SweepOutcome:
     records: tuple[RunRecord, ...]
     """One record per run, in the order of the grid."""
     counts: dict[str, Any]
-    """Runs in all, ``ran``, ``skipped`` (finished before), ``failed``, and runs per status."""
+    """Runs in all, ``ran``, ``skipped`` (finished before), ``failed``, ``planned`` (runs that
+    ran the planner now; the others were finished before or share the plan of a run of the
+    same mission), and runs per status."""
     view: ParetoView | None
     """The energy/navigation trade-off of the runs, if they have one."""
     trade_off: dict[str, dict[str, Any] | None] | None
@@ -88,6 +101,7 @@ def sweep_to_folder(
     vary: Sequence[str] = (),
     seeds: str | None = None,
     stage: str = "full",
+    client: Any = None,
     scheduler: str | None = None,
     workers: int | None = None,
     figures: bool = False,
@@ -107,13 +121,16 @@ def sweep_to_folder(
     vary : sequence of str
         ``KEY=V1,V2,...`` items (:func:`auvplan.sweep.parse_vary`); the grid is their product.
     seeds : str, optional
-        Seeds such as ``"0..49"`` or ``"0,3,7"`` (:func:`auvplan.sweep.parse_seeds`).
+        Seeds such as ``"0..49"`` or ``"0,3,7"`` (:func:`auvplan.sweep.parse_seeds`): the
+        scenarios' seeds, or the Monte-Carlo seeds of ``navigation`` (module notes).
     stage : str
         Last stage of each run: ``"preplan"``, ``"deconflict"`` or ``"full"``.
+    client : distributed.Client, optional
+        A client of a cluster the caller made (left open); or
     scheduler : str, optional
-        Address of a running dask scheduler; default a local cluster.
+        the address of a running dask scheduler; or
     workers : int, optional
-        Worker processes of the local cluster (default: the number of cores).
+        the worker processes of a local cluster (default: the number of cores).
     figures : bool
         Also write each run's figures.
     navigation : NavigationRequest, optional
@@ -132,13 +149,26 @@ def sweep_to_folder(
     ------
     InputError, DataFormatError
         For a run that is not a valid mission, bad seeds or values, a navigation value out of
-        range, or dask missing; nothing is run.
+        range, more than one of ``client``, ``scheduler`` and ``workers``, or dask missing;
+        nothing is run.
+
+    Examples
+    --------
+    >>> from distributed import Client, LocalCluster  # doctest: +SKIP
+    >>> with LocalCluster(n_workers=2) as cluster, Client(cluster) as client:  # doctest: +SKIP
+    ...     outcome = sweep_to_folder("mission.toml", Path("sweep"), client=client,
+    ...                               vary=["weights.terrain=0,1"])
     """
-    options = None if navigation is None else _navigation_options(navigation, scheduler, workers)
+    local = client is None and scheduler is None
+    options = None if navigation is None else _navigation_options(navigation, local, workers)
     require_dask()
     seed_list: tuple[int | None, ...] = (None,) if seeds is None else parse_seeds(seeds)
     base_of, scenario_files = _bases(mission, output, seed_list, data_dir)
-    axes, runs = build_runs(vary, seed_list, base_of, stage=stage)
+    seeds_plan = mission == SCENARIOS or seeds is None
+    grid_seeds = seed_list if seeds_plan or options is not None else (None,)
+    axes, runs = build_runs(vary, grid_seeds, base_of, stage=stage)
+    if not seeds_plan:
+        _log_shared_plans(seeds or "", runs, evaluated=options is not None)
 
     def write_scenarios() -> None:  # only once every run is valid and the cluster answers
         for base, scenario in scenario_files:
@@ -152,23 +182,23 @@ def sweep_to_folder(
     run_options = RunOptions(
         stage=stage,
         write_figures=write_figures,
-        quiet_logs=scheduler is None,
+        quiet_logs=local,
         navigation=options,
     )
     started = time.perf_counter()
     with nullcontext() if progress is None else progress(len(runs)) as callback:
         records = run_sweep(
-            runs, output, options=run_options, scheduler=scheduler, n_workers=workers,
-            progress=callback, on_ready=write_scenarios,
+            runs, output, options=run_options, client=client, scheduler=scheduler,
+            n_workers=workers, progress=callback, on_ready=write_scenarios,
         )  # fmt: skip
     wall_s = time.perf_counter() - started
     keys = [axis.key for axis in axes]
     spec = {
-        "mission": mission if mission == SCENARIOS else str(Path(mission).resolve()),
+        "mission": mission if mission == SCENARIOS else relative_to(mission, output),
         "vary": {axis.key: list(axis.values) for axis in axes},
         "seeds": None if seeds is None else list(seed_list),
         "stage": stage,
-        "scheduler": scheduler,
+        "scheduler": scheduler if client is None else client.scheduler.address,
         "workers": workers,
         "figures": figures,
         "navigation": None if options is None else options.settings_document,
@@ -182,11 +212,11 @@ def sweep_to_folder(
 
 
 def _navigation_options(
-    request: NavigationRequest, scheduler: str | None, workers: int | None
+    request: NavigationRequest, local: bool, workers: int | None
 ) -> NavigationOptions:
-    """The evaluation of every run: local workers share the cores, remote ones get 1 each."""
+    """The evaluation of every run: ``local`` workers share the cores, others get 1 each."""
     threads = 1
-    if scheduler is None:
+    if local:
         cpus = available_cpus()
         threads = max(1, cpus // (workers or cpus))
     return request.options(None, seed=0, threads=threads)
@@ -203,6 +233,22 @@ def _bases(
     return (lambda seed: bases[seed][0]), list(bases.values())
 
 
+def _log_shared_plans(seeds: str, runs: Sequence[SweepRun], *, evaluated: bool) -> None:
+    """Say that a mission file's seeds do not change its plans, and what they do instead."""
+    n_plans = len({run.digest for run in runs})
+    if evaluated:
+        logger.info(
+            "--seeds %s do not change a mission file's plan: %d plans, each evaluated with "
+            "every seed (%d rows)", seeds, n_plans, len(runs),
+        )  # fmt: skip
+    else:
+        logger.info(
+            "--seeds %s do not change a mission file's plan: each of its %d missions is "
+            "planned once, one row without a seed (seeds count with --evaluate, the "
+            "Monte-Carlo seed, or with 'scenarios')", seeds, n_plans,
+        )  # fmt: skip
+
+
 def _counts(records: Sequence[RunRecord]) -> dict[str, Any]:
     statuses = Counter(record.status for record in records).most_common()
     return {
@@ -210,6 +256,7 @@ def _counts(records: Sequence[RunRecord]) -> dict[str, Any]:
         "ran": sum(not record.skipped for record in records),
         "skipped": sum(record.skipped for record in records),
         "failed": sum(record.failed for record in records),
+        "planned": sum(not record.skipped and record.plan_of is None for record in records),
         "status": dict(statuses),
     }
 

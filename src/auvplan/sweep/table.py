@@ -2,10 +2,12 @@
 
 Every finished run's folder holds, next to the normal ``plan`` output, ``sweep_run.json``:
 the run's id, varied values, seed, digest (:class:`~auvplan.sweep.spec.SweepRun`), wall time,
-peak memory and the worker process (host, pid). A run is *finished* when its folder holds
-``summary.json`` and a ``sweep_run.json`` with the digest the sweep expects;
-:func:`read_run_folder` then rebuilds its :class:`RunRecord` from the two files, exactly as
-for a run that just ended, so a resumed sweep's table equals a fresh one's.
+peak memory, the worker process (host, pid) and ``plan_of``: the run whose plan the folder
+shares (runs of one mission that differ only in their seed are planned once,
+:mod:`auvplan.sweep.runner`), ``null`` for a run that planned itself. A run is *finished*
+when its folder holds ``summary.json`` and a ``sweep_run.json`` with the digest the sweep
+expects; :func:`read_run_folder` then rebuilds its :class:`RunRecord` from the two files,
+exactly as for a run that just ended, so a resumed sweep's table equals a fresh one's.
 
 Columns of ``sweep.csv``, one row per run in grid order: ``run_id``, one column per varied key
 (its dotted name), ``seed``, ``status`` (the plan verdict ``CONVERGED`` /
@@ -14,7 +16,8 @@ or ``DECONFLICTED`` for ``--stage``, or for a run that raised, its error class s
 ``InfeasibleError`` or ``worker died``), ``reason`` (one line, empty for a converged plan),
 ``energy_J`` (fleet total), ``terrain_information`` (mean over vehicles of each one's mean
 terrain information), ``n_iter``, ``wall_s``, ``peak_rss_mb`` (empty where the platform cannot
-tell), ``tan_rmse_m``, ``energy_J.<vehicle>`` per vehicle, and ``folder``.
+tell), ``tan_rmse_m``, ``energy_J.<vehicle>`` per vehicle, and ``folder`` (relative to the
+sweep's folder in the files written: they hold no absolute path).
 
 **Adding columns per run** (the hook for later evaluations): :func:`add_run_columns` calls a
 function ``columns(folder) -> {column: value}`` on every run folder and fills (or adds) those
@@ -73,7 +76,8 @@ class RunRecord:
     ``folder`` is the run's output folder (``None`` when it failed before writing one);
     ``skipped`` tells a run finished by an earlier invocation; ``messages`` are the warnings
     the run logged; ``navigation_error`` says why its navigation evaluation (``--evaluate``)
-    failed, if it did.
+    failed, if it did; ``plan_of`` is the run whose plan (or planning failure) this run
+    shares, ``None`` when it planned itself.
     """
 
     run_id: str
@@ -91,6 +95,7 @@ class RunRecord:
     skipped: bool = False
     messages: tuple[str, ...] = ()
     navigation_error: str | None = None
+    plan_of: str | None = None
 
     @property
     def failed(self) -> bool:
@@ -106,9 +111,18 @@ class RunRecord:
 
 
 def run_record_document(
-    run: SweepRun, *, wall_s: float, peak_rss_mb: float | None, messages: Sequence[str]
+    run: SweepRun,
+    *,
+    wall_s: float,
+    peak_rss_mb: float | None,
+    messages: Sequence[str],
+    plan_of: str | None = None,
 ) -> dict[str, Any]:
-    """The content of a finished run's ``sweep_run.json`` (written by the worker that ran it)."""
+    """The content of a finished run's ``sweep_run.json`` (written by the worker that ran it).
+
+    ``wall_s`` [s] and ``peak_rss_mb`` [MiB] are those of the planning, also in a run that
+    shares the plan of run ``plan_of``.
+    """
     return {
         "auvplan_version": __version__,
         "run_id": run.run_id,
@@ -119,6 +133,7 @@ def run_record_document(
         "peak_rss_mb": peak_rss_mb,
         "worker": {"host": socket.gethostname(), "pid": os.getpid()},
         "messages": list(messages),
+        "plan_of": plan_of,
     }
 
 
@@ -151,6 +166,7 @@ def _record_from(
         "wall_s": float(record["wall_s"]),
         "peak_rss_mb": record["peak_rss_mb"],
         "messages": tuple(record["messages"]),
+        "plan_of": record.get("plan_of"),  # absent from the records of earlier versions
     }
     if optimization is None:
         return RunRecord(run.run_id, run.values, run.seed, STAGE_STATUS[summary.stage], **common)
@@ -268,12 +284,28 @@ def write_sweep_files(
     """
     directory.mkdir(parents=True, exist_ok=True)
     table, document = directory / "sweep.csv", directory / "sweep.json"
+    if "folder" in frame.columns:  # the run folders relative to the sweep's: the files travel
+        frame = frame.assign(folder=[f and relative_to(f, directory) for f in frame["folder"]])
     with staged_output_file(table) as staging:
         frame.to_csv(staging, index=False)
     content = {"auvplan_version": __version__, "spec": spec, **sections, "runs": json_rows(frame)}
     with staged_output_file(document) as staging:  # dates, paths, pandas NA as text
         write_json(json.loads(json.dumps(content, default=str)), staging)
     return [table, document]
+
+
+def relative_to(path: str | Path, directory: Path) -> str:
+    """``path`` relative to ``directory`` (POSIX; ``..`` where it lies outside).
+
+    How the sweep's files name other files: they hold no absolute path.
+
+    Examples
+    --------
+    >>> sweep = Path("/data/sweep")
+    >>> relative_to("/data/sweep/runs/a", sweep), relative_to("/data/m.toml", sweep)
+    ('runs/a', '../m.toml')
+    """
+    return Path(os.path.relpath(Path(path).resolve(), directory.resolve())).as_posix()
 
 
 def json_rows(frame: pd.DataFrame) -> list[dict[str, Any]]:
@@ -346,6 +378,7 @@ __all__ = [
     "json_rows",
     "navigation_columns",
     "read_run_folder",
+    "relative_to",
     "run_record_document",
     "sweep_frame",
     "write_pareto_table",
