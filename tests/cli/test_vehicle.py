@@ -59,6 +59,31 @@ def test_vehicle_file_path(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -
     assert table["hotel_power"] == 80.0
 
 
+def test_battery_and_its_range_at_the_cruise(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Range = capacity / energy per metre at the energy-optimal cruise; none without one."""
+    text = resources.files("auvplan").joinpath("data", "vehicles", "medusa.toml").read_text()
+    hotel = next(line for line in text.splitlines() if line.startswith("hotel "))
+    path = tmp_path / "boat.toml"
+    path.write_text(
+        text.replace(hotel, f'{hotel}\nbattery_capacity = {{ value = 0.5, unit = "kWh" }}')
+    )
+    assert main(["vehicle", str(path), "--json"]) == 0
+    document = json.loads(capsys.readouterr().out)
+    table = document["characteristics"]
+    assert table["battery_capacity"] == pytest.approx(1.8e6)
+    assert table["cruise_range"] == pytest.approx(1.8e6 / table["cruise_energy_per_metre"])
+    assert document["units"]["cruise_range"] == "m"
+    assert main(["vehicle", str(path)]) == 0
+    line = next(row for row in capsys.readouterr().out.splitlines() if row.startswith("battery"))
+    assert f"500.0 Wh; {table['cruise_range'] / 1e3:.2f} km" in line
+    assert main(["vehicle", "medusa", "--json"]) == 0
+    medusa = json.loads(capsys.readouterr().out)["characteristics"]
+    assert medusa["battery_capacity"] is None
+    assert medusa["cruise_range"] is None
+
+
 @pytest.mark.parametrize(
     ("argument", "message"),
     [

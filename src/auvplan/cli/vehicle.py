@@ -19,8 +19,8 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
         description="Load a vehicle type (packaged name such as 'medusa' or 'remus100', or a "
         "vehicle TOML file) and report bollard thrust and torque at maximum propeller speed, "
         "top speed, energy-optimal cruise speed and its energy per metre, steady electrical "
-        "power at 0.5 and 1.0 m/s, maximum steady yaw rate, and the turning radius at full "
-        "steering at the cruise speed.",
+        "power at 0.5 and 1.0 m/s, maximum steady yaw rate, the turning radius at full "
+        "steering at the cruise speed, and the battery and the range it gives at that speed.",
     )
     parser.add_argument(
         "vehicle",
@@ -81,6 +81,7 @@ def _check_figure_path(path: Path) -> None:
 
 
 def _print_table(table: VehicleCharacteristics, propeller: Propeller) -> None:
+    from auvplan.io.vehicle_tables import UNITS
     from auvplan.vehicle.params import PropellerParams
 
     series = (
@@ -112,3 +113,10 @@ def _print_table(table: VehicleCharacteristics, propeller: Propeller) -> None:
         f"turning radius             {table.turning_radius:.2f} m "
         f"(full steering at the cruise speed {table.cruise_speed:.2f} m/s)"
     )
+    if table.battery_capacity is None or table.cruise_range is None:
+        print("battery                    unknown (no [power] battery_capacity: no reserve check)")
+    else:
+        print(
+            f"battery                    {table.battery_capacity / UNITS['J']['Wh']:.1f} Wh; "
+            f"{table.cruise_range / 1e3:.2f} km at the energy-optimal cruise (still water)"
+        )

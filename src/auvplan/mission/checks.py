@@ -23,6 +23,7 @@ from typing import Final
 import numpy as np
 
 from auvplan._typing import FloatArray
+from auvplan.io.vehicle_tables import UNITS
 from auvplan.mission.config import AREA_NAME, MissionConfig
 from auvplan.mission.navigation import NavigationChoice, budget_of, smallest_budget
 from auvplan.navigation.prediction import ErrorPrediction
@@ -49,8 +50,8 @@ class PlanStatus(enum.Enum):
     """The optimiser stopped early; the best plan found is reported."""
 
 
-#: Joules in a watt-hour [J/Wh].
-JOULES_PER_WH: Final = 3600.0
+#: Joules in a watt-hour [J/Wh] (the vehicle files' unit table).
+JOULES_PER_WH: Final = UNITS["J"]["Wh"]
 
 
 @dataclass(frozen=True)

@@ -149,6 +149,8 @@ CHARACTERISTIC_UNITS: Final = {
     "n_at_1_0": "rev/s",
     "max_yaw_rate": "rad/s",
     "turning_radius": "m",
+    "battery_capacity": "J",
+    "cruise_range": "m",
 }
 
 
@@ -188,8 +190,13 @@ class VehicleCharacteristics:
     """Steady yaw rate at full steering (:func:`max_yaw_rate`) [rad/s]."""
     turning_radius: float
     """Radius of the steady turn at full steering at the cruise speed [m]."""
+    battery_capacity: float | None = None
+    """Energy of a full battery, None when the vehicle file gives none [J]."""
+    cruise_range: float | None = None
+    """Distance a full battery carries the vehicle at the energy-optimal cruise in still water,
+    ``battery_capacity / cruise_energy_per_metre`` (the longest of any steady speed) [m]."""
 
-    def to_dict(self) -> dict[str, float | int | str]:
+    def to_dict(self) -> dict[str, float | int | str | None]:
         """Plain dictionary (JSON-ready), SI units as documented per field.
 
         Examples
@@ -203,7 +210,7 @@ class VehicleCharacteristics:
         """
         return dict(asdict(self))
 
-    def to_document(self) -> dict[str, dict[str, float | int | str]]:
+    def to_document(self) -> dict[str, dict[str, float | int | str | None]]:
         """The JSON document of ``auvplan vehicle --json``: the fields and their units.
 
         ``{"characteristics": self.to_dict(), "units": CHARACTERISTIC_UNITS}``.

@@ -400,6 +400,7 @@ def vehicle_characteristics(model: VehicleModel) -> VehicleCharacteristics:
     cruise = optimal_cruise_speed(model)
     slow = trim_surge(model, 0.5)
     fast = trim_surge(model, 1.0)
+    battery = model.vehicle.battery_capacity
     return VehicleCharacteristics(
         name=model.vehicle.name,
         propeller_order=model.propeller_order,
@@ -417,6 +418,8 @@ def vehicle_characteristics(model: VehicleModel) -> VehicleCharacteristics:
         n_at_1_0=fast.n,
         max_yaw_rate=max_yaw_rate(model),
         turning_radius=tightest_turn(model, cruise.speed).radius,
+        battery_capacity=battery,
+        cruise_range=None if battery is None else battery / cruise.energy_per_metre,
     )
 
 
