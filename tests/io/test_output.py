@@ -13,7 +13,12 @@ import pytest
 
 from auvplan.errors import InputError
 from auvplan.io import output
-from auvplan.io.output import check_output_dir, staged_output_dir, staged_output_file
+from auvplan.io.output import (
+    check_output_dir,
+    link_entries,
+    staged_output_dir,
+    staged_output_file,
+)
 
 
 def _tree(root: Path) -> dict[str, bytes | None]:
@@ -281,3 +286,24 @@ def test_staged_output_file_is_all_or_nothing(tmp_path: Path) -> None:
     assert target.read_bytes() == b"png"
     with pytest.raises(InputError, match="is a folder, not a file name"):
         output.check_output_file(tmp_path)
+
+
+def test_link_entries_hard_links_all_but_skipped_and_hidden(tmp_path: Path) -> None:
+    source, destination = tmp_path / "source", tmp_path / "destination"
+    (source / "figures").mkdir(parents=True)
+    (source / "plan.csv").write_text("t,x\n0,1\n")
+    (source / "figures" / "map.png").write_bytes(b"png")
+    (source / "navigation.json").write_text("{}")
+    (source / ".plan.abc.partial.csv").write_text("half")
+    (source / "latest").symlink_to("plan.csv")
+    destination.mkdir()
+    link_entries(source, destination, skip={"navigation.json"})
+    assert _tree(destination) == {
+        "figures": None, "figures/map.png": b"png", "latest": None, "plan.csv": b"t,x\n0,1\n",
+    }  # fmt: skip
+    assert (destination / "plan.csv").samefile(source / "plan.csv")
+    assert (destination / "figures" / "map.png").samefile(source / "figures" / "map.png")
+    assert (destination / "latest").readlink() == Path("plan.csv")
+    with staged_output_file(source / "plan.csv") as staging:  # a writer replaces, not edits
+        staging.write_text("t,x\n0,2\n")
+    assert (destination / "plan.csv").read_text() == "t,x\n0,1\n"

@@ -49,8 +49,8 @@ def register(subparsers: argparse._SubParsersAction[Any]) -> None:
         "--seeds",
         metavar="SEEDS",
         help="seeds, e.g. 0..49 or 0,3,7: with 'scenarios' each seed is a mission of the "
-        "family; with a mission file the seed is only recorded in each row (for later "
-        "Monte-Carlo evaluations), the plan does not depend on it",
+        "family; with a mission file the plan does not depend on the seed: each mission is "
+        "planned once, and with --evaluate evaluated with every seed (one row per seed)",
     )
     cluster = parser.add_mutually_exclusive_group()
     cluster.add_argument(
@@ -130,7 +130,8 @@ def _print_summary(outcome: SweepOutcome) -> None:
     statuses = ", ".join(f"{count} {status}" for status, count in counts["status"].items())
     print(
         f"sweep: {counts['runs']} runs ({counts['ran']} ran, {counts['skipped']} skipped "
-        f"as finished before, {counts['failed']} failed): {statuses}; {outcome.wall_s:.1f} s"
+        f"as finished before, {counts['failed']} failed), {counts['planned']} planned: "
+        f"{statuses}; {outcome.wall_s:.1f} s"
     )
     if outcome.trade_off is not None:
         _print_trade_off(outcome.trade_off, outcome.view)

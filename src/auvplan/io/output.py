@@ -29,7 +29,7 @@ import logging
 import os
 import shutil
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Collection, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -187,6 +187,26 @@ def staged_output_file(target: Path) -> Iterator[Path]:
     except BaseException:
         temporary.unlink(missing_ok=True)
         raise
+
+
+def link_entries(source: Path, destination: Path, *, skip: Collection[str] = ()) -> None:
+    """Hard-link every entry of folder ``source`` into folder ``destination``.
+
+    Files are hard-linked (no copy on the same file system, else copied), sub-folders
+    rebuilt the same way, symbolic links kept as links. Names in ``skip`` and hidden names
+    (``.*``: the staging files of another writer) are left out. Writers replace files by
+    renaming (:func:`staged_output_file`), never in place, so neither folder can change the
+    other's files afterwards.
+    """
+    for entry in sorted(Path(source).iterdir()):
+        if entry.name in skip or entry.name.startswith("."):
+            continue
+        if entry.is_dir() and not entry.is_symlink():
+            shutil.copytree(
+                entry, destination / entry.name, symlinks=True, copy_function=_link_or_copy
+            )
+        else:
+            _link_or_copy(entry, destination / entry.name)
 
 
 def _mode_of(existing: Path, default: int) -> int:

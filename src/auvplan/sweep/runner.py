@@ -3,8 +3,16 @@
 By default a :class:`~distributed.LocalCluster` of worker *processes* (one thread each) runs
 the missions, so a run that crashes its process (or is killed for memory) takes down only its
 worker: the nanny starts a new one, and the run becomes a row with status ``worker died``.
-The same runs go to an existing cluster given by its scheduler address; its workers must
-import auvplan and see ``DIR`` at the same path.
+The same runs go to an existing cluster given by its scheduler address, or to the cluster of
+a :class:`distributed.Client` the caller made (and closes); its workers must import auvplan
+and see ``DIR`` at the same path.
+
+**One plan per mission.** Runs with the same digest (:class:`~auvplan.sweep.spec.SweepRun`:
+the same mission, folder and stage; runs of a mission file that differ only in their seed)
+are planned once: the first such run plans, and every other one waits for it and gets its
+folder's files hard-linked into its own (:func:`execute_shared`), then its own evaluation.
+A finished folder of that digest (of this grid, or of the run without a seed) is used in the
+same way, so a sweep resumed with more seeds plans nothing new.
 
 Each run (:func:`execute_run`, in a worker) plans its mission and writes the normal ``plan``
 output into ``DIR/runs/<run-id>/`` all-or-nothing (:func:`auvplan.io.output.staged_output_dir`),
@@ -16,7 +24,8 @@ With :attr:`RunOptions.navigation` each plan is then flown through the TAN simul
 (:mod:`auvplan.sweep.navigation`) in the same task, which adds ``navigation.json`` to its
 folder; a finished run whose folder lacks that file (or holds one of other settings) is
 submitted for the evaluation alone (:func:`execute_evaluation`). The Monte-Carlo seed is the
-run's seed (``--seeds``), else the options' own. An evaluation that fails leaves the plan as
+run's seed (``--seeds``), else the options' own: runs sharing a plan are evaluated each with
+its own seed. An evaluation that fails leaves the plan as
 it is and sets the record's ``navigation_error``.
 
 dask is imported only when a sweep runs; without it, the error names the extra to install.
@@ -42,13 +51,14 @@ from pathlib import Path
 from typing import Any, Final
 
 from auvplan.errors import AuvplanError, InputError
+from auvplan.record.files import NAVIGATION_FILE
 from auvplan.sweep.navigation import (
     NavigationOptions,
     evaluate_run_folder,
     has_plan,
     is_evaluated,
 )
-from auvplan.sweep.spec import SweepRun
+from auvplan.sweep.spec import SweepRun, run_identifier
 from auvplan.sweep.table import RUN_RECORD_FILE, RunRecord, read_run_folder, run_record_document
 
 #: Folder of the run folders inside the sweep's output folder.
@@ -113,12 +123,15 @@ def run_sweep(
     directory: Path,
     *,
     options: RunOptions = RunOptions(),
+    client: Any = None,
     scheduler: str | None = None,
     n_workers: int | None = None,
     progress: Callable[[SweepProgress], None] | None = None,
     on_ready: Callable[[], None] | None = None,
 ) -> list[RunRecord]:
     """Run every unfinished run of ``runs`` on dask; the records in the order of ``runs``.
+
+    Runs of the same digest are planned once (module notes).
 
     Parameters
     ----------
@@ -128,10 +141,13 @@ def run_sweep(
         The sweep's output folder; run folders go to ``directory/runs/``.
     options : RunOptions
         Stage, figures, logging of each run.
+    client : distributed.Client, optional
+        A client of a cluster the caller made; used as it is and left open.
     scheduler : str, optional
-        Address of a running dask scheduler (``tcp://host:8786``); default: a LocalCluster.
+        Address of a running dask scheduler (``tcp://host:8786``).
     n_workers : int, optional
-        Worker processes of the LocalCluster (default: the CPU count).
+        Worker processes of the LocalCluster made without ``client`` or ``scheduler``
+        (default: the CPU count).
     progress : callable, optional
         Called with a :class:`SweepProgress` at the start and after every run.
     on_ready : callable, optional
@@ -142,10 +158,21 @@ def run_sweep(
     Raises
     ------
     InputError
-        If dask.distributed is not installed (the message names the extra), or the scheduler
-        does not answer as a dask scheduler within ``CONNECT_TIMEOUT_S``
-        (:func:`probe_scheduler`).
+        If more than one of ``client``, ``scheduler`` and ``n_workers`` is given, ``client``
+        is not a :class:`distributed.Client`, dask.distributed is not installed (the message
+        names the extra), or the scheduler does not answer as a dask scheduler within
+        ``CONNECT_TIMEOUT_S`` (:func:`probe_scheduler`).
+
+    Examples
+    --------
+    >>> from distributed import Client, LocalCluster  # doctest: +SKIP
+    >>> with LocalCluster(n_workers=2) as cluster, Client(cluster) as client:  # doctest: +SKIP
+    ...     records = run_sweep(runs, Path("sweep"), client=client)
     """
+    cluster_given = {"client": client, "scheduler": scheduler, "n_workers": n_workers}
+    given = [name for name, value in cluster_given.items() if value is not None]
+    if len(given) > 1:
+        raise InputError(f"run_sweep: give one of {' and '.join(given)}, not both")
     directory = Path(directory).resolve()
     records: dict[str, RunRecord] = {}
     to_evaluate: set[str] = set()
@@ -162,14 +189,15 @@ def run_sweep(
         ready()
         report(SweepProgress(len(runs), len(records), 0, 0, 0))
         return [records[run.run_id] for run in runs]
-    with _dask_client(scheduler, n_workers) as (client, as_completed, killed_worker):
+    plans: dict[str, Any] = _finished_plans(directory, runs, records)  # digest -> record/future
+    with _dask_client(client, scheduler, n_workers) as (cluster, as_completed, killed_worker):
         ready()
         for run in pending:
             if run.run_id not in to_evaluate:
                 _remove_stale_staging(run_folder(directory, run))
 
         def event(finished: int, failed: int, record: RunRecord | None = None) -> SweepProgress:
-            threads = sum(client.nthreads().values()) or 1
+            threads = sum(cluster.nthreads().values()) or 1
             running = min(threads, len(pending) - finished)
             return SweepProgress(
                 len(runs), len(runs) - len(pending), finished, failed, running, record
@@ -177,17 +205,20 @@ def run_sweep(
 
         report(event(0, 0))
         batch = uuid.uuid4().hex[:8]  # keys unique on a shared scheduler
-        futures = {
-            client.submit(
-                *(
-                    (execute_evaluation, records[run.run_id], run, options.navigation)
-                    if run.run_id in to_evaluate
-                    else (execute_run, run, run_folder(directory, run), options)
-                ),
-                key=f"auvplan-run-{batch}-{index}", pure=False,
-            ): run
-            for index, run in enumerate(pending)
-        }  # fmt: skip
+        futures: dict[Any, SweepRun] = {}
+        for index, run in enumerate(pending):
+            key = f"auvplan-run-{batch}-{index}"
+            folder = run_folder(directory, run)
+            if run.run_id in to_evaluate:
+                evaluation = (records[run.run_id], run, options.navigation)
+                future = cluster.submit(execute_evaluation, *evaluation, key=key, pure=False)
+            elif run.digest in plans:  # a finished record, or the future of the run that plans
+                shared = (plans[run.digest], run, folder, options)
+                future = cluster.submit(execute_shared, *shared, key=key, pure=False)
+            else:
+                future = cluster.submit(execute_run, run, folder, options, key=key, pure=False)
+                plans[run.digest] = future
+            futures[future] = run
         n_failed = 0
         for n_finished, future in enumerate(as_completed(futures), start=1):
             run = futures[future]
@@ -241,12 +272,73 @@ def execute_run(run: SweepRun, folder: Path, options: RunOptions) -> RunRecord:
                 write_json(document, staging / RUN_RECORD_FILE)
         except Exception as error:  # noqa: BLE001 (any failure is the run's row)
             return _failure(run, error, wall_s=time.perf_counter() - started)
+    return _read_back(run, folder, options)
+
+
+def execute_shared(plan: RunRecord, run: SweepRun, folder: Path, options: RunOptions) -> RunRecord:
+    """Give ``run`` the plan of ``plan``, a run of the same digest; nothing is planned.
+
+    ``plan``'s folder is hard-linked into ``folder`` (all or nothing,
+    :func:`auvplan.io.output.link_entries`) without its ``navigation.json`` and
+    ``sweep_run.json``; ``run``'s own ``sweep_run.json`` names the run that planned
+    (``plan_of``) and carries its wall time, peak memory and messages. Then ``run`` is
+    evaluated with its own seed when ``options.navigation`` asks. A ``plan`` that failed
+    without a folder gives ``run`` the same status and reason. Other failures are records,
+    as in :func:`execute_run`.
+    """
+    from auvplan.io.output import link_entries, staged_output_dir
+    from auvplan.io.results import write_json
+
+    origin = plan.plan_of or plan.run_id
+    if plan.folder is None:
+        return RunRecord(
+            run.run_id, run.values, run.seed, plan.status, plan.reason, wall_s=plan.wall_s,
+            plan_of=origin,
+        )  # fmt: skip
+    try:
+        with staged_output_dir(folder) as staging:
+            link_entries(plan.folder, staging, skip={NAVIGATION_FILE, RUN_RECORD_FILE})
+            document = run_record_document(
+                run,
+                wall_s=plan.wall_s or 0.0,
+                peak_rss_mb=plan.peak_rss_mb,
+                messages=plan.messages,
+                plan_of=origin,
+            )
+            write_json(document, staging / RUN_RECORD_FILE)
+    except Exception as error:  # noqa: BLE001 (any failure is the run's row)
+        return replace(_failure(run, error), plan_of=origin)
+    return _read_back(run, folder, options)
+
+
+def _read_back(run: SweepRun, folder: Path, options: RunOptions) -> RunRecord:
+    """The record of the run just written to ``folder``, evaluated when ``options`` ask."""
     record = read_run_folder(folder, run)
     if record is None:
         raise InputError(f"run {run.run_id}: its folder {folder} cannot be read back")
     if _needs_evaluation(record, run, options.navigation):
         return execute_evaluation(record, run, options.navigation)
     return record
+
+
+def _finished_plans(
+    directory: Path, runs: Sequence[SweepRun], finished: dict[str, RunRecord]
+) -> dict[str, RunRecord]:
+    """Digest -> the record of a finished folder holding that plan.
+
+    The finished runs of the grid, else the folder of a seeded run's values without a seed
+    (an earlier sweep of the same mission without ``--seeds``).
+    """
+    plans: dict[str, RunRecord | None] = {}
+    for run in runs:
+        if run.run_id in finished:
+            plans.setdefault(run.digest, finished[run.run_id])
+    for run in runs:
+        if run.seed is None or run.digest in plans:  # each digest looked for once
+            continue
+        unseeded = replace(run, run_id=run_identifier(run.values, None), seed=None)
+        plans[run.digest] = read_run_folder(run_folder(directory, unseeded), unseeded)
+    return {digest: record for digest, record in plans.items() if record is not None}
 
 
 def execute_evaluation(
@@ -317,13 +409,26 @@ def require_dask() -> None:
 
 
 @contextlib.contextmanager
-def _dask_client(scheduler: str | None, n_workers: int | None) -> Iterator[tuple[Any, Any, Any]]:
-    """``(client, as_completed, KilledWorker)`` of the cluster; closed (and stopped) after."""
+def _dask_client(
+    client: Any, scheduler: str | None, n_workers: int | None
+) -> Iterator[tuple[Any, Any, Any]]:
+    """``(client, as_completed, KilledWorker)`` of the cluster; closed (and stopped) after.
+
+    A ``client`` given is used as it is and left open.
+    """
     require_dask()
     dask = importlib.import_module("dask")
     distributed = importlib.import_module("distributed")
     as_completed = distributed.as_completed
     killed_worker = distributed.scheduler.KilledWorker
+    if client is not None:
+        if not isinstance(client, distributed.Client):
+            raise InputError(
+                f"run_sweep: client must be a distributed.Client, not {type(client).__name__} "
+                "(a scheduler address goes to scheduler=)"
+            )
+        yield client, as_completed, killed_worker
+        return
     if scheduler is not None:
         probe_scheduler(scheduler)
         try:
