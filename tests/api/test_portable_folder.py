@@ -1,10 +1,10 @@
 """Folders that travel (issue 25): an output folder copied elsewhere, the inputs gone, reruns.
 
-A small mission on a real file-based grid (a copy of the packaged Monterey sample, cropped by a
-lat/lon window), a gridded current file and two vehicle files naming their own propeller
-tables (one beside the file, one in another folder) is planned; the folder is copied to another
-place and every original input deleted; ``auvplan plan COPY/mission.toml -o NEW`` must give the
-same trajectories and maps. No output file may hold an absolute path.
+A small mission on a real file-based grid (the packaged Monterey sample with one absurd value
+in a corner, cropped by a lat/lon window), a gridded current file and two vehicle files naming
+their own propeller tables (one beside the file, one in another folder) is planned; the folder
+is copied to another place and every original input deleted; ``auvplan plan COPY/mission.toml
+-o NEW`` must give the same trajectories and maps. No output file may hold an absolute path.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+import xarray as xr
 
 from auvplan.cli.main import main
 from auvplan.io.samples import sample_path
@@ -60,7 +61,14 @@ def _inputs(root: Path) -> Path:
     source = root / "source"
     for folder in ("data", "boats/props", "far", "missions"):
         (source / folder).mkdir(parents=True)
-    shutil.copyfile(sample_path("monterey"), source / "data" / "grid.nc")
+    with xr.open_dataset(sample_path("monterey")) as sample:
+        grid = sample.load()
+    # one absurd value in the window's north-west corner, far from the paths: a warning that
+    # names the grid file (summary.json keeps it without the file's folders)
+    row = int(np.searchsorted(grid["lat"].values, 36.7970)) - 1
+    col = int(np.searchsorted(grid["lon"].values, -121.8146)) + 1
+    grid["elevation"][row, col] = -30_000.0
+    grid.to_netcdf(source / "data" / "grid.nc")
     write_current_file(source / "data" / "currents.nc")
     (source / "data" / "b4.csv").write_bytes(TABLE)
     (source / "boats" / "props" / "mine.csv").write_bytes(TABLE)
@@ -122,6 +130,8 @@ def test_the_folder_names_its_own_inputs(travelled: tuple[Path, Path, Path]) -> 
 
 def test_no_output_file_holds_an_absolute_path(travelled: tuple[Path, Path, Path]) -> None:
     root, original, rerun = travelled
+    warnings = json.loads((original / "summary.json").read_text())["warnings"]
+    assert [line for line in warnings if line.startswith("bathymetry grid.nc: 1 of ")], warnings
     needles = {str(root).encode(), str(root.resolve()).encode(), str(Path.cwd()).encode()}
     for folder in (original, rerun):
         files = sorted(path for path in folder.rglob("*") if path.is_file())

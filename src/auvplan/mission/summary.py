@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import platform
+import re
 from collections.abc import Sequence
 from datetime import UTC, datetime
 from enum import Enum
@@ -145,6 +146,23 @@ def _obstacles(preplan: PreplanStage) -> list[dict[str, Any]]:
     return shapes
 
 
+#: The folders of an absolute POSIX path (``/home/me/data/``), before its last name.
+_FOLDERS: Final = re.compile(r"(?<![\w./~-])/(?:[^\s/'\"]+/)+(?=[^\s/'\"])")
+
+
+def without_folders(message: str) -> str:
+    """``message`` with each absolute path cut to its last name (outputs hold no folder).
+
+    Examples
+    --------
+    >>> without_folders("bathymetry /home/me/data/grid.nc: 3 of 9 values beyond ±12000 m")
+    'bathymetry grid.nc: 3 of 9 values beyond ±12000 m'
+    >>> without_folders("speed 0.5 m/s, pair blue / green, ./rel/path.csv")
+    'speed 0.5 m/s, pair blue / green, ./rel/path.csv'
+    """
+    return _FOLDERS.sub("", message)
+
+
 def _fingerprint(path: Path | Traversable) -> dict[str, str]:
     """A file the run read: its name (an output folder holds no absolute path) and SHA-256."""
     return {"path": path.name, "sha256": file_sha256(path)}
@@ -233,7 +251,8 @@ def mission_summary(
     ``vehicle_types`` are the vehicles' ``type`` as the output folder's ``mission.toml``
     names them (a packaged type or a carried file, :mod:`auvplan.mission.carry`): no path
     outside the folder. ``warnings`` are the warnings logged during the run (one line each),
-    kept under ``"warnings"``.
+    kept under ``"warnings"`` with each absolute path cut to its file name
+    (:func:`without_folders`).
     """
     config = result.config
     preplan = result.preplan
@@ -273,7 +292,7 @@ def mission_summary(
         "solver": {**config.solver.model_dump(), "propeller_order": config.solver.harmonics},
         "vehicles": [],
         "wall_time_s": dict(result.timings),
-        "warnings": list(warnings),
+        "warnings": [without_folders(line) for line in warnings],
     }
     for i, name in enumerate(preplan.names):
         route = preplan.routes[i]
