@@ -157,3 +157,19 @@ def test_not_a_maps_file(tmp_path: Path) -> None:
     xr.Dataset({"a": ("t", [1.0])}).to_netcdf(path)
     with pytest.raises(DataFormatError, match="missing"):
         read_maps_netcdf(path)
+
+
+def test_vertical_datum_of_the_source_is_carried(tmp_path: Path, bathymetry_dir: Path) -> None:
+    """NCEI's Monterey DEM is relative to NAVD88: maps.nc's depth says so, and reads back."""
+    grid = read_bathymetry(bathymetry_dir / "monterey_canyon_head_ncei_13arcsec.nc")
+    assert grid.attributes["vertical_datum"] == "NAVD88"
+    maps = compute_terrain_maps(grid.window((0.0, 200.0), (0.0, 200.0)))
+    path = write_maps_netcdf(maps, tmp_path / "maps.nc")
+    with xr.open_dataset(path) as ds:
+        assert ds["depth"].attrs["vertical_datum"] == "NAVD88"
+    assert read_maps_netcdf(path).bathymetry.attributes == {"vertical_datum": "NAVD88"}
+    assert read_bathymetry(path).attributes["vertical_datum"] == "NAVD88"
+    # a source without one: no attribute (nothing invented)
+    local = write_maps_netcdf(compute_terrain_maps(synthetic_bank()), tmp_path / "local.nc")
+    with xr.open_dataset(local) as ds:
+        assert "vertical_datum" not in ds["depth"].attrs

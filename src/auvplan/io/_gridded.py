@@ -33,6 +33,9 @@ _DATA_NAMES = ("depth", "elevation", "z", "Band1", "topo", "height", "bathymetry
 #: Names of auvplan's own local-frame axes (``maps.nc`` and metric grids), known without
 #: attributes; any other axis is recognised by cf_xarray (attributes, then names).
 _NORTH_NAME, _EAST_NAME = "north", "east"
+#: Attribute naming the vertical datum of the depths or elevations (``"NAVD88"``, ``"MSL"``),
+#: on the data variable or the file; kept in the grid's attributes and written to ``maps.nc``.
+VERTICAL_DATUM = "vertical_datum"
 
 
 # --- NetCDF --------------------------------------------------------------------------------
@@ -47,6 +50,8 @@ def read_netcdf(path: Path) -> Raster:
     such as ``lat``/``lon``/``y``/``x``). The CRS is the CF ``grid_mapping`` of the variable
     (:meth:`pyproj.CRS.from_cf`, which also reads ``crs_wkt`` and GDAL's ``spatial_ref``);
     without one, latitude/longitude axes are WGS 84 and metric axes have no georeference.
+    The variable's (else the file's) :data:`VERTICAL_DATUM`, if any, is kept in the
+    attributes.
     """
     import xarray as xr
 
@@ -75,6 +80,9 @@ def read_netcdf(path: Path) -> Raster:
         for key in ("title", "source", "license"):
             if key in dataset.attrs:
                 attributes[key] = first_line(dataset.attrs[key])
+        datum = data.attrs.get(VERTICAL_DATUM, dataset.attrs.get(VERTICAL_DATUM))
+        if datum is not None:
+            attributes[VERTICAL_DATUM] = first_line(datum)
         north_axis = np.asarray(north_var.values, dtype=np.float64)
         east_axis = np.asarray(east_var.values, dtype=np.float64)
         crs = grid_mapping_crs(dataset, data)

@@ -4,7 +4,8 @@ Layout:
 
 * fine grid, coordinate variables ``north(north)``, ``east(east)`` [m] (standard names
   ``projection_y_coordinate`` / ``projection_x_coordinate``, no ``_FillValue``): ``depth``
-  (standard name ``sea_floor_depth_below_sea_surface``, positive down) and ``information``;
+  (standard name ``sea_floor_depth_below_sea_surface``, positive down; ``vertical_datum``,
+  the source's, when it names one) and ``information``;
 * coarse (block) grid, coordinate variables ``north_block``, ``east_block`` [m]:
   ``excitation``, ``cost`` and ``shifted_cost``;
 * when the grid is georeferenced: the grid mapping variable ``crs`` (the local frame's
@@ -29,7 +30,7 @@ import numpy as np
 
 from auvplan._version import __version__
 from auvplan.errors import DataFormatError
-from auvplan.io._gridded import grid_mapping_crs
+from auvplan.io._gridded import VERTICAL_DATUM, grid_mapping_crs
 from auvplan.io.writing import writing
 from auvplan.terrain.grid import BathymetryGrid, GridGeometry
 from auvplan.terrain.maps import MapParameters, TerrainMaps
@@ -73,6 +74,7 @@ def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
         ),
     }
     fine_dims, coarse_dims = ("north", "east"), ("north_block", "east_block")
+    datum = maps.bathymetry.attributes.get(VERTICAL_DATUM)
     data_vars = {
         "depth": xr.Variable(
             fine_dims,
@@ -82,6 +84,7 @@ def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
                 "standard_name": "sea_floor_depth_below_sea_surface",
                 "long_name": "depth of the sea floor (NaN: land or no data)",
                 "positive": "down",
+                **({VERTICAL_DATUM: datum} if datum is not None else {}),
             },
         ),
         "information": xr.Variable(
@@ -234,6 +237,7 @@ def read_maps_netcdf(path: str | Path) -> TerrainMaps:
             }
             projection = _local_frame(dataset, path)
             source = str(attrs.get("source", path.name))
+            datum = dataset["depth"].attrs.get(VERTICAL_DATUM)
             fine = GridGeometry(
                 north.size,
                 east.size,
@@ -254,7 +258,14 @@ def read_maps_netcdf(path: str | Path) -> TerrainMaps:
         float(north_block[0]),
         float(east_block[0]),
     )
-    bathymetry = BathymetryGrid(arrays["depth"], fine, projection, None, source)
+    bathymetry = BathymetryGrid(
+        arrays["depth"],
+        fine,
+        projection,
+        None,
+        source,
+        {VERTICAL_DATUM: str(datum)} if datum is not None else {},
+    )
     return TerrainMaps(
         bathymetry,
         arrays["information"],
