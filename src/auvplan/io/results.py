@@ -31,6 +31,9 @@ from auvplan.vehicle import INPUT_NAMES, STATE_NAMES
 
 #: The columns of an all-MEDUSA fleet, present in every ``trajectories.csv``.
 TRAJECTORY_COLUMNS: Final = ("vehicle", "t", *STATE_NAMES, *INPUT_NAMES, "power")
+#: Columns of a plan with a depth profile (``[mission] altitude_m``), after ``power``: the
+#: depth [m], positive down, and the altitude above the seabed [m].
+PROFILE_COLUMNS: Final = ("depth_m", "altitude_m")
 DESIRED_COLUMNS = ("vehicle", "t", "north", "east", "psi")
 
 
@@ -92,13 +95,17 @@ def union_names(per_vehicle: Sequence[Sequence[str]], first: Sequence[str]) -> t
 
 
 def trajectory_columns(
-    state_names: Sequence[Sequence[str]], input_names: Sequence[Sequence[str]]
+    state_names: Sequence[Sequence[str]],
+    input_names: Sequence[Sequence[str]],
+    *,
+    has_profile: bool = False,
 ) -> tuple[str, ...]:
     """Header of ``trajectories.csv`` for vehicles with these state and input names.
 
     ``vehicle, t``, the states (MEDUSA's :data:`~auvplan.vehicle.STATE_NAMES`, then the
     others in model order), the inputs likewise, ``power``; :data:`TRAJECTORY_COLUMNS` for an
-    all-MEDUSA fleet.
+    all-MEDUSA fleet. A plan with a depth profile (``[mission] altitude_m``) adds
+    :data:`PROFILE_COLUMNS` at the end.
 
     Examples
     --------
@@ -112,6 +119,7 @@ def trajectory_columns(
         *union_names(state_names, STATE_NAMES),
         *union_names(input_names, INPUT_NAMES),
         "power",
+        *(PROFILE_COLUMNS if has_profile else ()),
     )
 
 
@@ -125,6 +133,7 @@ def write_trajectories_csv(
     *,
     state_names: Sequence[Sequence[str]],
     input_names: Sequence[Sequence[str]],
+    profiles: Sequence[tuple[FloatArray, FloatArray]] | None = None,
 ) -> None:
     """Write ``trajectories.csv`` (columns :func:`trajectory_columns`) into a text stream.
 
@@ -144,6 +153,9 @@ def write_trajectories_csv(
         Each vehicle's electrical power [W].
     state_names, input_names : sequence of sequence of str
         Each vehicle's own state and input names.
+    profiles : sequence of (ndarray of shape (n_t,), ndarray of shape (n_t,)), optional
+        Each vehicle's depth [m] (positive down) and altitude above the seabed [m], written
+        as ``depth_m`` and ``altitude_m`` (a plan of ``[mission] altitude_m``).
 
     Raises
     ------
@@ -162,7 +174,7 @@ def write_trajectories_csv(
                 f"inconsistent shapes for vehicle {name}: time ({n_t},), states {state_shape}, "
                 f"inputs {input_shape}, power {np.shape(power[index])}"
             )
-    columns = trajectory_columns(state_names, input_names)
+    columns = trajectory_columns(state_names, input_names, has_profile=profiles is not None)
     writer = csv.writer(handle)
     writer.writerow(columns)
     for index, name in enumerate(names):
@@ -172,6 +184,9 @@ def write_trajectories_csv(
             **dict(zip(state_names[index], np.transpose(states[index]), strict=True)),
             **dict(zip(input_names[index], held.T, strict=True)),
             "power": power[index],
+            **(
+                {} if profiles is None else dict(zip(PROFILE_COLUMNS, profiles[index], strict=True))
+            ),
         }
         for k in range(n_t):
             writer.writerow(

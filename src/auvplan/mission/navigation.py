@@ -245,6 +245,7 @@ def vehicle_navigation(
     cruise_speed: float | None,
     vehicle_depth: float,
     weight: float,
+    altitude: float | None = None,
 ) -> tuple[VehicleNavigation, ...]:
     """The :class:`VehicleNavigation` of each vehicle.
 
@@ -265,9 +266,12 @@ def vehicle_navigation(
         Depth of the plan [m] (the altimeter's range is the seabed below it).
     weight : float
         ``weights.navigation`` [W/m²].
+    altitude : float, optional
+        ``mission.altitude_m`` [m]: the vehicles follow the seabed at this height instead of
+        flying at ``vehicle_depth`` (:func:`~auvplan.navigation.prediction.fisher_map`).
     """
     settings = navigation.settings(vehicle_depth=vehicle_depth)
-    fisher = fisher_map(maps.bathymetry, maps.cost_geometry, settings.sensor)
+    fisher = fisher_map(maps.bathymetry, maps.cost_geometry, settings.sensor, altitude=altitude)
     vehicles = []
     for name, model, distance in zip(names, models, straight, strict=True):
         fastest = top_speed(model)
@@ -326,19 +330,22 @@ def predict_tracks(
     headings: FloatArray,
     *,
     vehicle_depth: float,
+    depths: tuple[FloatArray, ...] | None = None,
 ) -> tuple[ErrorPrediction, ...]:
     """The predicted TAN error along each vehicle's flown track (the evaluator's model).
 
     ``navigation`` is the mission's ``[navigation]`` table; ``time`` ``(n_t,)`` [s],
     ``tracks`` ``(n_vehicles, n_t, 2)`` north/east [m], ``headings`` ``(n_vehicles, n_t)``
-    [rad]; ``vehicle_depth`` [m] the plan's depth.
+    [rad]; ``vehicle_depth`` [m] the plan's depth, or ``depths`` each vehicle's depth
+    profile ``(n_t,)`` [m] (:mod:`auvplan.mission.depth_profile`) when it varies.
     """
     settings = navigation.settings(vehicle_depth=vehicle_depth)
     if time[-1] - time[0] < settings.update_period:  # shorter than one update: the prior
         settings = dataclasses.replace(settings, update_period=float(time[-1] - time[0]))
+    profiles = depths if depths is not None else (None,) * len(tracks)
     return tuple(
-        predict_error(bathymetry, Track(time, track, heading), settings)
-        for track, heading in zip(tracks, headings, strict=True)
+        predict_error(bathymetry, Track(time, track, heading, depth), settings)
+        for track, heading, depth in zip(tracks, headings, profiles, strict=True)
     )
 
 

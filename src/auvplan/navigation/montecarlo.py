@@ -69,11 +69,15 @@ class Track:
         ``north, east`` [m].
     heading : ndarray of shape (n,)
         Heading [rad], clockwise from north (may wrap; it is unwrapped before interpolation).
+    depth : ndarray of shape (n,), optional
+        The vehicle's depth [m], positive down, when it varies along the track (a plan of
+        ``[mission] altitude_m``); ``None``: the sensor's constant ``vehicle_depth``.
     """
 
     time: FloatArray
     positions: FloatArray
     heading: FloatArray
+    depth: FloatArray | None = None
 
     def __post_init__(self) -> None:
         n = self.time.shape[0]
@@ -86,6 +90,10 @@ class Track:
             )
         if not np.all(np.isfinite(self.positions)) or not np.all(np.isfinite(self.heading)):
             raise InputError("track positions and heading must be finite")
+        if self.depth is not None and (
+            self.depth.shape != (n,) or not np.all(np.isfinite(self.depth) & (self.depth >= 0.0))
+        ):
+            raise InputError(f"track depth must be {n} finite depths >= 0 m")
         if not np.all(np.diff(self.time) > 0.0):
             raise InputError("track time must be strictly increasing")
 
@@ -119,7 +127,8 @@ class Track:
             [np.interp(time, self.time, self.positions[:, axis]) for axis in range(2)]
         )
         heading = np.interp(time, self.time, np.unwrap(self.heading))
-        return Track(time, positions, heading)
+        depth = None if self.depth is None else np.interp(time, self.time, self.depth)
+        return Track(time, positions, heading, depth)
 
 
 @dataclass(frozen=True)
@@ -262,7 +271,9 @@ def run_monte_carlo(
     check_monte_carlo(track, settings, n_runs=n_runs, seed=seed)
     samples = track.sampled(settings.update_period)
     truth = samples.positions
-    offsets, variances = beam_geometry(settings.sensor, grid, truth, samples.heading)
+    offsets, variances = beam_geometry(
+        settings.sensor, grid, truth, samples.heading, vehicle_depth=samples.depth
+    )
     if np.all(np.isnan(variances[0])):
         raise InputError(
             f"the track starts at north {truth[0, 0]:.1f} m, east {truth[0, 1]:.1f} m, "

@@ -42,6 +42,7 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.navigation._prediction_kernel import covariance_recursion
+from auvplan.navigation.depth import depth_at
 from auvplan.navigation.montecarlo import NavigationSettings, Track
 from auvplan.navigation.motion import process_noise_sigma
 from auvplan.navigation.pcrb import sounding_information, unpack_covariance
@@ -119,7 +120,9 @@ def predict_error(
     """
     samples = track.sampled(settings.update_period)
     positions = samples.positions
-    offsets, variances = beam_geometry(settings.sensor, grid, positions, samples.heading)
+    offsets, variances = beam_geometry(
+        settings.sensor, grid, positions, samples.heading, vehicle_depth=samples.depth
+    )
     fisher = sounding_information(grid, positions, offsets, variances)
     steps = np.diff(positions, axis=0)
     packed = covariance_recursion(
@@ -133,7 +136,12 @@ def predict_error(
 
 
 def fisher_map(
-    grid: BathymetryGrid, geometry: GridGeometry, sensor: SensorModel, *, samples: int = 2
+    grid: BathymetryGrid,
+    geometry: GridGeometry,
+    sensor: SensorModel,
+    *,
+    samples: int = 2,
+    altitude: float | None = None,
 ) -> FloatArray:
     r"""Per-update Fisher information :math:`F` [1/m²] of every cell of ``geometry``.
 
@@ -141,7 +149,9 @@ def fisher_map(
     ``samples`` points spread evenly inside each cell (the seabed a vehicle crossing the cell
     sounds); for a swath sensor also over the headings :data:`SWATH_HEADINGS` (the
     heading-averaged information; an altimeter's does not depend on heading). Cells without
-    a sounding (land, no data, off the map) get 0.
+    a sounding (land, no data, off the map) get 0. With ``altitude`` [m] the vehicle follows
+    the seabed at that height (``[mission] altitude_m``; depth ``max(h - altitude, 0)``)
+    instead of flying at the sensor's constant ``vehicle_depth``.
 
     Returns
     -------
@@ -158,8 +168,15 @@ def fisher_map(
     points = np.column_stack([north.ravel(), east.ravel()])
     headings = SWATH_HEADINGS if sensor.n_beams > 1 else (0.0,)
     total = np.zeros((points.shape[0], 2, 2))
+    depth = None
+    if altitude is not None:
+        depth = np.maximum(
+            np.nan_to_num(depth_at(grid, points[:, 0], points[:, 1])) - altitude, 0.0
+        )
     for heading in headings:
-        offsets, variances = beam_geometry(sensor, grid, points, np.full(points.shape[0], heading))
+        offsets, variances = beam_geometry(
+            sensor, grid, points, np.full(points.shape[0], heading), vehicle_depth=depth
+        )
         total += sounding_information(grid, points, np.nan_to_num(offsets), variances)
     mean = total.reshape(*geometry.shape, samples * samples, 2, 2).mean(axis=2) / len(headings)
     return np.ascontiguousarray(mean[..., [0, 0, 1], [0, 1, 1]])

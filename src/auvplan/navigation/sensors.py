@@ -106,6 +106,8 @@ def beam_geometry(
     grid: BathymetryGrid,
     positions: FloatArray,
     heading: FloatArray,
+    *,
+    vehicle_depth: FloatArray | None = None,
 ) -> tuple[FloatArray, FloatArray]:
     """Footprint offsets and likelihood variances of every beam along a track.
 
@@ -119,6 +121,9 @@ def beam_geometry(
         True positions ``north, east`` [m].
     heading : ndarray of shape (n,)
         Heading [rad], clockwise from north.
+    vehicle_depth : ndarray of shape (n,), optional
+        The vehicle's depth [m] at each position (a depth profile); ``None``: the sensor's
+        constant ``vehicle_depth``. The altitude is the seabed depth minus it.
 
     Returns
     -------
@@ -128,7 +133,8 @@ def beam_geometry(
     variances : ndarray of shape (n, n_beams)
         ``map_variance + (range_error_fraction * range)²`` [m²].
     """
-    altitude = depth_at(grid, positions[:, 0], positions[:, 1]) - sensor.vehicle_depth
+    depth = sensor.vehicle_depth if vehicle_depth is None else vehicle_depth
+    altitude = depth_at(grid, positions[:, 0], positions[:, 1]) - depth
     altitude = np.where(altitude > 0.0, altitude, np.nan)
     angles = sensor.beam_angles
     across = altitude[:, None] * np.tan(angles)[None, :]

@@ -20,6 +20,7 @@ import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError
+from auvplan.io.results import PROFILE_COLUMNS
 from auvplan.record.summary import VehicleSummary
 
 #: Margin on a vehicle's top speed [-] beyond which a row is not a plan of that vehicle.
@@ -47,6 +48,11 @@ class VehicleTrajectory:
         Inputs named by ``input_names`` [-], held over each step.
     power : ndarray of shape (n_t,)
         Electrical power [W].
+    depth, altitude : ndarray of shape (n_t,), optional
+        The depth profile of a plan of ``[mission] altitude_m``
+        (:mod:`auvplan.mission.depth_profile`): depth [m], positive down, and height above
+        the seabed [m] (``trajectories.csv``'s ``depth_m``, ``altitude_m``); ``None`` for a
+        plan flown at the constant ``depth_m``.
     """
 
     name: str
@@ -56,6 +62,8 @@ class VehicleTrajectory:
     states: FloatArray
     inputs: FloatArray
     power: FloatArray
+    depth: FloatArray | None = None
+    altitude: FloatArray | None = None
 
     def state(self, name: str) -> FloatArray:
         """The time series of state ``name``, shape ``(n_t,)``."""
@@ -77,13 +85,35 @@ class VehicleTrajectory:
         return float(np.trapezoid(self.power, self.time))
 
 
+def depth_profiles(
+    tables: tuple[VehicleTrajectory, ...],
+) -> list[tuple[FloatArray, FloatArray]] | None:
+    """Each vehicle's ``(depth, altitude)`` [m] of a plan with a depth profile, else ``None``.
+
+    Raises
+    ------
+    DataFormatError
+        If some vehicles have a profile and others not.
+    """
+    pairs = [(table.depth, table.altitude) for table in tables]
+    complete = [
+        (depth, altitude) for depth, altitude in pairs if depth is not None and altitude is not None
+    ]
+    if not complete:
+        return None
+    if len(complete) != len(pairs):
+        raise DataFormatError("a depth profile (depth_m, altitude_m) for some vehicles only")
+    return complete
+
+
 def read_trajectory_tables(
     path: Path, vehicles: Sequence[VehicleSummary], *, max_current: float
 ) -> tuple[VehicleTrajectory, ...]:
     """Read a ``trajectories.csv`` of the vehicles ``vehicles`` (in their order).
 
     Each vehicle's rows must hold a finite number in each of its own columns (``t``, its
-    ``state_names``, ``input_names``, ``power``) and nothing in the others; its time must
+    ``state_names``, ``input_names``, ``power``, and ``depth_m``, ``altitude_m`` when the
+    table has them) and nothing in the others; its time must
     increase over at least 2 rows; its speed through the water ``hypot(u, v)`` must stay
     within :data:`SPEED_MARGIN` times its top speed, and each step within
     ``SPEED_MARGIN * (top speed + max_current) * dt``. (A summary written before auvplan
@@ -151,7 +181,8 @@ def _vehicle_table(
             f"{path} vehicle {vehicle.name!r}: its states {', '.join(state_names)} lack "
             f"{lacking[0]!r} (every vehicle has {', '.join(BODY_STATES)})"
         )
-    own = ("t", *state_names, *input_names, "power")
+    profile = tuple(name for name in PROFILE_COLUMNS if name in header)
+    own = ("t", *state_names, *input_names, "power", *profile)
     missing = [name for name in own if name not in header]
     if missing:
         raise DataFormatError(f"{path}: no column {missing[0]!r} of vehicle {vehicle.name!r}")
@@ -171,15 +202,20 @@ def _vehicle_table(
                 f"{path} line {line}: vehicle {vehicle.name!r} has no state "
                 f"{header[filled]!r}, but the cell holds {row[filled]!r}"
             )
-    n_x = len(state_names)
+    if profile and profile != PROFILE_COLUMNS:
+        raise DataFormatError(f"{path}: {profile[0]!r} without {PROFILE_COLUMNS}")
+    n_x, n_p = len(state_names), len(profile)
+    power = table[:, own.index("power")]
     trajectory = VehicleTrajectory(
         vehicle.name,
         state_names,
         input_names,
         table[:, 0],
         table[:, 1 : 1 + n_x],
-        table[:-1, 1 + n_x : -1],
-        table[:, -1],
+        table[:-1, 1 + n_x : -1 - n_p],
+        power,
+        depth=table[:, -2] if n_p else None,
+        altitude=table[:, -1] if n_p else None,
     )
     lines = [line for line, _ in rows]
     _check_motion(path, lines, vehicle, trajectory, max_current)
@@ -254,4 +290,10 @@ def _number(text: str, where: str, vehicle: str, column: str) -> float:
     return value
 
 
-__all__ = ["BODY_STATES", "SPEED_MARGIN", "VehicleTrajectory", "read_trajectory_tables"]
+__all__ = [
+    "BODY_STATES",
+    "SPEED_MARGIN",
+    "VehicleTrajectory",
+    "depth_profiles",
+    "read_trajectory_tables",
+]

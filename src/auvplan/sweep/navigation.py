@@ -124,7 +124,8 @@ def evaluate_folder(
         )
     plans = {
         label: {
-            v.name: VehiclePlan(Track(v.time, v.positions, v.heading), v.energy) for v in vehicles
+            v.name: VehiclePlan(Track(v.time, v.positions, v.heading, v.depth), v.energy)
+            for v in vehicles
         }
         for label, vehicles in record.plans.items()
     }

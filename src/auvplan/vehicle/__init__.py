@@ -92,6 +92,7 @@ from auvplan.vehicle.trim import (
     trim_turn,
     vehicle_characteristics,
 )
+from auvplan.vehicle.vertical import DepthLimits
 
 __all__ = [
     "INPUT_NAMES",
@@ -105,6 +106,7 @@ __all__ = [
     "ControlSurfaceParams",
     "CrossFlowParams",
     "CruiseOptimum",
+    "DepthLimits",
     "HullParams",
     "LinearPropellerParams",
     "MotorParams",
