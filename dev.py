@@ -36,7 +36,7 @@ def _run(*args: str | Path) -> None:
 
 
 def ensure_environment() -> None:
-    """Create ``.venv`` and install auvplan with its test extras, unless already current."""
+    """Create ``.venv`` and install auvplan with its test, bench and gis extras, unless current."""
     if sys.version_info < (3, 11):  # noqa: UP036  (dev.py may be started by an old python3)
         sys.exit(f"auvplan needs Python >= 3.11, this is {sys.version.split()[0]}")
     key = hashlib.sha256((ROOT / "pyproject.toml").read_bytes()).hexdigest()
@@ -47,7 +47,7 @@ def ensure_environment() -> None:
         venv.EnvBuilder(with_pip=True).create(VENV)
     print("dev.py: installing auvplan and its test dependencies into .venv", flush=True)
     _run(PYTHON, "-m", "pip", "install", "--quiet", "--upgrade", "pip")
-    _run(PYTHON, "-m", "pip", "install", "--quiet", "-e", ".[test,bench]")
+    _run(PYTHON, "-m", "pip", "install", "--quiet", "-e", ".[test,bench,gis]")
     STAMP.write_text(key)
 
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Final
+from typing import Any, Final, TypeVar
 
 from pydantic import Field, ValidationError, model_validator
 
@@ -23,6 +23,7 @@ from auvplan.errors import InputError
 from auvplan.io.tables import TableModel, one_line
 from auvplan.io.text import read_toml
 from auvplan.mission.tables import (
+    AreaConfig,
     CommConfig,
     CurrentConfig,
     DeconflictionConfig,
@@ -30,6 +31,7 @@ from auvplan.mission.tables import (
     FleetConfig,
     GoalPose,
     MapsConfig,
+    MetadataConfig,
     NavigationConfig,
     ObstacleConfig,
     PlannerConfig,
@@ -42,6 +44,8 @@ from auvplan.mission.tables import (
     WindowConfig,
 )
 
+#: The label of the operating area among the obstacles (messages, separations, summary).
+AREA_NAME: Final = "operating area"
 #: Most solver steps a mission may ask for (``horizon_s / dt_s``) before anything is allocated.
 MAX_SOLVER_STEPS: Final = 200_000
 
@@ -54,6 +58,7 @@ class MissionConfig(TableModel):
     fleet: FleetConfig
     vehicles: tuple[VehicleConfig, ...] = Field(alias="vehicle", min_length=1, max_length=64)
     obstacles: tuple[ObstacleConfig, ...] = Field((), alias="obstacle", max_length=1000)
+    area: AreaConfig | None = Field(None, description="operating area (absent: the whole map)")
     comms: tuple[CommConfig, ...] = Field((), alias="comm", max_length=1000)
     weights: WeightsConfig = Field(default_factory=WeightsConfig)
     planner: PlannerConfig = Field(default_factory=PlannerConfig)
@@ -62,6 +67,9 @@ class MissionConfig(TableModel):
     solver: SolverConfig = Field(default_factory=SolverConfig)
     mission: ExecutionConfig = Field(default_factory=ExecutionConfig)
     current: CurrentConfig | None = Field(None, description="ocean current (absent: still water)")
+    metadata: MetadataConfig = Field(
+        default_factory=MetadataConfig, description="who made the plan (trajectories.nc)"
+    )
     source: Path | None = Field(None, exclude=True, description="the mission file (not a key)")
 
     @model_validator(mode="before")
@@ -81,7 +89,7 @@ class MissionConfig(TableModel):
     @model_validator(mode="after")
     def _cross_checks(self) -> MissionConfig:
         names = [vehicle.name for vehicle in self.vehicles]
-        labels = names + list(self.obstacle_names)
+        labels = names + list(self.obstacle_names) + ([AREA_NAME] if self.area else [])
         repeated = sorted({label for label in labels if labels.count(label) > 1})
         if repeated:
             raise ValueError(f"vehicle and obstacle names must be unique: {', '.join(repeated)}")
@@ -159,15 +167,18 @@ def parse_mission(
         current = current.model_copy(update={"file": base_dir / current.file})
         config = config.model_copy(update={"current": current})
     vehicles = tuple(_resolve_vehicle_file(vehicle, base_dir) for vehicle in config.vehicles)
-    return config.model_copy(update={"vehicles": vehicles})
+    obstacles = tuple(_beside(obstacle, base_dir) for obstacle in config.obstacles)
+    area = None if config.area is None else _beside(config.area, base_dir)
+    return config.model_copy(update={"vehicles": vehicles, "obstacles": obstacles, "area": area})
 
 
 def resolved_document(config: MissionConfig) -> dict[str, Any]:
     """The mission as a TOML document: every default filled in, every file path absolute.
 
-    Written as ``mission.toml`` into each output folder, so that ``auvplan plan
-    OUTPUT/mission.toml`` runs the same mission (same start time) from anywhere.
-    :func:`parse_mission` of the document gives back ``config`` (less its ``source``).
+    :func:`parse_mission` of the document gives back ``config`` (less its ``source``). An
+    output folder's ``mission.toml`` is this document with every file one of the folder's
+    (:func:`auvplan.mission.carry.carried_mission`), so that ``auvplan plan
+    OUTPUT/mission.toml`` runs the same mission (same start time) from any copy of the folder.
 
     Examples
     --------
@@ -202,6 +213,16 @@ def _toml_values(value: Any) -> Any:
     return value
 
 
+_GisTable = TypeVar("_GisTable", ObstacleConfig, AreaConfig)
+
+
+def _beside(table: _GisTable, base_dir: Path) -> _GisTable:
+    """``table`` with a relative GIS ``file`` made relative to the mission's folder."""
+    if table.file is None or table.file.is_absolute():
+        return table
+    return table.model_copy(update={"file": base_dir / table.file})
+
+
 def _resolve_vehicle_file(vehicle: VehicleConfig, base_dir: Path) -> VehicleConfig:
     """A ``type`` naming an existing file next to the mission is made absolute."""
     candidate = base_dir / vehicle.type
@@ -211,6 +232,8 @@ def _resolve_vehicle_file(vehicle: VehicleConfig, base_dir: Path) -> VehicleConf
 
 
 __all__ = [
+    "AREA_NAME",
+    "AreaConfig",
     "CommConfig",
     "CurrentConfig",
     "DeconflictionConfig",
@@ -218,6 +241,7 @@ __all__ = [
     "FleetConfig",
     "GoalPose",
     "MapsConfig",
+    "MetadataConfig",
     "MissionConfig",
     "NavigationConfig",
     "ObstacleConfig",

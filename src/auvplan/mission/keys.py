@@ -42,6 +42,8 @@ class KeyReference:
 
 
 def _type_name(annotation: Any) -> str:
+    if hasattr(annotation, "__metadata__"):  # Annotated: the type it annotates
+        return _type_name(get_args(annotation)[0])
     origin = get_origin(annotation)
     if origin is Literal:
         return " | ".join(repr(value) for value in get_args(annotation))
@@ -53,9 +55,8 @@ def _type_name(annotation: Any) -> str:
         if len(arguments) == 2 and arguments[1] is Ellipsis:
             return f"[{_type_name(arguments[0])}, ...]"
         return "[" + ", ".join(_type_name(a) for a in arguments) + "]"
-    base = get_args(annotation)[0] if hasattr(annotation, "__metadata__") else annotation
     return {float: "number", int: "integer", bool: "boolean", str: "string"}.get(
-        base, getattr(base, "__name__", str(base))
+        annotation, getattr(annotation, "__name__", str(annotation))
     )
 
 

@@ -21,19 +21,19 @@ from auvplan.mission.config import (
     MapsConfig,
     MissionConfig,
     PlannerConfig,
-    Position,
     TerrainConfig,
 )
 from auvplan.mission.current import cell_currents, current_move_factor, load_current
 from auvplan.mission.models import vehicle_model
 from auvplan.mission.navigation import NavigationChoice, VehicleNavigation, vehicle_navigation
 from auvplan.mission.progress import ProgressReporter, no_progress
+from auvplan.mission.zones import resolve_obstacles, resolve_position
 from auvplan.navigation.depth import depth_at
 from auvplan.ocean import CurrentField
 from auvplan.planning import (
     CircleObstacle,
     EdgeModel,
-    PolygonObstacle,
+    Obstacle,
     Route,
     blocked_cells,
     blocked_lookup,
@@ -55,8 +55,6 @@ CORNER_CUT: Final = math.sqrt(2.0) - 1.0
 #: Radius of the disc about another vehicle's goal that a path skirts, per ``2 r_c`` (10 %
 #: over the deconfliction grid's largest margin, 5 % of ``2 r_c``, plus the chords' sagitta).
 GOAL_SKIRT: Final = 1.2
-
-Obstacle = CircleObstacle | PolygonObstacle
 
 
 @dataclass(frozen=True)
@@ -151,31 +149,6 @@ def compute_maps(bathymetry: BathymetryGrid, maps: MapsConfig) -> TerrainMaps:
     return compute_terrain_maps(bathymetry, parameters)
 
 
-def resolve_position(position: Position, grid: BathymetryGrid, what: str) -> tuple[float, float]:
-    """``north, east`` [m] of a local or geographic position on ``grid``."""
-    first, second = position.coordinates
-    if not position.is_geographic:
-        return first, second
-    if grid.projection is None:
-        raise InputError(f"{what} is given in lat/lon but the terrain has no geographic reference")
-    north, east = grid.projection.to_local(np.array([first]), np.array([second]))
-    return float(north[0]), float(east[0])
-
-
-def resolve_obstacles(
-    config: MissionConfig, grid: BathymetryGrid
-) -> tuple[tuple[Obstacle, ...], tuple[str, ...]]:
-    """The mission's obstacles in the map frame, and their labels."""
-    obstacles: list[Obstacle] = []
-    for obstacle, name in zip(config.obstacles, config.obstacle_names, strict=True):
-        if obstacle.polygon is not None:
-            obstacles.append(PolygonObstacle(np.array(obstacle.polygon, dtype=np.float64)))
-        else:
-            north, east = resolve_position(obstacle.circle[0], grid, f"{name} center")
-            obstacles.append(CircleObstacle(north, east, obstacle.circle[1]))
-    return tuple(obstacles), config.obstacle_names
-
-
 #: A goal closer than this [m] to its vehicle's start is that start: the path between them has
 #: no direction to smooth, to leave the start along or to time (a mission moves every vehicle).
 MIN_TRAVEL: Final = 1e-3
@@ -222,6 +195,32 @@ def check_depth_above_seabed(
         f"{float(np.nanmax(bathymetry.depth)):.1f} m over the map): give depth_m < "
         f"{math.floor(10.0 * shallowest[index]) / 10.0:g} m"
     )
+
+
+def check_seabed_clearance(
+    min_altitudes: tuple[float, ...],
+    bathymetry: BathymetryGrid,
+    names: tuple[str, ...],
+    paths: tuple[FloatArray, ...],
+) -> None:
+    """Raise InputError where a path's seabed is shallower than its vehicle's minimum altitude.
+
+    For ``[mission] altitude_m`` plans: vehicle ``i`` stays at least ``min_altitudes[i]`` [m]
+    (its ``[vertical] min_altitude``) above the seabed and never above the surface, which is
+    impossible where the seabed (the bilinear depth of ``bathymetry`` at the points of
+    ``paths[i]``, each ``(n_points, 2)`` north/east [m]) is shallower than that.
+    """
+    for name, path, clearance in zip(names, paths, min_altitudes, strict=True):
+        seabed = depth_at(bathymetry, path[:, 0], path[:, 1])
+        if not np.nanmin(seabed) < clearance:
+            continue
+        point = path[int(np.nanargmin(seabed))]
+        raise InputError(
+            f"{name}'s path crosses a seabed {float(np.nanmin(seabed)):.1f} m deep at north "
+            f"{point[0]:.0f} m, east {point[1]:.0f} m, shallower than its vehicle's "
+            f"[vertical] min_altitude = {clearance:g} m: move its start or goal, add an "
+            "obstacle over the shoal, or use a vehicle file with a smaller min_altitude"
+        )
 
 
 def check_communication_ranges(
@@ -514,7 +513,7 @@ def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progre
         navigation = vehicle_navigation(
             maps, config.navigation, names, models, np.hypot(*(goals[:, :2] - starts[:, :2]).T),
             horizon=config.fleet.horizon, cruise_speed=cruise, vehicle_depth=config.mission.depth,
-            weight=config.weights.navigation,
+            weight=config.weights.navigation, altitude=config.mission.altitude,
         )  # fmt: skip
     routes, paths, choices = plan_routes(
         maps, names, starts, goals, obstacles, obstacle_names=obstacle_names,
@@ -529,7 +528,11 @@ def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progre
         ),
         progress=progress,
     )  # fmt: skip
-    check_depth_above_seabed(config.mission.depth, bathymetry, names, paths)
+    if config.mission.altitude is None:
+        check_depth_above_seabed(config.mission.depth, bathymetry, names, paths)
+    else:
+        clearances = tuple(model.vehicle.depth_limits.min_altitude for model in models)
+        check_seabed_clearance(clearances, bathymetry, names, paths)
     return PreplanStage(
         bathymetry=bathymetry,
         maps=maps,

@@ -13,9 +13,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Final, Literal
 
 from pydantic import (
+    Discriminator,
     Field,
     SerializerFunctionWrapHandler,
     Strict,
+    Tag,
     field_validator,
     model_serializer,
     model_validator,
@@ -221,9 +223,17 @@ class VehicleConfig(TableModel):
         return self
 
 
+def _vertex_kind(value: Any) -> str:
+    return "table" if isinstance(value, dict | Position) else "tuple[north, east]"
+
+
 #: A polygon vertex: ``[north, east]`` [m], or a table ``{ lat = .., lon = .. }`` [deg]
-#: (``{ north = .., east = .. }`` too); every vertex of a polygon in the same frame.
-Vertex = tuple[Number, Number] | Position
+#: (``{ north = .., east = .. }`` too); every vertex of a polygon in the same frame. The
+#: tags route a bad vertex's error to its own form (``one_line`` drops the ``tuple[`` tag).
+Vertex = Annotated[
+    Annotated[tuple[Number, Number], Tag("tuple[north, east]")] | Annotated[Position, Tag("table")],
+    Discriminator(_vertex_kind),
+]
 
 #: Description of the ``file`` key of ``[[obstacle]]`` and ``[area]``.
 _GIS_FILE: Final = (

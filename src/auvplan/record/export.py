@@ -15,7 +15,7 @@ from auvplan.errors import InputError
 from auvplan.export.plan import CircleZone, ExportPlan, PolygonZone, VehicleTrack
 from auvplan.record.files import MAIN_PLAN
 from auvplan.record.folder import PlanRecord
-from auvplan.record.summary import Obstacle, PolygonObstacle
+from auvplan.record.summary import AreaObstacle, CircleObstacle, PolygonObstacle
 
 logger = logging.getLogger(__name__)
 
@@ -23,12 +23,15 @@ logger = logging.getLogger(__name__)
 def export_plan(record: PlanRecord) -> ExportPlan:
     """The optimised plan of ``record``, ready to export.
 
+    On terrain without geographic reference (the synthetic bank) the plan has no lat/lon
+    and no keep-out zones: only :func:`auvplan.export.check_georeference`'s formats are
+    written of it.
+
     Raises
     ------
     InputError
         If the record holds no optimised plan (``--stage`` stopped early or the optimiser
-        failed) or its terrain has no geographic reference (the synthetic bank): exports need
-        lat/lon.
+        failed).
     """
     summary = record.summary
     outcome = summary.optimization
@@ -37,11 +40,8 @@ def export_plan(record: PlanRecord) -> ExportPlan:
         raise InputError(f"the record holds no optimised plan ({reason}); nothing to export")
     projection = record.maps.bathymetry.projection
     origin = summary.terrain.origin
-    if projection is None or origin.lat is None or origin.lon is None:
-        raise InputError(
-            f"the plan is on terrain without geographic reference ({summary.terrain.name}); "
-            "exports need lat/lon: plan on a georeferenced grid"
-        )
+    if origin.lat is None or origin.lon is None:
+        projection = None
     if outcome.plan_status != "CONVERGED":
         logger.warning(
             "the plan is %s (see summary.json): check it before a vehicle flies it",
@@ -50,21 +50,30 @@ def export_plan(record: PlanRecord) -> ExportPlan:
     tracks = []
     for table in record.plans[MAIN_PLAN]:
         north, east = table.state("north"), table.state("east")
-        lat, lon = projection.to_geographic(north, east)
-        tracks.append(VehicleTrack(table.name, table.time, north, east, lat, lon))
+        lat, lon = (None, None) if projection is None else projection.to_geographic(north, east)
+        tracks.append(VehicleTrack(table.name, table.time, north, east, lat, lon, table.depth))
     return ExportPlan(
         tracks=tuple(tracks),
         start_time=summary.start,
         depth=record.depth,
-        origin_lat=origin.lat,
-        origin_lon=origin.lon,
+        origin_lat=None if projection is None else origin.lat,
+        origin_lon=None if projection is None else origin.lon,
         capture_radius=summary.fleet.safety_radius_m,
-        zones=tuple(_zone(obstacle) for obstacle in summary.obstacles),
+        zones=()
+        if projection is None
+        else tuple(  # the operating area is kept in, not out
+            _zone(obstacle)
+            for obstacle in summary.obstacles
+            if not isinstance(obstacle, AreaObstacle)
+        ),
     )
 
 
-def _zone(obstacle: Obstacle) -> CircleZone | PolygonZone:
-    """A keep-out zone from an obstacle of ``summary.json`` (lat/lon required)."""
+def _zone(obstacle: CircleObstacle | PolygonObstacle) -> CircleZone | PolygonZone:
+    """A keep-out zone from an obstacle of ``summary.json`` (lat/lon required).
+
+    A polygon's holes are not exported: its zone keeps out of them too (on the safe side).
+    """
     if isinstance(obstacle, PolygonObstacle):
         corners = [(v.lat, v.lon) for v in obstacle.vertices]
         if any(lat is None or lon is None for lat, lon in corners):

@@ -1,0 +1,258 @@
+"""No-go zones from GIS files and the operating area, through the whole mission.
+
+A GeoJSON zone (EPSG:4326) and a shapefile zone in UTM (EPSG:32610) are avoided with
+clearance ``r_c`` by the pre-planned paths and, in the slow suite, by the optimised plan's
+closed-loop replay; an operating area keeps every path ``r_c`` inside it; holes are free
+water in a zone and islands in an area; the verdict names a replay that leaves the area.
+"""
+
+from __future__ import annotations
+
+import json
+import tomllib
+import warnings
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+import pytest
+import shapely
+import xarray as xr
+from pyproj import Transformer
+from shapely.geometry import LineString, Polygon, mapping
+
+from auvplan.cli.main import main
+from auvplan.io.bathymetry import read_bathymetry
+from auvplan.mission.checks import PlanStatus, judge_plan
+from auvplan.mission.config import AREA_NAME, parse_mission
+from auvplan.record.labels import Pair
+from auvplan.terrain import LocalProjection
+
+SAFETY_RADIUS = 5.0
+#: Zones and areas as local ``[north, east]`` [m] rings on the 500 m grid of ``write_grid``.
+REEF = np.array([[130.0, 215.0], [130.0, 285.0], [170.0, 285.0], [170.0, 215.0]])
+WRECK = np.array([[195.0, 250.0], [195.0, 320.0], [225.0, 320.0], [225.0, 250.0]])
+CORRIDOR = np.array([[30.0, 170.0], [30.0, 330.0], [290.0, 330.0], [290.0, 170.0]])
+
+
+def write_grid(path: Path) -> LocalProjection:
+    """A 500 m x 500 m lat/lon grid (about 5 m cells), depths 20-40 m; its local frame."""
+    lat = np.linspace(36.790, 36.7945, 91)
+    lon = np.linspace(-121.815, -121.8094, 101)
+    north = (lat[:, None] - lat[0]) * 111_000.0
+    east = (lon[None, :] - lon[0]) * 89_000.0
+    elevation = -(30.0 + 10.0 * np.sin(north / 40.0) * np.cos(east / 55.0))
+    xr.Dataset(
+        {"elevation": (("lat", "lon"), elevation, {"units": "m"})},
+        coords={
+            "lat": ("lat", lat, {"units": "degrees_north"}),
+            "lon": ("lon", lon, {"units": "degrees_east"}),
+        },
+    ).to_netcdf(path)
+    projection = read_bathymetry(path).projection
+    assert projection is not None
+    return projection
+
+
+def geographic(projection: LocalProjection, ring: np.ndarray, *holes: np.ndarray) -> Polygon:
+    """A local polygon [m] as a (lon, lat) shapely polygon."""
+
+    def lon_lat(points: np.ndarray) -> list[tuple[float, float]]:
+        lat, lon = projection.to_geographic(points[:, 0], points[:, 1])
+        return list(zip(lon.tolist(), lat.tolist(), strict=True))
+
+    return Polygon(lon_lat(ring), [lon_lat(hole) for hole in holes])
+
+
+def write_geojson(path: Path, polygon: Polygon) -> str:
+    feature = {"type": "Feature", "properties": {}, "geometry": mapping(polygon)}
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [feature]}))
+    return path.name
+
+
+def write_utm_shapefile(path: Path, polygon: Polygon) -> str:
+    """``polygon`` (lon/lat) as a shapefile in UTM zone 10 N (EPSG:32610), with pyogrio."""
+    pyogrio = pytest.importorskip("pyogrio")
+    transformer = Transformer.from_crs("EPSG:4326", "EPSG:32610", always_xy=True)
+    utm = shapely.transform(polygon, lambda xy: np.column_stack(transformer.transform(*xy.T)))
+    wkb = np.array([shapely.to_wkb(utm)], dtype=object)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        pyogrio.raw.write(
+            path, wkb, [], [], geometry_type="Polygon", crs="EPSG:32610", driver="ESRI Shapefile"
+        )
+    return path.name
+
+
+def mission_text(start: tuple[float, float], goal: tuple[float, float], tables: str) -> str:
+    return f"""
+[terrain]
+file = "grid.nc"
+[fleet]
+horizon_s = 300.0
+safety_radius_m = {SAFETY_RADIUS}
+[[vehicle]]
+name = "blue"
+start = {{ north = {start[0]}, east = {start[1]}, speed = 0.5 }}
+goal = {{ north = {goal[0]}, east = {goal[1]} }}
+[planner]
+edge_model = "crossed"
+[solver]
+dt_s = 1.0
+{tables}
+"""
+
+
+def lat_lon_vertices(projection: LocalProjection, ring: np.ndarray) -> str:
+    lat, lon = projection.to_geographic(ring[:, 0], ring[:, 1])
+    pairs = zip(lat.tolist(), lon.tolist(), strict=True)
+    return ", ".join(f"{{ lat = {a!r}, lon = {o!r} }}" for a, o in pairs)
+
+
+def reef_wreck_corridor(root: Path) -> Path:
+    """A mission whose straight line crosses a GeoJSON reef, past a UTM shapefile wreck,
+    inside a lat/lon corridor (the operating area)."""
+    projection = write_grid(root / "grid.nc")
+    reef = write_geojson(root / "reef.geojson", geographic(projection, REEF))
+    wreck = write_utm_shapefile(root / "wreck.shp", geographic(projection, WRECK))
+    tables = f"""
+[[obstacle]]
+name = "reef"
+file = "{reef}"
+[[obstacle]]
+name = "wreck"
+file = "{wreck}"
+[area]
+polygon = [{lat_lon_vertices(projection, CORRIDOR)}]
+"""
+    path = root / "mission.toml"
+    path.write_text(mission_text((60.0, 250.0), (260.0, 250.0), tables))
+    return path
+
+
+def preplan(mission: Path) -> dict[str, Any]:
+    out = mission.parent / "out"
+    assert main(["-q", "plan", str(mission), "-o", str(out), "--stage", "preplan"]) == 0
+    summary: dict[str, Any] = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    return summary
+
+
+def path_of(summary: dict[str, Any]) -> np.ndarray:
+    return np.asarray(summary["vehicles"][0]["preplan"]["points_north_east_m"], dtype=float)
+
+
+def clearance(path: np.ndarray, region: Polygon) -> float:
+    """Least distance [m] of the path's points to ``region`` (local, x = east, y = north)."""
+    return float(np.min(shapely.distance(region, shapely.points(path[:, 1], path[:, 0]))))
+
+
+def inside_by(path: np.ndarray, area: Polygon) -> float:
+    """Least distance [m] of the path's points inside ``area`` from its boundary (< 0: out)."""
+    points = shapely.points(path[:, 1], path[:, 0])
+    distance = shapely.distance(area.boundary, points)
+    return float(np.min(np.where(area.contains(points), distance, -distance)))
+
+
+def local(ring: np.ndarray, *holes: np.ndarray) -> Polygon:
+    return Polygon(ring[:, ::-1], [hole[:, ::-1] for hole in holes])
+
+
+def test_gis_zones_and_a_lat_lon_area_shape_the_preplanned_path(tmp_path: Path) -> None:
+    summary = preplan(reef_wreck_corridor(tmp_path))
+    path = path_of(summary)
+    straight = LineString([(250.0, 60.0), (250.0, 260.0)])
+    assert straight.intersects(local(REEF))  # the zone is in the way
+    assert clearance(path, local(REEF)) >= SAFETY_RADIUS
+    assert clearance(path, local(WRECK)) >= SAFETY_RADIUS
+    assert inside_by(path, local(CORRIDOR)) >= SAFETY_RADIUS
+    shapes = {obstacle["name"]: obstacle for obstacle in summary["obstacles"]}
+    assert set(shapes) == {"reef feature 0", "wreck feature 0", AREA_NAME}
+    assert shapes[AREA_NAME]["shape"] == "area"
+    # the UTM shapefile and the lat/lon vertices land where they were drawn (pyproj, to 1 mm)
+    for name, ring in (("wreck feature 0", WRECK), (AREA_NAME, CORRIDOR)):
+        drawn = np.array([(v["north"], v["east"]) for v in shapes[name]["vertices"]])
+        assert local(drawn).symmetric_difference(local(ring)).area < 1e-3 * local(ring).length
+
+
+def test_an_l_shaped_area_file_keeps_the_path_off_the_short_cut(tmp_path: Path) -> None:
+    """The straight line leaves the L; the path keeps r_c inside it, around its island."""
+    projection = write_grid(tmp_path / "grid.nc")
+    ell = np.array(
+        [[40.0, 60.0], [40.0, 440.0], [160.0, 440.0], [160.0, 160.0], [330.0, 160.0],
+         [330.0, 60.0]]
+    )  # fmt: skip
+    island = np.array([[80.0, 250.0], [80.0, 290.0], [120.0, 290.0], [120.0, 250.0]])
+    area = write_geojson(tmp_path / "area.geojson", geographic(projection, ell, island))
+    mission = tmp_path / "mission.toml"
+    tables = f'[area]\nfile = "{area}"\n'
+    mission.write_text(mission_text((100.0, 400.0), (300.0, 110.0), tables))
+    path = path_of(preplan(mission))
+    straight = LineString([(400.0, 100.0), (110.0, 300.0)])
+    assert not local(ell).contains(straight)
+    assert inside_by(path, local(ell, island)) >= SAFETY_RADIUS
+
+
+def test_a_hole_of_a_zone_is_free_water(tmp_path: Path) -> None:
+    """Start and goal inside a zone's hole: planned (a polygon without holes would refuse)."""
+    projection = write_grid(tmp_path / "grid.nc")
+    frame = np.array([[40.0, 40.0], [40.0, 460.0], [460.0, 460.0], [460.0, 40.0]])
+    hole = np.array([[100.0, 100.0], [100.0, 400.0], [400.0, 400.0], [400.0, 100.0]])
+    zone = write_geojson(tmp_path / "lagoon.geojson", geographic(projection, frame, hole))
+    mission = tmp_path / "mission.toml"
+    mission.write_text(
+        mission_text((150.0, 150.0), (350.0, 330.0), f'[[obstacle]]\nfile = "{zone}"\n')
+    )
+    summary = preplan(mission)
+    assert clearance(path_of(summary), local(frame, hole)) >= SAFETY_RADIUS
+    (shape,) = summary["obstacles"]
+    assert len(shape["holes"]) == 1
+
+
+def test_a_replay_outside_the_area_is_a_violation_naming_it() -> None:
+    config = parse_mission(
+        tomllib.loads(
+            """
+[terrain]
+synthetic = true
+[fleet]
+horizon_s = 100.0
+safety_radius_m = 5.0
+[[vehicle]]
+name = "a"
+start = { north = 10.0, east = 10.0 }
+goal = { north = 50.0, east = 10.0 }
+[area]
+polygon = [[0.0, 0.0], [0.0, 100.0], [100.0, 100.0], [100.0, 0.0]]
+"""
+        )
+    )
+    time = np.linspace(0.0, 100.0, 101)
+    distance = np.full(time.size, 10.0)
+    result = SimpleNamespace(success=True, status=SimpleNamespace(name="CONVERGED"))
+    inside = judge_plan(config, ("a",), result, time, {Pair("a", AREA_NAME): distance}, np.zeros(1))
+    assert inside.status is PlanStatus.CONVERGED
+    distance[40] = -0.5  # one sample half a metre outside the area
+    verdict = judge_plan(
+        config, ("a",), result, time, {Pair("a", AREA_NAME): distance}, np.zeros(1)
+    )
+    assert verdict.status is PlanStatus.CONSTRAINT_VIOLATED
+    (violation,) = verdict.violations
+    assert (violation.kind, violation.value, violation.limit) == (AREA_NAME, -0.5, 5.0)
+    assert verdict.message.startswith(f"{AREA_NAME}: a / {AREA_NAME} at -0.50 m < 5 m (t = 40 s)")
+    assert "\n" not in verdict.message
+
+
+@pytest.mark.slow
+def test_the_optimised_replay_keeps_clear_of_gis_zones_and_inside_the_area(
+    tmp_path: Path,
+) -> None:
+    """The full plan: exit 0, converged, the replay r_c from each zone and inside the area."""
+    mission = reef_wreck_corridor(tmp_path)
+    out = tmp_path / "out"
+    assert main(["-q", "plan", str(mission), "-o", str(out), "--no-figures"]) == 0
+    summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    assert summary["optimization"]["plan_status"] == "CONVERGED"
+    minima = summary["optimization"]["vehicles"]["blue"]["min_separation_m"]
+    assert set(minima) == {"reef feature 0", "wreck feature 0", AREA_NAME}
+    assert min(minima.values()) >= SAFETY_RADIUS - 1e-3
