@@ -13,7 +13,7 @@ from auvplan.io.currents import read_current
 from auvplan.ocean import GriddedCurrent, UniformCurrent, ground_speed, through_water
 from auvplan.terrain import LocalProjection
 
-from ._current_files import EAST, LAT_0, LEVELS, LON_0, NORTH, analytic, write_current_file
+from ._current_files import EAST, LAT_0, LON_0, NORTH, analytic, write_current_file
 
 PROJECTION = LocalProjection(LAT_0, LON_0).shifted(-1000.0, -1000.0)
 EXTENT = ((0.0, 2000.0), (0.0, 2000.0))
@@ -37,14 +37,14 @@ def test_cf_file_reproduces_the_analytic_field(
     Exactly, but for the affine map of the file's axes to the local frame: over ±1 km the
     curvature of the meridians and parallels changes the field by a few 1e-6 m/s.
     """
-    field = _read(current_file, depth=12.0)  # the 10 m level
+    field = _read(current_file, depth=12.0)  # 0.48: 1/20 of the way from 0.5 (10 m) to 0.1 (50 m)
     north, east = rng.uniform(200.0, 1800.0, (2, 50))
     time = rng.uniform(0.0, 3 * 3600.0, 50)
     lat, lon = PROJECTION.to_geographic(north, east)
     hours = 1.0 + time / 3600.0
     v_n, v_e = field.velocity(north, east, time)
-    np.testing.assert_allclose(v_n, LEVELS[10.0] * analytic(NORTH, lat, lon, hours), atol=1e-5)
-    np.testing.assert_allclose(v_e, LEVELS[10.0] * analytic(EAST, lat, lon, hours), atol=1e-5)
+    np.testing.assert_allclose(v_n, 0.48 * analytic(NORTH, lat, lon, hours), atol=1e-5)
+    np.testing.assert_allclose(v_e, 0.48 * analytic(EAST, lat, lon, hours), atol=1e-5)
 
 
 def test_time_origin_is_the_files_first_time_without_start_time(current_file: Path) -> None:

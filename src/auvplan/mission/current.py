@@ -51,8 +51,9 @@ def load_current(config: MissionConfig, bathymetry: BathymetryGrid) -> CurrentFi
     A uniform current of zero is still water (the plan is then exactly the still-water one;
     the current's code path gives it up to round-off, ~1e-6 m on positions). A file is read
     onto the terrain's local frame (:func:`auvplan.io.currents.read_current`), with time
-    relative to ``[mission] start_time`` when the mission gives one; it must hold values over
-    the map's water cells (NaN there is an error, NaN over land is still water).
+    relative to ``[mission] start_time`` when the mission gives one (only the slices around a
+    given ``fleet.horizon_s`` are read); it must hold values over the map's water cells (NaN
+    there is an error, NaN over land is still water).
     """
     table = config.current
     if table is None:
@@ -73,6 +74,7 @@ def load_current(config: MissionConfig, bathymetry: BathymetryGrid) -> CurrentFi
         start_time=config.mission.start_time if given else None,
         depth=config.mission.depth,
         water=geometry.to_world(rows, cols),
+        horizon=config.fleet.horizon,
     )
 
 
