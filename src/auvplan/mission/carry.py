@@ -13,7 +13,7 @@ reads paths relative to the mission file's folder):
   names at the same place relative to it. A table named by an absolute path or from outside
   the vehicle file's folder is copied beside it, and the copy of the vehicle file (written
   again from its TOML document, without its comments) names it so;
-* a current file is copied into ``inputs/``.
+* a current file, and the file of any other key, is copied into ``inputs/``.
 
 A different file of a name already taken goes to ``inputs/2/``, ``inputs/3/``, …
 """
@@ -24,10 +24,12 @@ from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from typing import Any
 
+from pydantic import BaseModel
+
 from auvplan.io._propeller_tables import propeller_table_file
 from auvplan.io.text import read_bytes, read_toml, toml_text
 from auvplan.io.vehicles import packaged_vehicle_types
-from auvplan.mission.config import MissionConfig, resolved_document
+from auvplan.mission.config import MissionConfig, TerrainConfig, resolved_document
 from auvplan.record.files import INPUTS_FOLDER, MAPS_FILE
 
 
@@ -60,15 +62,33 @@ def carried_mission(config: MissionConfig) -> CarriedMission:
     files: dict[str, bytes] = {}
     if config.terrain.file is not None:
         document["terrain"] = {**document["terrain"], "file": MAPS_FILE, "window": {}}
-    current = config.current
-    if current is not None and current.file is not None:
-        content = read_bytes(current.file, what="current file")
-        folder = _place(files, {current.file.name: content})
-        document["current"]["file"] = f"{folder}/{current.file.name}"
+    _carry_paths(config, document, files)
     for table, vehicle in zip(document["vehicle"], config.vehicles, strict=True):
         if vehicle.type not in packaged_vehicle_types():
             table["type"] = _carry_vehicle(files, Path(vehicle.type))
     return CarriedMission(document, files)
+
+
+def _carry_paths(model: BaseModel, table: dict[str, Any], files: dict[str, bytes]) -> None:
+    """Copy each file a key of ``model`` names into ``files``; ``table`` names the copy.
+
+    ``table`` is ``model``'s document. Every key whose value is a :class:`~pathlib.Path`
+    (``current.file``, and any file key added later), in the tables and arrays of tables
+    below ``model``; the terrain is the folder's ``maps.nc`` (:func:`carried_mission`).
+    """
+    for name, field in type(model).model_fields.items():
+        value, key = getattr(model, name), field.alias or name
+        if key not in table or isinstance(value, TerrainConfig):  # not a key, or maps.nc
+            continue
+        if isinstance(value, Path):
+            content = read_bytes(value, what="input file")
+            table[key] = f"{_place(files, {value.name: content})}/{value.name}"
+        elif isinstance(value, BaseModel):
+            _carry_paths(value, table[key], files)
+        elif isinstance(value, tuple):
+            for item, entry in zip(value, table[key], strict=True):
+                if isinstance(item, BaseModel):
+                    _carry_paths(item, entry, files)
 
 
 def _carry_vehicle(files: dict[str, bytes], path: Path) -> str:
