@@ -176,3 +176,25 @@ def test_curvilinear_file_off_the_map_is_refused(tmp_path: Path) -> None:
             start_time=START_TIME,
             depth=0.0,
         )
+
+
+@pytest.mark.parametrize(
+    ("attribute", "value", "message"),
+    [
+        ("calendar", "lunar", r"roms.nc: time axis ocean_time .* cannot be decoded"),
+        ("units", "seconds since the flood", r"roms.nc: time axis ocean_time .* cannot be decoded"),
+    ],
+)
+def test_undecodable_time_is_one_line(
+    tmp_path: Path, attribute: str, value: str, message: str
+) -> None:
+    import xarray as xr
+
+    source = write_roms(tmp_path / "source.nc", angle_deg=0.0)
+    with xr.open_dataset(source, decode_times=False) as opened:
+        dataset = opened.load()
+    dataset["ocean_time"].attrs[attribute] = value
+    dataset.to_netcdf(tmp_path / "roms.nc")
+    with pytest.raises(DataFormatError, match=message) as raised:
+        _read(tmp_path / "roms.nc", depth=0.0)
+    assert "\n" not in str(raised.value)
