@@ -129,3 +129,19 @@ def test_packaged_inputs_are_not_copied(tmp_path: Path) -> None:
     assert carried.files == {}
     assert carried.document["terrain"]["sample"] == "monterey"
     assert [table["type"] for table in carried.document["vehicle"]] == ["medusa", "remus100"]
+
+
+def test_gis_files_are_carried_a_shapefile_with_its_parts(tmp_path: Path) -> None:
+    source = tmp_path / "source"
+    (source / "gis").mkdir(parents=True)
+    parts = {suffix: f"{suffix} bytes".encode() for suffix in (".shp", ".shx", ".dbf", ".prj")}
+    for suffix, content in parts.items():
+        (source / "gis" / f"reefs{suffix}").write_bytes(content)
+    (source / "gis" / "reefs_old.shp").write_bytes(b"another layer")  # not a part
+    (source / "area.geojson").write_bytes(b"{}")
+    extra = '[[obstacle]]\nfile = "gis/reefs.shp"\n[area]\nfile = "area.geojson"\n'
+    carried = carried_mission(load_mission(_mission(source, ["medusa"], extra)))
+    assert carried.document["obstacle"][0]["file"] == "inputs/reefs.shp"
+    assert carried.document["area"]["file"] == "inputs/area.geojson"
+    expected = {f"inputs/reefs{suffix}": content for suffix, content in parts.items()}
+    assert carried.files == {**expected, "inputs/area.geojson": b"{}"}

@@ -13,13 +13,15 @@ reads paths relative to the mission file's folder):
   names at the same place relative to it. A table named by an absolute path or from outside
   the vehicle file's folder is copied beside it, and the copy of the vehicle file (written
   again from its TOML document, without its comments) names it so;
-* a current file, and the file of any other key, is copied into ``inputs/``.
+* a current file, a GIS ``file`` of ``[[obstacle]]`` or ``[area]`` (a Shapefile with the
+  files of its stem), and the file of any key added later, is copied into ``inputs/``.
 
 A different file of a name already taken goes to ``inputs/2/``, ``inputs/3/``, …
 """
 
 from __future__ import annotations
 
+import glob
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from typing import Any
@@ -81,14 +83,25 @@ def _carry_paths(model: BaseModel, table: dict[str, Any], files: dict[str, bytes
         if key not in table or isinstance(value, TerrainConfig):  # not a key, or maps.nc
             continue
         if isinstance(value, Path):
-            content = read_bytes(value, what="input file")
-            table[key] = f"{_place(files, {value.name: content})}/{value.name}"
+            bundle = {part.name: read_bytes(part, what="input file") for part in _parts(value)}
+            table[key] = f"{_place(files, bundle)}/{value.name}"
         elif isinstance(value, BaseModel):
             _carry_paths(value, table[key], files)
         elif isinstance(value, tuple):
             for item, entry in zip(value, table[key], strict=True):
                 if isinstance(item, BaseModel):
                     _carry_paths(item, entry, files)
+
+
+def _parts(path: Path) -> list[Path]:
+    """The files read as ``path``: the file alone, or for a Shapefile the files of its stem.
+
+    A Shapefile is its ``.shp`` and the files of the same stem beside it (``.shx``, ``.dbf``,
+    ``.prj``, ``.cpg``, …: ESRI Shapefile Technical Description, 1998).
+    """
+    if path.suffix.lower() != ".shp":
+        return [path]
+    return [path, *sorted(p for p in path.parent.glob(f"{glob.escape(path.stem)}.*") if p != path)]
 
 
 def _carry_vehicle(files: dict[str, bytes], path: Path) -> str:
