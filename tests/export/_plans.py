@@ -72,6 +72,15 @@ dt_s = 1.0
 [mission]
 start_time = 2026-05-01T10:00:00+02:00
 depth_m = 3.0
+[metadata]
+creator_name = "Ada Operator"
+creator_email = "ada@example.org"
+creator_url = "https://example.org/ada"
+creator_type = "person"
+institution = "Example Marine Robotics Lab"
+project = "auvplan export tests"
+license = "CC-BY-4.0"
+naming_authority = "org.example"
 """
 
 

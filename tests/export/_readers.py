@@ -129,15 +129,22 @@ def moos_points(value: str) -> list[tuple[float, float]]:
     return [(float(x), float(y)) for x, y in pairs]
 
 
-def checker_report(path: Path, report: Path, test: str) -> dict[str, Any]:
-    """The IOOS compliance checker's JSON report of ``test`` (``"cf:1.8"``, ``"acdd:1.3"``,
-    ``"ncei-trajectory:2.0"`` with the NCEI plugin) on ``path``, written to ``report``."""
+def checker_passes(path: Path, report: Path, test: str) -> bool:
+    """Whether ``compliance-checker --test TEST PATH`` exits 0: no failed check of high or
+    medium priority (its default ``--criteria normal``); the JSON report goes to ``report``."""
     CheckSuite.load_all_available_checkers()
     with warnings.catch_warnings():  # the NCEI plugin calls a deprecated checker interface
         warnings.simplefilter("ignore", DeprecationWarning)
-        ComplianceChecker.run_checker(
+        passed, _ = ComplianceChecker.run_checker(
             str(path), [test], 0, "normal", output_filename=str(report), output_format="json"
         )
+    return bool(passed)
+
+
+def checker_report(path: Path, report: Path, test: str) -> dict[str, Any]:
+    """The IOOS compliance checker's JSON report of ``test`` (``"cf:1.8"``, ``"acdd:1.3"``,
+    ``"ncei-trajectory:2.0"`` with the NCEI plugin) on ``path``, written to ``report``."""
+    checker_passes(path, report, test)
     results: dict[str, Any] = json.loads(report.read_text())[test]
     return results
 

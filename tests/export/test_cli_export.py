@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import itertools
 import json
@@ -20,12 +21,13 @@ import xarray as xr
 
 from auvplan.cli.main import main
 from auvplan.export import FORMATS
+from auvplan.io.maps_file import read_maps_netcdf, write_maps_netcdf
 from auvplan.io.vehicles import vehicle_file
 from auvplan.mission.config import load_mission, parse_mission
 from auvplan.terrain import LocalProjection
 
 from ._plans import MISSION
-from ._readers import cf_findings, checker_passes, checker_report
+from ._readers import cf_findings, checker_passes, checker_report, moos_points, parse_moos
 
 ALL = ",".join(FORMATS)
 
@@ -233,14 +235,51 @@ def test_export_user_errors(
     assert _fails_cleanly(["export", str(tmp_path), "--format", "gpx"], tmp_path, capsys).endswith(
         "(no summary.json)"
     )
+
+
+def _without_georeference(planned_folder: Path, folder: Path) -> None:
+    """``planned_folder`` as on the synthetic bank: maps.nc without CRS, origin without lat/lon
+    (the maps' arrays, which summary.json's digest covers, unchanged)."""
+    shutil.copytree(planned_folder, folder, ignore=shutil.ignore_patterns("export"))
+    maps = read_maps_netcdf(folder / "maps.nc")
+    local = dataclasses.replace(maps.bathymetry, projection=None)
+    write_maps_netcdf(dataclasses.replace(maps, bathymetry=local), folder / "maps.nc")
+    summary = json.loads((folder / "summary.json").read_text())
+    summary["terrain"]["origin"] = {"north": 0.0, "east": 0.0}
+    (folder / "summary.json").write_text(json.dumps(summary))
+
+
+def test_export_without_georeference_is_moos_in_the_local_frame_only(
+    planned_folder: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every format that needs lat/lon is refused in one line naming it, exit 2, nothing
+    written; MOOS-IvP's local frame is the plan's own north/east."""
     local = tmp_path / "local"
-    shutil.copytree(planned_folder, local, ignore=shutil.ignore_patterns("export"))
-    summary = json.loads((local / "summary.json").read_text())
-    summary["terrain"]["origin"] = {"north": 0.0, "east": 0.0}  # as on the synthetic bank
-    (local / "summary.json").write_text(json.dumps(summary))
-    assert "exports need lat/lon" in _fails_cleanly(
-        ["export", str(local), "--format", "kml"], local, capsys
-    )
+    _without_georeference(planned_folder, local)
+    for formats in ("geojson", "kml", "gpx", "qgc", "imc", "moos", "moos,gpx"):
+        arguments = ["export", str(local), "--format", formats, "--moos-frame"]
+        frame = "local" if "," in formats else "utm"  # moos in the local frame is written
+        message = _fails_cleanly([*arguments, frame], local, capsys)
+        name = formats.split(",")[-1]
+        assert message.startswith(f"auvplan: error: {name} export needs lat/lon"), message
+        assert "has no geographic reference" in message
+        assert ("--moos-frame local" in message) == (name == "moos")
+    out = tmp_path / "moos"
+    arguments = ["-q", "export", str(local), "--format", "moos", "--moos-frame", "local"]
+    assert main([*arguments, "-o", str(out), "--tolerance-m", "0"]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["blue.bhv", "green.bhv", "origin.moos"]
+    origin = (out / "origin.moos").read_text()
+    assert "LatOrigin  =" not in origin
+    assert "set LatOrigin and LongOrigin" in origin
+    table = pd.read_csv(planned_folder / "trajectories.csv")
+    blue = table[table["vehicle"] == "blue"]
+    _, legs = parse_moos((out / "blue.bhv").read_text())
+    points = [moos_points(leg["points"])[0] for leg in legs if "points" in leg]
+    assert len(points) > 2
+    # each waypoint is a sample of the plan, as x = east, y = north of the plan's own frame
+    samples = np.column_stack([blue["east"], blue["north"]])
+    for x, y in points:
+        assert np.min(np.hypot(*(samples - [x, y]).T)) < 0.01
 
 
 def test_plan_export_refuses_before_planning(
@@ -251,7 +290,11 @@ def test_plan_export_refuses_before_planning(
     message = _fails_cleanly(
         ["plan", str(mission), "-o", str(tmp_path / "out"), "--export", "gpx"], tmp_path, capsys
     )
-    assert "synthetic bank has no geographic reference" in message
+    assert "gpx export needs lat/lon, but the synthetic bank has no geographic" in message
+    message = _fails_cleanly(
+        ["plan", str(mission), "-o", str(tmp_path / "out"), "--export", "moos"], tmp_path, capsys
+    )
+    assert "(or export moos with --moos-frame local)" in message
     message = _fails_cleanly(
         [
             "plan",

@@ -21,7 +21,7 @@ from auvplan.export.waypoints import Waypoints, thin_track
 from auvplan.terrain import LocalProjection
 
 from ._plans import synthetic_plan
-from ._readers import fly_moos, parse_moos, validate_json
+from ._readers import fly_moos, moos_points, parse_moos, validate_json
 
 TOLERANCE = 0.5
 GEOD = Geod(ellps="WGS84")
@@ -352,3 +352,33 @@ def test_file_stems_are_safe_and_unique() -> None:
 def test_unknown_formats_are_named(text: str) -> None:
     with pytest.raises(InputError, match="export format"):
         parse_formats(text)
+
+
+def test_without_geographic_reference_only_moos_in_the_local_frame_is_written() -> None:
+    """The synthetic bank's plans: every format that needs lat/lon refused by name; MOOS-IvP's
+    local frame flies the plan's own north/east, the points the georeferenced plan gets."""
+    plan = synthetic_plan()
+    tracks = tuple(dataclasses.replace(track, lat=None, lon=None) for track in plan.tracks)
+    local = dataclasses.replace(plan, tracks=tracks, origin_lat=None, origin_lon=None, zones=())
+    assert plan.is_georeferenced
+    assert not local.is_georeferenced
+    for name in FORMATS:
+        frame = "utm" if name == "moos" else "local"
+        with pytest.raises(InputError, match=rf"^{name} export needs lat/lon, but") as info:
+            render_exports(local, [name], moos_frame=frame)
+        assert ("--moos-frame local" in str(info.value)) == (name == "moos")
+    files = render_exports(local, ["moos"], tolerance=TOLERANCE, moos_frame="local")
+    same = render_exports(plan, ["moos"], tolerance=TOLERANCE, moos_frame="local")
+    assert "LatOrigin" not in parse_moos(files["origin.moos"])[0]
+    stems = file_stems([track.name for track in plan.tracks])
+    for stem, waypoints in zip(stems, _fleet(local), strict=True):
+        settings, blocks = parse_moos(files[f"{stem}.bhv"])
+        expected = np.column_stack([waypoints.east, waypoints.north])
+        flown = np.array(fly_moos(settings, blocks, start=tuple(expected[0])))
+        np.testing.assert_allclose(flown[:, 1:], expected, atol=0.01)
+        planned = waypoints.time - waypoints.time[0]  # speeds written to 1 mm/s
+        np.testing.assert_allclose(flown[:, 0], planned, atol=1e-3 * planned[-1] + 0.01)
+        _, georeferenced = parse_moos(same[f"{stem}.bhv"])
+        points = [moos_points(block["points"]) for block in blocks if "points" in block]
+        expected_points = [moos_points(b["points"]) for b in georeferenced if "points" in b]
+        np.testing.assert_allclose(points, expected_points, atol=0.011)  # written to 1 cm

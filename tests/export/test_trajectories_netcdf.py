@@ -6,18 +6,21 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
+import pytest
 import xarray as xr
 from pyproj import Proj
 
+from auvplan.errors import DataFormatError
 from auvplan.io.trajectories_file import (
     SERIES,
     read_trajectories_netcdf,
     trajectories_dataset,
     true_heading,
 )
+from auvplan.record.dataset import operator_metadata
 from auvplan.terrain import LocalProjection
 
-from ._readers import cf_findings
+from ._readers import checker_passes, checker_report
 
 
 def test_true_heading_adds_the_meridian_convergence() -> None:
@@ -50,9 +53,7 @@ def test_without_georeference_the_file_has_no_lat_lon_and_is_still_cf(tmp_path: 
     built.to_netcdf(path)
     # the in-memory dataset is the file as read back (values, coordinates, attributes)
     xr.testing.assert_identical(read_trajectories_netcdf(path), built)
-    findings = cf_findings(path, tmp_path / "cf.json")
-    assert findings["high"] == [], findings
-    assert findings["medium"] == ["§2.6 Attributes"], findings  # CF-1.6 as NCEI v2.0 requires
+    assert checker_passes(path, tmp_path / "cf.json", "cf:1.8")  # exit 0: no error, no warning
     with xr.open_dataset(path) as dataset:
         assert "lat" not in dataset.variables
         assert "lon" not in dataset.variables
@@ -61,3 +62,42 @@ def test_without_georeference_the_file_has_no_lat_lon_and_is_still_cf(tmp_path: 
         np.testing.assert_allclose(dataset["heading"].values, np.mod(np.degrees(psi), 360.0))
         for name in SERIES:
             np.testing.assert_array_equal(dataset[name].values, series[name])
+
+
+def test_operator_metadata_and_dates_never_replace_computed_attributes(tmp_path: Path) -> None:
+    """[metadata] keys are written as given, below the computed ones; dates only when known."""
+    time = np.arange(0.0, 4.5, 0.5)
+    series = {name: np.ones((1, time.size)) for name in SERIES}
+    start = datetime(2026, 5, 1, 8, 0, 0, tzinfo=UTC)
+    common = {"psi": np.zeros((1, time.size)), "start_time": start, "depth": 2.0}
+    bare = trajectories_dataset(
+        ["a"], time, series, **common, projection=None, attributes={}
+    )  # fmt: skip
+    assert not {"date_created", "creator_name"} & set(bare.attrs)
+    created = datetime(2026, 11, 25, 23, 10, 5, 700000, tzinfo=UTC)
+    dataset = trajectories_dataset(
+        ["a"], time, series, **common, projection=LocalProjection(36.8, -121.8),
+        attributes={"history": "test"},
+        metadata={"creator_name": "Ada", "Conventions": "none", "id": "x"},
+        created=created,
+    )  # fmt: skip
+    assert dataset.attrs["creator_name"] == "Ada"
+    assert dataset.attrs["Conventions"] == bare.attrs["Conventions"]
+    assert dataset.attrs["id"] == bare.attrs["id"]  # the positions' digest
+    assert dataset.attrs["date_created"] == "2026-11-25T23:10:05Z"
+    assert dataset.attrs["time_coverage_resolution"] == "PT0.5S"
+    path = tmp_path / "trajectories.nc"
+    dataset.to_netcdf(path)
+    assert checker_passes(path, tmp_path / "cf.json", "cf:1.8")
+    # the dates score: ACDD's date_created check finds an ISO 8601 date
+    acdd = checker_report(path, tmp_path / "acdd.json", "acdd:1.3")
+    (dates,) = [r for r in acdd["medium_priorities"] if r["name"] == "date_created_is_iso"]
+    assert dates["value"] == [2, 2]
+
+
+def test_operator_metadata_of_an_edited_mission_file_is_refused_in_one_line() -> None:
+    assert operator_metadata({}) == {}
+    assert operator_metadata({"metadata": {"project": "p"}}) == {"project": "p"}
+    for table in ({"project": 3}, "text"):
+        with pytest.raises(DataFormatError, match=r"mission.toml: \[metadata\] must hold text"):
+            operator_metadata({"metadata": table})

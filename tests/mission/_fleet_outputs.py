@@ -38,7 +38,9 @@ def stand_in_result(
 ) -> Any:
     """The attributes of a MissionResult and OptimizedPlan that the trajectory writers read."""
     time = DT * np.arange(np.shape(power)[1], dtype=np.float64)
-    plan = SimpleNamespace(states=states, inputs=inputs, power=power, terrain_weight=1.0)
+    plan = SimpleNamespace(
+        states=states, inputs=inputs, power=power, terrain_weight=1.0, depth_profiles=None
+    )
     result = SimpleNamespace(
         config=SimpleNamespace(mission=SimpleNamespace(start_time=START, depth=0.0)),
         preplan=SimpleNamespace(names=names, bathymetry=SimpleNamespace(projection=None)),
@@ -65,9 +67,11 @@ def write_files(result: Any, plan: Any, folder: Path) -> tuple[Path, Path]:
         plans={"terrain_aware": tables},
         summary=SimpleNamespace(
             start=START,
+            created_at=None,
             vehicles=[SimpleNamespace(type_name=model.vehicle.name) for model in models],
             outcome=lambda label: SimpleNamespace(terrain_weight=plan.terrain_weight),
         ),
+        mission={},
         depth=result.config.mission.depth,
         maps=SimpleNamespace(bathymetry=result.preplan.bathymetry),
     )

@@ -167,3 +167,27 @@ def test_non_utf8_and_deeply_nested_mission_files(tmp_path: Path) -> None:
     (tmp_path / "deep.toml").write_text("x = " + "[" * 5000 + "]" * 5000 + "\n")
     with pytest.raises(DataFormatError, match="not valid TOML"):
         load_mission(tmp_path / "deep.toml")
+
+
+def test_metadata_table_defaults_the_publisher_to_the_creator() -> None:
+    assert parse_mission(_mission()).metadata.attributes() == {}
+    metadata = parse_mission(
+        _mission('[metadata]\ncreator_name = "Ada"\ncreator_email = "a@b.org"\npublisher_url = "u"')
+    ).metadata
+    assert metadata.attributes() == {
+        "creator_name": "Ada",
+        "creator_email": "a@b.org",
+        "publisher_name": "Ada",
+        "publisher_email": "a@b.org",
+        "publisher_url": "u",
+    }
+    for extra, key in (
+        ('[metadata]\ncreator_type = "robot"\n', "metadata.creator_type"),
+        ('[metadata]\nproject = "two\\nlines"\n', "metadata.project"),
+        ("[metadata]\nlicense = 4\n", "metadata.license"),
+        ('[metadata]\nauthor = "Ada"\n', "metadata.author"),
+    ):
+        with pytest.raises(InputError) as info:
+            parse_mission(_mission(extra))
+        assert key in str(info.value)
+        assert "\n" not in str(info.value)

@@ -18,7 +18,7 @@ from auvplan._figures import DEFAULT_DPI
 from auvplan.api.companion import Companion, resolve_jobs
 from auvplan.api.result import plan
 from auvplan.errors import InputError
-from auvplan.export import DEFAULT_TOLERANCE_M, MoosFrame, parse_formats
+from auvplan.export import DEFAULT_TOLERANCE_M, MoosFrame, check_georeference, parse_formats
 from auvplan.mission.config import MissionConfig
 from auvplan.mission.pipeline import MissionResult
 
@@ -68,7 +68,7 @@ def plan_to_folder(
         Processes, 1 or 2 (default: :func:`~auvplan.api.companion.resolve_jobs`).
     exports : str, optional
         Export formats, comma-separated (:data:`auvplan.export.FORMATS`); they need the full
-        stage and a georeferenced terrain.
+        stage and, but for ``moos`` in the ``local`` frame, a georeferenced terrain.
     figures, figure_format, dpi, tolerance_m, moos_frame
         The output folder's options, as in :meth:`auvplan.MissionPlan.save` (``dpi`` in dots
         per inch, ``tolerance_m`` in m).
@@ -84,7 +84,7 @@ def plan_to_folder(
         For a mission that cannot be planned, exports that cannot be made of it, or ``jobs``
         other than 1 or 2; nothing is written.
     """
-    formats = _export_formats(config, exports, stage)
+    formats = _export_formats(config, exports, stage, moos_frame)
     with Companion() if resolve_jobs(jobs) == 2 else nullcontext() as companion:
         if companion is not None and figures:
             companion.start()  # its imports overlap the planning
@@ -111,16 +111,20 @@ def plan_to_folder(
     return SavedPlan(mission_plan.result, tuple(written))
 
 
-def _export_formats(config: MissionConfig, exports: str | None, stage: str) -> tuple[str, ...]:
-    """The formats of ``exports``, checked before any planning (fail fast)."""
+def _export_formats(
+    config: MissionConfig, exports: str | None, stage: str, moos_frame: str
+) -> tuple[str, ...]:
+    """The formats of ``exports``, checked before any planning (fail fast).
+
+    On the synthetic bank only those that need no lat/lon
+    (:func:`~auvplan.export.check_georeference`); a bathymetry file without a CRS is known
+    only once read, and refused when exporting.
+    """
     if exports is None:
         return ()
     formats = parse_formats(exports)
     if stage != "full":
         raise InputError(f"--export needs the optimised plan: drop --stage {stage}")
     if config.terrain.synthetic:
-        raise InputError(
-            "--export needs lat/lon, but the synthetic bank has no geographic reference: "
-            "plan on a georeferenced bathymetry file"
-        )
+        check_georeference(formats, moos_frame, "the synthetic bank")
     return formats

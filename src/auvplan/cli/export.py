@@ -68,13 +68,16 @@ def register(subparsers: Any) -> None:
 
 def run_export(args: argparse.Namespace) -> int:
     """Read the folder's plan and write the exports all-or-nothing."""
-    from auvplan.export import parse_formats, write_exports
+    from auvplan.export import check_georeference, parse_formats, write_exports
     from auvplan.io.output import staged_output_dir
     from auvplan.record import export_plan, read_record
     from auvplan.record.files import EXPORT_FOLDER
 
     formats = parse_formats(args.formats)
-    plan = export_plan(read_record(args.folder))
+    record = read_record(args.folder)
+    plan = export_plan(record)
+    if not plan.is_georeferenced:
+        check_georeference(formats, args.moos_frame, f"the terrain {record.summary.terrain.name}")
     target = args.output if args.output is not None else args.folder / EXPORT_FOLDER
     with staged_output_dir(target) as staging:
         written = write_exports(

@@ -16,8 +16,10 @@ format      files                      for
 
 Every format is written from the same waypoints: each track thinned to ``tolerance`` with its
 time law kept (:func:`auvplan.export.waypoints.thin_track`). The plan they are written from is
-an :class:`auvplan.export.plan.ExportPlan`. This module imports nothing heavy (not even numpy)
-until a format is rendered, so that the command line starts fast.
+an :class:`auvplan.export.plan.ExportPlan`. Every format but ``moos`` in its ``local`` frame
+places the plan in lat/lon, so on terrain without geographic reference (the synthetic bank)
+only that one is written (:func:`check_georeference`). This module imports nothing heavy
+(not even numpy) until a format is rendered, so that the command line starts fast.
 """
 
 from __future__ import annotations
@@ -72,6 +74,36 @@ def check_moos_frame(frame: str) -> None:
         raise InputError(f"MOOS frame {frame!r} is not one of {', '.join(MOOS_FRAMES)}")
 
 
+def check_georeference(formats: Sequence[str], moos_frame: str, terrain: str) -> None:
+    """Refuse the formats that need lat/lon, for a plan on ``terrain`` without georeference.
+
+    Only ``moos`` in the ``local`` frame (x east, y north of the plan's own frame) is written
+    from north/east alone.
+
+    Raises
+    ------
+    InputError
+        Naming the first such format of ``formats`` and ``terrain`` (e.g. ``"the synthetic
+        bank"``).
+
+    Examples
+    --------
+    >>> check_georeference(["moos"], "local", "the synthetic bank")
+    >>> check_georeference(["moos", "gpx"], "local", "the synthetic bank")
+    Traceback (most recent call last):
+    ...
+    auvplan.errors.InputError: gpx export needs lat/lon, but the synthetic bank has no geog...
+    """
+    for name in formats:
+        if name == "moos" and moos_frame == "local":
+            continue
+        hint = " (or export moos with --moos-frame local)" if name == "moos" else ""
+        raise InputError(
+            f"{name} export needs lat/lon, but {terrain} has no geographic reference: "
+            f"plan on a georeferenced bathymetry file{hint}"
+        )
+
+
 def check_tolerance(tolerance: float) -> None:
     """Raise InputError unless ``tolerance`` [m] is a number from 0 to :data:`MAX_TOLERANCE_M`.
 
@@ -116,13 +148,17 @@ def render_exports(
     Raises
     ------
     InputError
-        If ``moos_frame`` or ``tolerance`` is out of its range, or a format is unknown.
+        If ``moos_frame`` or ``tolerance`` is out of its range, a format is unknown, or a
+        format needs lat/lon the plan does not have (:func:`check_georeference`).
     """
     from auvplan.export import geojson, gpx, imc, kml, moos, qgc
     from auvplan.export.waypoints import thin_track
 
     check_moos_frame(moos_frame)
     check_tolerance(tolerance)
+    names = parse_formats(",".join(formats))
+    if not plan.is_georeferenced:
+        check_georeference(names, moos_frame, "the plan's terrain")
     renderers: dict[str, Callable[[ExportPlan, list[Waypoints]], dict[str, str]]] = {
         "moos": functools.partial(moos.render, frame=moos_frame),
         "qgc": qgc.render,
@@ -133,7 +169,7 @@ def render_exports(
     }
     fleet = [thin_track(track, tolerance) for track in plan.tracks]
     files: dict[str, str] = {}
-    for name in parse_formats(",".join(formats)):
+    for name in names:
         files.update(renderers[name](plan, fleet))
     return files
 
@@ -159,6 +195,7 @@ __all__ = [
     "MAX_TOLERANCE_M",
     "MOOS_FRAMES",
     "MoosFrame",
+    "check_georeference",
     "check_moos_frame",
     "check_tolerance",
     "parse_formats",

@@ -2,7 +2,8 @@
 
 * ``trajectories.geojson``: one ``LineString`` per vehicle; the time law travels in the
   feature's properties: ``times`` (UTC, ISO 8601), ``t_s`` (seconds after the start) per
-  point, ``leg_speed_m_s`` per leg, ``depth_m``, and the feature's ``start_time``/``end_time``.
+  point, ``leg_speed_m_s`` per leg, ``depth_m`` (the deepest point's, for a depth profile),
+  and the feature's ``start_time``/``end_time``.
 * ``waypoints.geojson``: one ``Point`` per waypoint with its own ``time`` (UTC, ISO 8601), so
   QGIS's temporal controller ("single field with date/time") animates the fleet, and the
   speed of the leg that leaves it.
@@ -10,7 +11,9 @@
   (circles as 72-gons, counter-clockwise exterior rings as RFC 7946 §3.1.6 asks).
 
 Coordinates are ``[lon, lat]`` in WGS 84 with :data:`DECIMALS` decimals (≈ 1 cm, RFC 7946
-§11.2 advises against more precision than is meaningful).
+§11.2 advises against more precision than is meaningful); a plan with a depth profile
+(``[mission] altitude_m``) adds each position's altitude ``-depth`` [m] (sea level as the
+datum), and each waypoint's ``depth_m`` is its own.
 """
 
 from __future__ import annotations
@@ -30,8 +33,11 @@ from auvplan.export.waypoints import Waypoints
 DECIMALS: Final = 7
 
 
-def _positions(lon: FloatArray, lat: FloatArray) -> list[list[float]]:
-    positions: list[list[float]] = np.round(np.column_stack([lon, lat]), DECIMALS).tolist()
+def _positions(
+    lon: FloatArray, lat: FloatArray, depth: FloatArray | None = None
+) -> list[list[float]]:
+    columns = [lon, lat] if depth is None else [lon, lat, 0.0 - depth]
+    positions: list[list[float]] = np.round(np.column_stack(columns), DECIMALS).tolist()
     return positions
 
 
@@ -47,7 +53,7 @@ def trajectory_features(plan: ExportPlan, fleet: Sequence[Waypoints]) -> list[di
             "type": "Feature",
             "properties": {
                 "name": waypoints.name,
-                "depth_m": plan.depth,
+                "depth_m": float(np.max(plan.waypoint_depths(waypoints))),
                 "start_time": utc_text(plan.timestamp(waypoints.time[0])),
                 "end_time": utc_text(plan.timestamp(waypoints.time[-1])),
                 "times": [utc_text(plan.timestamp(seconds)) for seconds in waypoints.time],
@@ -56,7 +62,7 @@ def trajectory_features(plan: ExportPlan, fleet: Sequence[Waypoints]) -> list[di
             },
             "geometry": {
                 "type": "LineString",
-                "coordinates": _positions(waypoints.lon, waypoints.lat),
+                "coordinates": _positions(*waypoints.geographic()[::-1], waypoints.depth),
             },
         }
         for waypoints in fleet
@@ -68,14 +74,16 @@ def waypoint_features(plan: ExportPlan, fleet: Sequence[Waypoints]) -> list[dict
     features = []
     for waypoints in fleet:
         speeds = [*waypoints.leg_speeds.tolist(), 0.0]  # the last waypoint: arrived
-        for k, position in enumerate(_positions(waypoints.lon, waypoints.lat)):
+        depths = plan.waypoint_depths(waypoints)
+        positions = _positions(*waypoints.geographic()[::-1], waypoints.depth)
+        for k, position in enumerate(positions):
             properties = {
                 "name": waypoints.name,
                 "waypoint": k,
                 "time": utc_text(plan.timestamp(waypoints.time[k])),
                 "t_s": float(waypoints.time[k]),
                 "speed_m_s": speeds[k],
-                "depth_m": plan.depth,
+                "depth_m": float(depths[k]),
             }
             geometry = {"type": "Point", "coordinates": position}
             features.append({"type": "Feature", "properties": properties, "geometry": geometry})

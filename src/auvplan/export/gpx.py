@@ -29,11 +29,13 @@ def gpx_document(plan: ExportPlan, fleet: Sequence[Waypoints]) -> str:
         track = ElementTree.SubElement(root, "trk")
         ElementTree.SubElement(track, "name").text = waypoints.name
         segment = ElementTree.SubElement(track, "trkseg")
-        for lat, lon, seconds in zip(waypoints.lat, waypoints.lon, waypoints.time, strict=True):
+        depths = plan.waypoint_depths(waypoints)
+        lats, lons = waypoints.geographic()
+        for lat, lon, seconds, depth in zip(lats, lons, waypoints.time, depths, strict=True):
             point = ElementTree.SubElement(
                 segment, "trkpt", {"lat": f"{lat:.9f}", "lon": f"{lon:.9f}"}
             )
-            ElementTree.SubElement(point, "ele").text = f"{0.0 - plan.depth:g}"
+            ElementTree.SubElement(point, "ele").text = f"{0.0 - depth:g}"
             ElementTree.SubElement(point, "time").text = utc_text(plan.timestamp(seconds))
     ElementTree.indent(root)
     return ElementTree.tostring(root, encoding="unicode", xml_declaration=True) + "\n"

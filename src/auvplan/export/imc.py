@@ -26,6 +26,7 @@ from typing import Any, Final
 
 import numpy as np
 
+from auvplan._typing import FloatArray
 from auvplan.export.plan import ExportPlan
 from auvplan.export.waypoints import Waypoints, by_file_stem
 from auvplan.terrain.projection import LocalProjection
@@ -42,32 +43,37 @@ TIMEOUT_FACTOR: Final = 1.5
 MAX_TIMEOUT_S: Final = 65_535
 
 
-def trajectory_points(waypoints: Waypoints) -> list[dict[str, Any]]:
-    """``TrajectoryPoint`` messages: offsets [m] from the first waypoint, ``t`` after the last."""
-    lat_0, lon_0 = float(waypoints.lat[0]), float(waypoints.lon[0])
-    north, east = LocalProjection(lat_0, lon_0).to_local(waypoints.lat, waypoints.lon)
+def trajectory_points(waypoints: Waypoints, depths: FloatArray) -> list[dict[str, Any]]:
+    """``TrajectoryPoint`` messages: offsets [m] from the first waypoint, ``t`` after the last.
+
+    ``z`` is the down offset [m] of each waypoint's depth ``depths`` from the first's.
+    """
+    lat, lon = waypoints.geographic()
+    north, east = LocalProjection(float(lat[0]), float(lon[0])).to_local(lat, lon)
     north, east = north - north[0], east - east[0]  # exactly 0 at the start (not 1e-9)
     steps = np.diff(waypoints.time, prepend=waypoints.time[0])
     return [
-        {"abbrev": "TrajectoryPoint", "x": float(n), "y": float(e), "z": 0.0, "t": float(t)}
-        for n, e, t in zip(north, east, steps, strict=True)
+        {"abbrev": "TrajectoryPoint", "x": float(n), "y": float(e), "z": float(z), "t": float(t)}
+        for n, e, z, t in zip(north, east, depths - depths[0], steps, strict=True)
     ]
 
 
 def plan_specification(plan: ExportPlan, waypoints: Waypoints) -> dict[str, Any]:
     """The ``PlanSpecification`` of one vehicle."""
     duration = float(waypoints.time[-1] - waypoints.time[0])
+    depths = plan.waypoint_depths(waypoints)
+    lat, lon = waypoints.geographic()
     maneuver = {
         "abbrev": "FollowTrajectory",
         "timeout": min(MAX_TIMEOUT_S, math.ceil(TIMEOUT_FACTOR * duration)),
-        "lat": math.radians(float(waypoints.lat[0])),
-        "lon": math.radians(float(waypoints.lon[0])),
-        "z": plan.depth,
+        "lat": math.radians(float(lat[0])),
+        "lon": math.radians(float(lon[0])),
+        "z": float(depths[0]),
         "z_units": Z_UNITS_DEPTH,
         "speed": waypoints.mean_speed,
         "speed_units": SPEED_UNITS_METERS_PS,
         "custom": "",
-        "points": trajectory_points(waypoints),
+        "points": trajectory_points(waypoints, depths),
     }
     return {
         "abbrev": "PlanSpecification",

@@ -76,8 +76,9 @@ def kml_document(plan: ExportPlan, fleet: Sequence[Waypoints]) -> str:
         _child(track, _kml("altitudeMode"), "absolute")
         for seconds in waypoints.time:
             _child(track, _kml("when"), utc_text(plan.timestamp(seconds)))
-        for lat, lon in zip(waypoints.lat, waypoints.lon, strict=True):
-            coord = f"{float(lon)!r} {float(lat)!r} {0.0 - plan.depth!r}"
+        depths = plan.waypoint_depths(waypoints)
+        for lat, lon, depth in zip(*waypoints.geographic(), depths, strict=True):
+            coord = f"{float(lon)!r} {float(lat)!r} {0.0 - float(depth)!r}"
             _child(track, f"{{{GX_NAMESPACE}}}coord", coord)
     if plan.zones:
         obstacles = _child(document, _kml("Folder"), id="obstacles")

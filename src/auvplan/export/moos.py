@@ -7,7 +7,10 @@ MOOS-IvP's build script configures ``-DUSE_UTM=ON``, and the geodesy then uses
 (frame ``"utm"``, the default). A build without it uses ``LatLong2LocalGrid``, a local tangent
 grid (frame ``"local"``: the plan's own transverse-Mercator tangent at the origin). The two
 differ by the meridian convergence and the UTM scale (≈ 1.2 % of the distance from the
-origin near Monterey: 6–7 m at 500 m), so the file says which it is.
+origin near Monterey: 6–7 m at 500 m), so the file says which it is. On terrain without
+geographic reference (the synthetic bank) only the ``local`` frame exists: the points are the
+plan's own north/east, and ``origin.moos`` asks for the ``LatOrigin``/``LongOrigin`` of the
+grid's south-west corner instead of giving them.
 
 **Timing.** ``BHV_Waypoint`` has one ``speed``. To keep the plan's time law (the
 deconfliction's waits and speed changes), each leg is its own behaviour at that leg's speed,
@@ -36,7 +39,8 @@ from pyproj import CRS, Transformer
 
 from auvplan._typing import FloatArray
 from auvplan._version import __version__
-from auvplan.export import MoosFrame, check_moos_frame
+from auvplan.errors import InputError
+from auvplan.export import MoosFrame, check_georeference, check_moos_frame
 from auvplan.export.plan import ExportPlan, utc_text
 from auvplan.export.waypoints import Waypoints, by_file_stem
 from auvplan.terrain.projection import GEOGRAPHIC_CRS, LocalProjection
@@ -69,22 +73,46 @@ def moos_xy(
     plan: ExportPlan, lat: FloatArray, lon: FloatArray, frame: MoosFrame = "utm"
 ) -> tuple[FloatArray, FloatArray]:
     """``x`` east and ``y`` north [m] of ``lat, lon`` [deg] in MOOS ``frame`` (module notes)."""
+    lat_0, lon_0 = _origin(plan)
     if frame == "local":
-        north, east = LocalProjection(plan.origin_lat, plan.origin_lon).to_local(lat, lon)
+        north, east = LocalProjection(lat_0, lon_0).to_local(lat, lon)
         return east, north
     check_moos_frame(frame)
-    to_utm = Transformer.from_crs(
-        GEOGRAPHIC_CRS, utm_crs(plan.origin_lat, plan.origin_lon), always_xy=True
-    )
-    east_0, north_0 = to_utm.transform(plan.origin_lon, plan.origin_lat)
+    to_utm = Transformer.from_crs(GEOGRAPHIC_CRS, utm_crs(lat_0, lon_0), always_xy=True)
+    east_0, north_0 = to_utm.transform(lon_0, lat_0)
     east, north = to_utm.transform(np.asarray(lon), np.asarray(lat))
     return np.asarray(east) - east_0, np.asarray(north) - north_0
 
 
+def waypoint_xy(
+    plan: ExportPlan, waypoints: Waypoints, frame: MoosFrame = "utm"
+) -> tuple[FloatArray, FloatArray]:
+    """``x`` east and ``y`` north [m] of the waypoints in MOOS ``frame``.
+
+    Without geographic reference the plan's own ``east``, ``north`` (``local`` frame only).
+    """
+    if plan.is_georeferenced:
+        return moos_xy(plan, *waypoints.geographic(), frame)
+    check_georeference(["moos"], frame, "the plan's terrain")
+    return waypoints.east, waypoints.north
+
+
+def _origin(plan: ExportPlan) -> tuple[float, float]:
+    """``LatOrigin``, ``LongOrigin`` [deg] of a georeferenced plan."""
+    if plan.origin_lat is None or plan.origin_lon is None:
+        raise InputError("the plan's terrain has no geographic reference: no LatOrigin/LongOrigin")
+    return plan.origin_lat, plan.origin_lon
+
+
 def frame_note(plan: ExportPlan, frame: MoosFrame) -> str:
     """One comment line naming the frame of the ``points``."""
+    if not plan.is_georeferenced:
+        return (
+            "// points: the plan's own frame [m] (origin: the south-west corner of its terrain "
+            "grid, which has no geographic reference), x = east, y = north"
+        )
     if frame == "utm":
-        zone = utm_crs(plan.origin_lat, plan.origin_lon).utm_zone
+        zone = utm_crs(*_origin(plan)).utm_zone
         return (
             f"// points: UTM zone {zone} offsets [m] from LatOrigin/LongOrigin, x = east, "
             "y = north (CMOOSGeodesy::LatLong2LocalUTM, MOOS-IvP's default -DUSE_UTM=ON)"
@@ -110,7 +138,7 @@ def behavior_file(
     plan: ExportPlan, waypoints: Waypoints, *, stem: str, frame: MoosFrame = "utm"
 ) -> str:
     """The ``.bhv`` file of one vehicle: initial values, depth, and one behaviour per leg."""
-    x, y = moos_xy(plan, waypoints.lat, waypoints.lon, frame)
+    x, y = waypoint_xy(plan, waypoints, frame)
     capture = plan.capture_radius
     n_legs = len(waypoints.leg_durations)
     lines = [
@@ -126,7 +154,9 @@ def behavior_file(
         f"initialize {LEG_VARIABLE} = 1",
         "",
     ]
-    if plan.depth > 0.0:
+    if plan.has_profile:
+        lines += leg_depths(plan, waypoints, stem=stem)
+    elif plan.depth > 0.0:
         lines += _block(
             "BHV_ConstantDepth",
             [
@@ -175,6 +205,30 @@ def behavior_file(
     return "\n".join(lines)
 
 
+def leg_depths(plan: ExportPlan, waypoints: Waypoints, *, stem: str) -> list[str]:
+    """One ``BHV_ConstantDepth`` per leg of a depth profile: the depth of the leg's end.
+
+    Each is active while its leg is (``LEG = k``), so the vehicle reaches each waypoint's
+    planned depth [m] along the leg to it (the plan's profile keeps the climb and dive rates
+    and the minimum altitude; :mod:`auvplan.mission.depth_profile`).
+    """
+    depths = plan.waypoint_depths(waypoints)
+    lines = []
+    for k in range(len(waypoints.leg_durations)):
+        lines += _block(
+            "BHV_ConstantDepth",
+            [
+                ("name", f"{stem}_depth_{k + 1}"),
+                ("pwt", "100"),
+                ("condition", "DEPLOY = true"),
+                ("condition", f"{LEG_VARIABLE} = {k + 1}"),
+                ("depth", f"{float(depths[k + 1]):.2f}"),
+                ("duration", "no-time-limit"),
+            ],
+        )
+    return lines
+
+
 def render(
     plan: ExportPlan, fleet: Sequence[Waypoints], *, frame: MoosFrame = "utm"
 ) -> dict[str, str]:
@@ -183,12 +237,22 @@ def render(
         f"{stem}.bhv": behavior_file(plan, waypoints, stem=stem, frame=frame)
         for stem, waypoints in by_file_stem(fleet)
     }
+    origin = (
+        [
+            f"LatOrigin  = {plan.origin_lat:.9f}",
+            f"LongOrigin = {plan.origin_lon:.9f}",
+        ]
+        if plan.is_georeferenced
+        else [
+            "// set LatOrigin and LongOrigin to where the grid's south-west corner lies, and use",
+            "// a MOOS-IvP built with -DUSE_UTM=OFF (CMOOSGeodesy::LatLong2LocalGrid)",
+        ]
+    )
     files["origin.moos"] = "\n".join(
         [
             f"// auvplan {__version__}: origin of the x (east) / y (north) frame of the .bhv files",
             frame_note(plan, frame),
-            f"LatOrigin  = {plan.origin_lat:.9f}",
-            f"LongOrigin = {plan.origin_lon:.9f}",
+            *origin,
             "",
         ]
     )
@@ -202,4 +266,5 @@ __all__ = [
     "moos_xy",
     "render",
     "utm_crs",
+    "waypoint_xy",
 ]

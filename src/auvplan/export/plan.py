@@ -12,11 +12,15 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime, timedelta
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
+
+if TYPE_CHECKING:
+    from auvplan.export.waypoints import Waypoints
 
 
 @dataclass(frozen=True)
@@ -31,20 +35,28 @@ class VehicleTrack:
         Time since the plan's start time [s], increasing.
     north, east : ndarray of shape (n_t,)
         Position in the local frame [m].
-    lat, lon : ndarray of shape (n_t,)
-        The same positions in WGS 84 [deg].
+    lat, lon : ndarray of shape (n_t,) or None
+        The same positions in WGS 84 [deg]; ``None`` on terrain without geographic reference
+        (the synthetic bank).
+    depth : ndarray of shape (n_t,), optional
+        Depth [m], positive down, along a depth profile (``[mission] altitude_m``); ``None``:
+        the plan's constant depth.
     """
 
     name: str
     time: FloatArray
     north: FloatArray
     east: FloatArray
-    lat: FloatArray
-    lon: FloatArray
+    lat: FloatArray | None
+    lon: FloatArray | None
+    depth: FloatArray | None = None
 
     def __post_init__(self) -> None:
         n_t = np.shape(self.time)
-        arrays = (self.north, self.east, self.lat, self.lon)
+        if (self.lat is None) != (self.lon is None):
+            raise InputError(f"track {self.name}: give both lat and lon, or neither")
+        optional = (self.lat, self.lon, self.depth)
+        arrays = (self.north, self.east, *(a for a in optional if a is not None))
         if len(n_t) != 1 or n_t[0] < 2 or any(np.shape(a) != n_t for a in arrays):
             raise InputError(f"track {self.name}: time and positions need one common length >= 2")
         if not np.all(np.diff(self.time) > 0.0):
@@ -81,23 +93,46 @@ class ExportPlan:
     start_time : datetime
         UTC time of ``t = 0`` (time-zone aware).
     depth : float
-        Constant depth of the plan [m], positive down.
-    origin_lat, origin_lon : float
-        WGS 84 position [deg] of the local frame's origin (``north = east = 0``).
+        Constant depth of the plan [m], positive down (used where a track has no depth
+        profile).
+    origin_lat, origin_lon : float or None
+        WGS 84 position [deg] of the local frame's origin (``north = east = 0``); ``None``
+        on terrain without geographic reference, whose tracks have no lat/lon either.
     capture_radius : float
         Distance [m] at which a vehicle counts a waypoint as reached (the fleet's safety
         radius ``r_c``).
     zones : tuple of CircleZone or PolygonZone
-        The mission's obstacles.
+        The mission's obstacles (none without geographic reference: only the formats that
+        need lat/lon draw them).
     """
 
     tracks: tuple[VehicleTrack, ...]
     start_time: datetime
     depth: float
-    origin_lat: float
-    origin_lon: float
+    origin_lat: float | None
+    origin_lon: float | None
     capture_radius: float
     zones: tuple[CircleZone | PolygonZone, ...] = ()
+
+    @property
+    def is_georeferenced(self) -> bool:
+        """Whether the plan has lat/lon (its origin and every track)."""
+        return (
+            self.origin_lat is not None
+            and self.origin_lon is not None
+            and all(track.lat is not None for track in self.tracks)
+        )
+
+    @property
+    def has_profile(self) -> bool:
+        """Whether the tracks carry a depth profile (``[mission] altitude_m``)."""
+        return any(track.depth is not None for track in self.tracks)
+
+    def waypoint_depths(self, waypoints: Waypoints) -> FloatArray:
+        """Depth [m], positive down, at each waypoint: its track's profile, else ``depth``."""
+        if waypoints.depth is not None:
+            return waypoints.depth
+        return np.full(waypoints.time.shape, float(self.depth))
 
     def timestamp(self, seconds: float) -> datetime:
         """The UTC time ``seconds`` [s] after the start."""

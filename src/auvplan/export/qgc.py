@@ -6,7 +6,8 @@ on a submarine (``vehicleType`` 12 = MAV_TYPE_SUBMARINE):
 
 * a ``MAV_CMD_NAV_WAYPOINT`` (16) per waypoint, frame 3 (MAV_FRAME_GLOBAL_RELATIVE_ALT), params
   ``[hold, acceptance radius, pass radius 0, yaw unchanged (null), lat, lon, altitude]``;
-  the altitude is the depth as a negative number, since ArduSub refuses a waypoint above home
+  the altitude is the waypoint's depth (along a depth profile, its own) as a negative
+  number, since ArduSub refuses a waypoint above home
   ("Alt above home must be negative"). ArduSub's ``do_nav_wp`` reads an altitude of exactly 0
   as "keep the current depth", so a surface plan (depth 0) is written at
   :data:`SURFACE_DEPTH` (1 cm, the resolution of ArduPilot's ``Location`` altitudes), which
@@ -72,7 +73,8 @@ def mission_items(plan: ExportPlan, waypoints: Waypoints) -> list[dict[str, Any]
     is_wait = waypoints.waits
     holds = np.append(np.where(is_wait, waypoints.leg_durations, 0.0), 0.0)
     commands: list[tuple[int, int, list[float | None]]] = []
-    altitude = 0.0 - max(plan.depth, SURFACE_DEPTH)
+    altitudes = 0.0 - np.maximum(plan.waypoint_depths(waypoints), SURFACE_DEPTH)
+    lat, lon = waypoints.geographic()
     speed = None
     for k in range(waypoints.time.size):
         if k > 0 and not is_wait[k - 1]:
@@ -80,7 +82,7 @@ def mission_items(plan: ExportPlan, waypoints: Waypoints) -> list[dict[str, Any]
             if leg_speed != speed:
                 commands.append((DO_CHANGE_SPEED, FRAME_MISSION, [1, leg_speed, -1, 0, 0, 0, 0]))
                 speed = leg_speed
-        position = [float(waypoints.lat[k]), float(waypoints.lon[k]), altitude]
+        position = [float(lat[k]), float(lon[k]), float(altitudes[k])]
         parameters: list[float | None] = [float(holds[k]), plan.capture_radius, 0, None, *position]
         commands.append((NAV_WAYPOINT, FRAME_GLOBAL_RELATIVE_ALT, parameters))
     return [
@@ -93,7 +95,7 @@ def mission_items(plan: ExportPlan, waypoints: Waypoints) -> list[dict[str, Any]
             "params": parameters,
             **(
                 {
-                    "Altitude": altitude,
+                    "Altitude": parameters[6],
                     "AltitudeMode": ALTITUDE_MODE_RELATIVE,
                     "AMSLAltAboveTerrain": None,
                 }
@@ -107,6 +109,7 @@ def mission_items(plan: ExportPlan, waypoints: Waypoints) -> list[dict[str, Any]
 
 def plan_document(plan: ExportPlan, waypoints: Waypoints) -> dict[str, Any]:
     """The ``.plan`` document of one vehicle."""
+    home_lat, home_lon = waypoints.geographic()
     return {
         "fileType": "Plan",
         "version": 1,
@@ -120,7 +123,7 @@ def plan_document(plan: ExportPlan, waypoints: Waypoints) -> dict[str, Any]:
             "vehicleType": VEHICLE_SUBMARINE,
             "cruiseSpeed": waypoints.mean_speed,
             "hoverSpeed": waypoints.mean_speed,
-            "plannedHomePosition": [float(waypoints.lat[0]), float(waypoints.lon[0]), 0],
+            "plannedHomePosition": [float(home_lat[0]), float(home_lon[0]), 0],
             "items": mission_items(plan, waypoints),
         },
     }

@@ -48,7 +48,8 @@ class Waypoints:
     """The kept samples of a track: every array has shape ``(n_waypoints,)``.
 
     ``index`` are their positions in the track; ``time`` [s since the start], ``north``,
-    ``east`` [m] and ``lat``, ``lon`` [deg] are the track's values there.
+    ``east`` [m], ``lat``, ``lon`` [deg] (``None`` without geographic reference) and
+    ``depth`` [m] (``None`` without a depth profile) are the track's values there.
     """
 
     name: str
@@ -56,8 +57,22 @@ class Waypoints:
     time: FloatArray
     north: FloatArray
     east: FloatArray
-    lat: FloatArray
-    lon: FloatArray
+    lat: FloatArray | None
+    lon: FloatArray | None
+    depth: FloatArray | None = None
+
+    def geographic(self) -> tuple[FloatArray, FloatArray]:
+        """``(lat, lon)`` [deg] of the waypoints.
+
+        Raises
+        ------
+        InputError
+            If the plan has no geographic reference (see
+            :func:`auvplan.export.check_georeference`, which refuses such formats first).
+        """
+        if self.lat is None or self.lon is None:
+            raise InputError(f"vehicle {self.name}: the plan has no lat/lon")
+        return self.lat, self.lon
 
     @property
     def leg_lengths(self) -> FloatArray:
@@ -171,8 +186,9 @@ def thin_track(track: VehicleTrack, tolerance: float) -> Waypoints:
         time=track.time[kept],
         north=track.north[kept],
         east=track.east[kept],
-        lat=track.lat[kept],
-        lon=track.lon[kept],
+        lat=None if track.lat is None else track.lat[kept],
+        lon=None if track.lon is None else track.lon[kept],
+        depth=None if track.depth is None else track.depth[kept],
     )
 
 
@@ -185,6 +201,8 @@ def _check_finite(track: VehicleTrack) -> None:
     """Raise InputError naming the vehicle, column and first sample that is not finite."""
     for column in ("time", "north", "east", "lat", "lon"):
         values = getattr(track, column)
+        if values is None:  # no geographic reference
+            continue
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
             raise InputError(

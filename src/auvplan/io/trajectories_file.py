@@ -1,8 +1,8 @@
 """``trajectories.nc``: the optimised trajectories as a CF ``featureType = "trajectory"`` file.
 
 It follows the NCEI NetCDF trajectory template v2.0 and carries ACDD-1.3 discovery attributes
-(:func:`_discovery_attributes`), and every variable its ``coverage_content_type`` and valid
-range.
+(:func:`_discovery_attributes`: computed from the plan, and who made it from the mission's
+``[metadata]``), and every variable its ``coverage_content_type`` and valid range.
 
 The layout follows the NCEI NetCDF trajectory template (v2.0, multidimensional array
 representation, CF §H.4.1): one ``trajectory`` per vehicle (the ``trajectory`` variable holds
@@ -12,7 +12,9 @@ grid. ``time``, ``lat``, ``lon`` and ``depth`` are the auxiliary coordinates of 
 
 * ``time`` [seconds since ``start_time``, UTC] (standard name ``time``);
 * ``lat``, ``lon`` [degrees, WGS 84] (``latitude``, ``longitude``; georeferenced terrain only);
-* ``depth`` [m, positive down], the plan's constant depth (``depth``);
+* ``depth`` [m, positive down], the plan's constant depth (``depth``), or each sample's
+  depth along a depth profile (``[mission] altitude_m``), which also writes ``altitude``
+  [m], the height above the seabed (``height_above_sea_floor``);
 * ``north``, ``east`` [m]: the position in the local frame of ``maps.nc``;
 * ``heading`` [degree]: ψ clockwise from true north (``platform_orientation``);
 * ``u``, ``v`` [m s-1]: surge (body x, forward) and sway (body y, to starboard) speed through
@@ -39,7 +41,7 @@ from __future__ import annotations
 
 import hashlib
 from collections.abc import Mapping, Sequence
-from datetime import datetime, timedelta
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Final
 
@@ -153,10 +155,13 @@ def trajectories_dataset(
     *,
     psi: FloatArray,
     start_time: datetime,
-    depth: float,
+    depth: float | FloatArray,
     projection: LocalProjection | None,
     attributes: Mapping[str, Any],
     vehicle_types: Sequence[str] | None = None,
+    metadata: Mapping[str, str] | None = None,
+    created: datetime | None = None,
+    altitude: FloatArray | None = None,
 ) -> xr.Dataset:
     """The content of ``trajectories.nc`` as :func:`read_trajectories_netcdf` returns it.
 
@@ -177,14 +182,22 @@ def trajectories_dataset(
         Yaw angle [rad], clockwise from the local north.
     start_time : datetime
         UTC time of ``t = 0`` (time-zone aware).
-    depth : float
-        Constant depth [m] of the plan.
+    depth : float or ndarray of shape (n_vehicles, n_t)
+        Constant depth [m] of the plan, or each sample's depth (a depth profile).
     projection : LocalProjection or None
         Local frame to WGS 84; ``None`` gives no ``lat``/``lon``.
     attributes : mapping
         Extra global attributes (strings or numbers).
     vehicle_types : sequence of str, optional
         Each vehicle's type name, written as ``vehicle_type`` when given.
+    metadata : mapping of str to str, optional
+        Who made the plan: ACDD attributes by name (the mission's ``[metadata]``); an
+        attribute computed here or in ``attributes`` takes precedence.
+    created : datetime, optional
+        Time the plan was made: ``date_created``, ``date_modified`` and ``date_issued``
+        (none when not given).
+    altitude : ndarray of shape (n_vehicles, n_t), optional
+        Height above the seabed [m] along a depth profile, written as ``altitude``.
 
     Returns
     -------
@@ -212,7 +225,7 @@ def trajectories_dataset(
         ),
         "depth": (
             dims,
-            np.full(shape, float(depth)),
+            np.broadcast_to(np.asarray(depth, dtype=np.float64), shape).copy(),
             {
                 "standard_name": "depth",
                 "long_name": "depth below the sea surface",
@@ -240,6 +253,16 @@ def trajectories_dataset(
             "long_name": f"heading, clockwise from {heading_reference}",
         },
     )
+    if altitude is not None:
+        data["altitude"] = (
+            dims,
+            np.asarray(altitude, dtype=np.float64),
+            {
+                "units": "m",
+                "standard_name": "height_above_sea_floor",
+                "long_name": "height of the vehicle above the seabed",
+            },
+        )
     if vehicle_types is not None:
         data["vehicle_type"] = (
             "trajectory",
@@ -255,7 +278,9 @@ def trajectories_dataset(
             variable.attrs["valid_min"] = float(np.nanmin(variable.values))
             variable.attrs["valid_max"] = float(np.nanmax(variable.values))
     dataset.attrs = {
-        **_discovery_attributes(dataset, names, time, start_time, depth),
+        **(metadata or {}),
+        **_discovery_attributes(dataset, names, time, start_time),
+        **(_dates(created) if created is not None else {}),
         **attributes,
     }
     for variable in dataset.variables.values():
@@ -274,9 +299,10 @@ def trajectories_dataset(
 
 #: The NCEI NetCDF template the file follows (checked by ``cc-plugin-ncei``).
 NCEI_TEMPLATE: Final = "NCEI_NetCDF_Trajectory_Template_v2.0"
-#: ``Conventions``: the NCEI trajectory template v2.0 requires exactly this string (its CF
-#: layer is CF-1.6); the content is also CF-1.8-clean (``compliance-checker -t cf:1.8``).
-CONVENTIONS: Final = "CF-1.6, ACDD-1.3"
+#: ``Conventions``: the file follows CF-1.8 (``compliance-checker -t cf:1.8``) and ACDD-1.3;
+#: the NCEI trajectory template v2.0 requires ``CF-1.6`` in the list too (its checker,
+#: ``compliance-checker -t ncei-trajectory:2.0``, finds no required attribute missing).
+CONVENTIONS: Final = "CF-1.8, CF-1.6, ACDD-1.3"
 
 
 def _discovery_attributes(
@@ -284,14 +310,23 @@ def _discovery_attributes(
     names: Sequence[str],
     time: FloatArray,
     start_time: datetime,
-    depth: float,
 ) -> dict[str, Any]:
     """CF, ACDD-1.3 and NCEI trajectory-template global attributes from the data itself.
 
-    Everything is derived from the plan (extent, times, vehicles), so the same plan gives the
-    same file: no creation date.
+    Everything is derived from the plan (extent, times, vehicles): the same plan gives the
+    same attributes (the dates of :func:`_dates` aside). ``id`` is ``auvplan-`` and the first
+    16 hexadecimal digits of the SHA-256 of the positions, unique under any
+    ``naming_authority``; ``time_coverage_duration`` and ``_resolution`` are ISO 8601
+    durations (``PT<seconds>S``) of the horizon and the solver step.
     """
     end_time = start_time + timedelta(seconds=float(time[-1]))
+    depth = dataset["depth"].values
+    shallowest, deepest = float(np.min(depth)), float(np.max(depth))
+    depths = (
+        f"at a constant depth of {shallowest:g} m"
+        if shallowest == deepest
+        else f"at depths of {shallowest:.1f} to {deepest:.1f} m"
+    )
     digest = hashlib.sha256(np.ascontiguousarray(dataset["north"].values).tobytes())
     digest.update(np.ascontiguousarray(dataset["east"].values).tobytes())
     attributes: dict[str, Any] = {
@@ -302,9 +337,8 @@ def _discovery_attributes(
         "title": "auvplan optimised trajectories",
         "summary": f"Energy-optimal, collision-free trajectories of {len(names)} marine "
         f"vehicle(s) ({', '.join(names)}) planned by auvplan over a bathymetry grid, from "
-        f"{start_time.isoformat()} to {end_time.isoformat()}, at a constant depth of "
-        f"{depth:g} m: positions, body velocities, actuator states and electrical power at "
-        "the solver's time steps.",
+        f"{start_time.isoformat()} to {end_time.isoformat()}, {depths}: positions, body "
+        "velocities, actuator states and electrical power at the solver's time steps.",
         "keywords": "autonomous underwater vehicle, AUV, trajectory planning, multi-vehicle, "
         "terrain-aided navigation, bathymetry, energy",
         "id": f"auvplan-{digest.hexdigest()[:16]}",
@@ -321,8 +355,8 @@ def _discovery_attributes(
         "acknowledgment": "Method: Häusler, Saccon, Pascoal, Hauser and Aguiar, Cooperative AUV "
         "Motion Planning using Terrain Information, OCEANS 2013; bathymetry: the source named "
         "in the run's summary.json",
-        "geospatial_vertical_min": float(depth),
-        "geospatial_vertical_max": float(depth),
+        "geospatial_vertical_min": shallowest,
+        "geospatial_vertical_max": deepest,
         "geospatial_vertical_units": "m",
         "geospatial_vertical_positive": "down",
     }
@@ -340,6 +374,15 @@ def _discovery_attributes(
             geospatial_bounds_vertical_crs="EPSG:5831",  # depth below the sea surface
         )
     return attributes
+
+
+def _dates(created: datetime) -> dict[str, str]:
+    """ACDD ``date_created``, ``date_modified`` and ``date_issued``: ``created`` in ISO 8601.
+
+    The plan is made, last changed and issued at once (UTC, whole seconds, ``Z``).
+    """
+    text = created.astimezone(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
+    return {"date_created": text, "date_modified": text, "date_issued": text}
 
 
 def _bounds_wkt(lat: FloatArray, lon: FloatArray) -> str:

@@ -3,6 +3,8 @@
 :func:`trajectories_dataset_of` is what :func:`~auvplan.record.write_record` writes and what
 :meth:`auvplan.MissionPlan.to_xarray` returns, for a plan made in memory and for one read
 back from its folder alike (:func:`auvplan.io.trajectories_file.trajectories_dataset`).
+Who made the plan comes from ``mission.toml``'s ``[metadata]``
+(:class:`auvplan.mission.tables.MetadataConfig`), the platform from the vehicle types.
 """
 
 from __future__ import annotations
@@ -16,7 +18,8 @@ from auvplan._version import __version__
 from auvplan.errors import DataFormatError
 from auvplan.io.results import union_names
 from auvplan.io.trajectories_file import SERIES, trajectories_dataset
-from auvplan.record.trajectories import VehicleTrajectory
+from auvplan.record.files import MISSION_FILE
+from auvplan.record.trajectories import VehicleTrajectory, depth_profiles
 from auvplan.vehicle import STATE_NAMES
 
 if TYPE_CHECKING:
@@ -49,13 +52,16 @@ def trajectories_dataset_of(record: PlanRecord, label: str) -> xr.Dataset:
     names = union_names([table.state_names for table in tables], tuple(SERIES))
     series = {name: fleet_series(tables, name) for name in names if name not in ("power", "psi")}
     is_medusa_layout = all(table.state_names == STATE_NAMES for table in tables)
+    profiles = depth_profiles(tables)
+    types = [vehicle.type_name or vehicle.type for vehicle in record.summary.vehicles]
     return trajectories_dataset(
         [table.name for table in tables],
         tables[0].time,
         {**series, "power": np.array([table.power for table in tables])},
         psi=fleet_series(tables, "psi"),
         start_time=record.summary.start,
-        depth=record.depth,
+        depth=record.depth if profiles is None else np.array([depth for depth, _ in profiles]),
+        altitude=None if profiles is None else np.array([altitude for _, altitude in profiles]),
         projection=record.maps.bathymetry.projection,
         attributes={
             "source": f"auvplan {__version__}",
@@ -63,11 +69,26 @@ def trajectories_dataset_of(record: PlanRecord, label: str) -> xr.Dataset:
             "references": "Häusler et al., Cooperative AUV Motion Planning using Terrain "
             "Information, OCEANS 2013",
             "terrain_weight": outcome.terrain_weight,
+            "platform": ", ".join(dict.fromkeys(types)),
         },
-        vehicle_types=None
-        if is_medusa_layout
-        else [vehicle.type_name or vehicle.type for vehicle in record.summary.vehicles],
+        vehicle_types=None if is_medusa_layout else types,
+        metadata=operator_metadata(record.mission),
+        created=record.summary.created_at,
     )
 
 
-__all__ = ["fleet_series", "trajectories_dataset_of"]
+def operator_metadata(mission: dict[str, object]) -> dict[str, str]:
+    """The ``[metadata]`` table of a resolved mission document: attribute name -> text.
+
+    Raises
+    ------
+    DataFormatError
+        If the table or one of its values is not text (a ``mission.toml`` edited by hand).
+    """
+    table = mission.get("metadata", {})
+    if not isinstance(table, dict) or not all(isinstance(v, str) for v in table.values()):
+        raise DataFormatError(f"{MISSION_FILE}: [metadata] must hold text values only")
+    return {str(key): value for key, value in table.items()}
+
+
+__all__ = ["fleet_series", "operator_metadata", "trajectories_dataset_of"]
