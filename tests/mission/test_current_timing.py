@@ -10,9 +10,8 @@ import numpy as np
 import pytest
 
 from auvplan.errors import InfeasibleError
-from auvplan.mission.config import parse_mission
 from auvplan.io.vehicles import load_vehicle
-from auvplan.mission.config import DeconflictionConfig, FleetConfig
+from auvplan.mission.config import DeconflictionConfig, FleetConfig, parse_mission
 from auvplan.mission.current import mean_ground_speed, water_speed_times
 from auvplan.mission.fleet import FleetLayout
 from auvplan.mission.pipeline import fleet_layout, run_optimization

@@ -158,3 +158,23 @@ def test_a_goal_in_the_start_cell_is_planned(tmp_path: Path) -> None:
     green = json.loads((out / "summary.json").read_text(encoding="utf-8"))["vehicles"][1]
     assert green["name"] == "green"
     assert green["preplan"]["navigation"]["route_predicted_rms_m"] > 0.0
+
+
+def test_a_budget_route_is_flown_within_its_corridor(
+    tmp_path: Path, transit_mission: TransitMission
+) -> None:
+    """The optimiser keeps a budget route's plan within CORRIDOR_CELLS cells of the certified
+    route at every node (the corridor rows' smallest slack is >= 0, and binding somewhere is
+    allowed), and the replayed plan keeps the budget (CONVERGED)."""
+    free = _preplan(transit_mission(tmp_path, ridge=True, navigation="max_energy_increase = 0.0"),
+                    tmp_path / "free")  # fmt: skip
+    budget = 0.6 * float(free["energy_only_route_predicted_peak_m"])  # type: ignore[arg-type]
+    mission = transit_mission(tmp_path, ridge=True, navigation=f"max_error_m = {budget:.2f}")
+    out = tmp_path / "plan"
+    assert main(["-q", "plan", str(mission), "-o", str(out), "--no-figures"]) == 0
+    summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    plan = summary["optimization"]
+    slack = plan["constraint_slack"]["corridor"]
+    assert list(slack) == [f"{summary['vehicles'][0]['name']} / corridor"]
+    assert min(slack.values()) >= -1e-9
+    assert plan["plan_status"] == "CONVERGED"

@@ -28,6 +28,8 @@ from auvplan.optimization import PathConstraint, Trajectory, TrajectoryProblem
 from auvplan.planning import CircleObstacle
 from auvplan.vehicle import headings, reference_states, regulator_floor, stable_rk4_step
 
+#: Half-width of a budget route's corridor in cells of the cost grid (:func:`navigation_corridors`).
+CORRIDOR_CELLS: Final = 2.0
 #: Largest working memory [bytes] the optimiser may need before the mission is refused.
 MEMORY_BUDGET: Final = 16 * 2**30
 #: Dense arrays of size ``(n_x + n_u)²`` the optimiser keeps per solver step (Jacobians,
@@ -42,6 +44,21 @@ class AssembledProblem:
     functions: FleetProblemFunctions
     problem: TrajectoryProblem
     guess: Trajectory
+
+
+@dataclass(frozen=True)
+class WarmStart:
+    """Where stage 3 starts instead of the mission's start poses and desired trajectories.
+
+    ``initial_state`` ``(n_x,)`` is the stacked state ``x_0`` (a replan: each vehicle's state
+    at the replanning time); ``guess`` the curve PRONTO projects from it, or None for the
+    desired trajectories with zero inputs (:func:`assemble_problem`); ``delta`` the barrier's
+    switching point ``δ`` the guess was optimal for (None: the solver's ``delta_initial``).
+    """
+
+    initial_state: FloatArray
+    guess: Trajectory | None = None
+    delta: float | None = None
 
 
 def check_optimizer_memory(layout: FleetLayout, n_steps: int) -> None:
@@ -141,6 +158,24 @@ def stage_parameters(
     )
 
 
+def navigation_corridors(preplan: PreplanStage) -> tuple[float, ...]:
+    """Per vehicle the corridor half-width [m] around its desired trajectory (``inf``: none).
+
+    A route chosen to meet an explicit navigation budget (``[navigation] max_error_m``) is
+    certified by the belief-space search on the cost grid, cell by cell: the optimised plan
+    keeps within :data:`CORRIDOR_CELLS` cells of it at every solver node (a hockey-stick
+    barrier, inactive inside), so it flies over the seabed the certificate counted on; the
+    closed-loop replay then checks the budget itself (:mod:`auvplan.mission.checks`).
+    Automatic routes and the paper's have no corridor.
+    """
+    choices = preplan.navigation or ()
+    geometry = preplan.maps.cost_geometry
+    width = CORRIDOR_CELLS * max(geometry.spacing_north, geometry.spacing_east)
+    return tuple(
+        width if choice.mode == "budget" and choice.tracked else math.inf for choice in choices
+    )
+
+
 def assemble_problem(
     layout: FleetLayout,
     preplan: PreplanStage,
@@ -151,6 +186,7 @@ def assemble_problem(
     safety_radius: float,
     comms: tuple[CommConfig, ...],
     current: CurrentField | None = None,
+    warm_start: WarmStart | None = None,
 ) -> AssembledProblem:
     """The stacked fleet problem for PRONTO (and the IPOPT reference), with its initial guess.
 
@@ -159,6 +195,8 @@ def assemble_problem(
     around is not tracked: its vehicle's plan is the energy-optimal one. The
     guess is the desired trajectory with zero inputs; PRONTO projects it onto the dynamics.
     ``current`` (None: still water) enters each stage linearised about the desired position.
+    ``warm_start`` replaces the initial state (:func:`start_states`) and, when it has one, the
+    guess.
 
     Raises
     ------
@@ -181,6 +219,7 @@ def assemble_problem(
             (layout.names.index(comm.pair[0]), layout.names.index(comm.pair[1]), comm.max_range)
             for comm in comms
         ),
+        corridors=navigation_corridors(preplan),
     )
     functions = build_fleet_functions(
         layout,
@@ -200,7 +239,9 @@ def assemble_problem(
         dynamics=functions.dynamics,
         running_cost=functions.running_cost,
         terminal_cost=functions.terminal_cost,
-        initial_state=start_states(layout, preplan),
+        initial_state=start_states(layout, preplan)
+        if warm_start is None
+        else warm_start.initial_state,
         dt=deconfliction.dt,
         n_steps=deconfliction.time.size - 1,
         stage_parameters=stage_parameters(layout, desired, deconfliction.time, current),
@@ -218,4 +259,6 @@ def assemble_problem(
     guess = Trajectory(
         states=stacked_desired, inputs=np.zeros((deconfliction.time.size - 1, layout.n_u))
     )
+    if warm_start is not None and warm_start.guess is not None:
+        guess = warm_start.guess
     return AssembledProblem(functions, problem, guess)

@@ -98,8 +98,8 @@ def constraint_slack(
     """The smallest value of every constraint row along ``trajectory``, by block and label.
 
     ``slack[block][label]`` with ``block`` a constraint name (``"collision"``, ``"obstacle"``,
-    ``"communication"``, ``"state_limits"``) and ``label`` the row's pair (``"a / b"``);
-    feasible when ``>= 0``.
+    ``"communication"``, ``"corridor"``, ``"state_limits"``) and ``label`` the row's pair
+    (``"a / b"``); feasible when ``>= 0``.
     """
     states, inputs = trajectory.states, trajectory.inputs
     n_steps = inputs.shape[0]

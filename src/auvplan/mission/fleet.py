@@ -320,6 +320,9 @@ class FleetLimits:
     ``obstacle_names``; ``comm_pairs``: vehicle index pairs and their range [m].
     ``separation_margin`` [m] is added to ``2 r_c`` and ``r_c + r_o``: the constraints are imposed
     at the grid nodes only, and it covers the largest dip of a distance between two nodes.
+    ``corridors`` (empty: none): per vehicle the half-width ``w`` [m] of the corridor around
+    its desired position it keeps, ``|p_k − p_d,k| ≤ w`` (``inf``: no corridor), for routes
+    certified by a navigation budget (:func:`auvplan.mission.assembly.navigation_corridors`).
     """
 
     safety_radius: float
@@ -327,6 +330,7 @@ class FleetLimits:
     obstacles: FloatArray
     obstacle_names: tuple[str, ...]
     comm_pairs: tuple[tuple[int, int, float], ...]
+    corridors: tuple[float, ...] = ()
 
 
 def build_fleet_functions(
@@ -392,7 +396,13 @@ def build_fleet_functions(
         running_cost=running_cost,
         power=ca.Function("fleet_power", [x, c], [powers]),
         terminal_cost=ca.Function("fleet_m", [x], [terminal]),
-        constraints=_constraints(layout, (x, c, p), xs, limits),
+        constraints=_constraints(
+            layout,
+            (x, c, p),
+            xs,
+            [p[layout.parameter_slice(i, has_current=has_current)] for i in range(len(models))],
+            limits,
+        ),
     )
 
 
@@ -400,8 +410,13 @@ def _constraints(
     layout: FleetLayout,
     arguments: tuple[ca.SX, ca.SX, ca.SX],
     xs: list[ca.SX],
+    desired: list[ca.SX],
     limits: FleetLimits,
 ) -> tuple[FleetConstraint, ...]:
+    """The path constraint blocks ``c ≥ 0``.
+
+    ``desired`` holds each vehicle's stage parameters (its desired state first).
+    """
     names, models = layout.names, layout.models
     blocks: list[FleetConstraint] = []
 
@@ -448,6 +463,20 @@ def _constraints(
         [1 - squared_distance(i, *position(j)) / d_max**2 for i, j, d_max in limits.comm_pairs],
         [Pair(names[i], names[j]) for i, j, _ in limits.comm_pairs],
         "plain",
+    )
+    corridors = [(i, w) for i, w in enumerate(limits.corridors) if np.isfinite(w)]
+    add(
+        "corridor",
+        [
+            1
+            - squared_distance(
+                i, desired[i][models[i].index("north")], desired[i][models[i].index("east")]
+            )
+            / w**2
+            for i, w in corridors
+        ],
+        [Pair(names[i], "corridor") for i, _ in corridors],
+        "hockey",
     )
     add(
         "state_limits",
