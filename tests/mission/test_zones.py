@@ -9,6 +9,7 @@ water in a zone and islands in an area; the verdict names a replay that leaves t
 from __future__ import annotations
 
 import json
+import re
 import tomllib
 import warnings
 from pathlib import Path
@@ -133,7 +134,8 @@ polygon = [{lat_lon_vertices(projection, CORRIDOR)}]
 
 def preplan(mission: Path) -> dict[str, Any]:
     out = mission.parent / "out"
-    assert main(["-q", "plan", str(mission), "-o", str(out), "--stage", "preplan"]) == 0
+    argv = ["-q", "plan", str(mission), "-o", str(out), "--stage", "preplan", "--no-figures"]
+    assert main(argv) == 0
     summary: dict[str, Any] = json.loads((out / "summary.json").read_text(encoding="utf-8"))
     return summary
 
@@ -256,3 +258,136 @@ def test_the_optimised_replay_keeps_clear_of_gis_zones_and_inside_the_area(
     minima = summary["optimization"]["vehicles"]["blue"]["min_separation_m"]
     assert set(minima) == {"reef feature 0", "wreck feature 0", AREA_NAME}
     assert min(minima.values()) >= SAFETY_RADIUS - 1e-3
+
+
+BOWTIE = np.array([[100.0, 100.0], [150.0, 150.0], [100.0, 150.0], [150.0, 100.0]])
+SQUARE = np.array([[300.0, 300.0], [300.0, 400.0], [400.0, 400.0], [400.0, 300.0]])
+
+
+def write_two_polygons(root: Path, projection: LocalProjection) -> str:
+    geometries = [geographic(projection, SQUARE), geographic(projection, SQUARE - 200.0)]
+    features = [{"type": "Feature", "properties": {}, "geometry": mapping(g)} for g in geometries]
+    (root / "two.geojson").write_text(
+        json.dumps({"type": "FeatureCollection", "features": features})
+    )
+    return "two.geojson"
+
+
+def write_bowtie(root: Path, projection: LocalProjection) -> str:
+    document = {
+        "type": "FeatureCollection",
+        "features": [
+            {
+                "type": "Feature",
+                "properties": {},
+                "geometry": mapping(geographic(projection, SQUARE)),
+            },
+            {
+                "type": "Feature",
+                "id": "kelp",
+                "properties": {},
+                "geometry": mapping(geographic(projection, BOWTIE)),
+            },
+        ],
+    }
+    (root / "bad.geojson").write_text(json.dumps(document))
+    return "bad.geojson"
+
+
+BOX = "[[0.0, 0.0], [0.0, 450.0], [450.0, 450.0], [450.0, 0.0]]"
+NORTH_BAND = "[[300.0, 0.0], [300.0, 450.0], [450.0, 450.0], [450.0, 0.0]]"
+TRIANGLE = "[[0.0, 0.0], [0.0, 9.0], [9.0, 0.0]]"
+MIXED = "[[0.0, 0.0], [0.0, 9.0], {{ lat = 36.79, lon = -121.81 }}]"
+CIRCLE = "center = {{ north = 1.0, east = 1.0 }}\nradius_m = 3.0"
+NAMED_AREA = (
+    '[[vehicle]]\nname = "operating area"\nstart = {{ north = 60.0, east = 100.0 }}\n'
+    "goal = {{ north = 260.0, east = 100.0 }}\n"
+)
+ALONG = ((60.0, 250.0), (260.0, 250.0))
+
+
+@pytest.mark.parametrize(
+    ("poses", "tables", "expected"),
+    [
+        (
+            ALONG, '[[obstacle]]\nname = "z"\nfile = "{bad}"\n',
+            r"bad\.geojson: feature 1 \(id 'kelp'\): invalid polygon \(Self-intersection\[",
+        ),
+        (
+            ((350.0, 350.0), (60.0, 60.0)), '[[obstacle]]\nname = "z"\nfile = "{two}"\n',
+            r"blue: start \(350, 350\) m is inside obstacle 'z feature 0'",
+        ),
+        (
+            ((350.0, 350.0), (60.0, 60.0)),
+            f'[area]\npolygon = {BOX}\n[[obstacle]]\nfile = "{{two}}"',
+            r"blue: start \(350, 350\) m is inside obstacle 'obstacle 0 feature 0'",
+        ),
+        (
+            ((350.0, 350.0), (480.0, 60.0)), f"[area]\npolygon = {NORTH_BAND}\n",
+            r"blue: goal \(480, 60\) m is outside the operating area",
+        ),
+        (
+            ((350.0, 350.0), (400.0, 60.0)), '[area]\nfile = "{two}"\n',
+            r"two\.geojson: an operating area is one polygon, the file holds 2",
+        ),
+        (
+            ALONG, '[[obstacle]]\nfile = "missing.geojson"\n',
+            r"zones file .*missing\.geojson: file not found",
+        ),
+        (
+            ALONG, '[[obstacle]]\nfile = "{two}"\nlayer = "x"\n',
+            r"two\.geojson: a GeoJSON file has no layers",
+        ),
+        (ALONG, f'[[obstacle]]\nlayer = "x"\n{CIRCLE}\n', r"obstacle\[0\]: layer needs a file"),
+        (
+            ALONG, f'[area]\nfile = "{{two}}"\npolygon = {TRIANGLE}\n',
+            r"area: give a polygon or a file \(one of them\)",
+        ),
+        (
+            ALONG, f"[area]\npolygon = {MIXED}\n",
+            r"area: give every vertex as \[north, east\] or every one as \{ lat, lon \}",
+        ),
+        (
+            ALONG, NAMED_AREA + '[area]\nfile = "{two}"\n',
+            r"names must be unique: operating area",
+        ),
+    ],
+)  # fmt: skip
+def test_bad_zones_and_areas_are_one_line_exit_2_and_write_nothing(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    poses: tuple[tuple[float, float], tuple[float, float]],
+    tables: str,
+    expected: str,
+) -> None:
+    projection = write_grid(tmp_path / "grid.nc")
+    names = {
+        "bad": write_bowtie(tmp_path, projection),
+        "two": write_two_polygons(tmp_path, projection),
+    }
+    mission = tmp_path / "mission.toml"
+    mission.write_text(mission_text(*poses, tables.format(**names)))
+    before = sorted(tmp_path.iterdir())
+    capsys.readouterr()
+    code = main(["plan", str(mission), "-o", str(tmp_path / "out"), "--stage", "preplan"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert len(err.splitlines()) == 1, err
+    assert re.search(expected, err), err
+    assert sorted(tmp_path.iterdir()) == before  # nothing written
+
+
+def test_lat_lon_zones_on_terrain_without_a_geographic_reference_are_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    vertices = "[{ lat = 1.0, lon = 2.0 }, { lat = 1.0, lon = 2.1 }, { lat = 1.1, lon = 2.0 }]"
+    text = mission_text((10.0, 400.0), (200.0, 400.0), f"[area]\npolygon = {vertices}\n")
+    mission = tmp_path / "mission.toml"
+    mission.write_text(text.replace('file = "grid.nc"', "synthetic = true"))
+    code = main(["plan", str(mission), "-o", str(tmp_path / "out"), "--stage", "preplan"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert err == (
+        "auvplan: error: operating area is given in lat/lon but the terrain has no geographic "
+        "reference"
+    )
