@@ -43,6 +43,7 @@ if TYPE_CHECKING:
 
     from auvplan.api.companion import Companion
     from auvplan.api.progress import ConsoleProgress
+    from auvplan.api.replanning import StatesSource
 
 #: What :func:`plan` accepts as a mission: a TOML file, a validated mission, or its document.
 MissionSource = str | os.PathLike[str] | MissionConfig | Mapping[str, Any]
@@ -195,6 +196,26 @@ class MissionPlan:
             circles=circles, polygons=polygons,
         )  # fmt: skip
 
+    def replan(
+        self, at: float, states: StatesSource = None, *, progress: bool = True
+    ) -> MissionPlan:
+        """Plan the rest of this plan from time ``at`` [s] and the vehicles' states then.
+
+        ``states``: a ``STATES.csv`` file (columns ``vehicle,north,east,heading_deg,speed``,
+        or ``lat,lon`` for ``north,east``) or vehicle -> ``{north, east, heading_deg,
+        speed}``; vehicles not given start where this plan has them at ``at``. The new plan
+        keeps the goals, the horizon's end (its horizon is ``T - at``) and the constraints;
+        ``summary["replan"]`` names this plan (:func:`auvplan.api.replanning.replan`).
+
+        Raises
+        ------
+        InputError, DataFormatError
+            For a bad ``at`` or state, before anything is planned.
+        """
+        from auvplan.api.replanning import replan
+
+        return replan(self, at, states, progress=progress)
+
     def save(
         self,
         directory: str | os.PathLike[str],
@@ -297,7 +318,7 @@ def plan(
     except ValueError:
         choices = ", ".join(repr(s.value) for s in Stage)
         raise InputError(f"stage must be one of {choices}, got {stage!r}") from None
-    with _logged_warnings() as warnings, _reporter(config, progress) as reporter:
+    with logged_warnings() as warnings, progress_reporter(config, progress) as reporter:
         stages: ProgressReporter = no_progress if reporter is None else reporter
         if companion is not None and last_stage is Stage.FULL:
             companion.warm_up(config)
@@ -338,7 +359,7 @@ def _mission_config(mission: MissionSource) -> MissionConfig:
 
 
 @contextmanager
-def _logged_warnings() -> Iterator[list[str]]:
+def logged_warnings() -> Iterator[list[str]]:
     """Collect the warnings that auvplan logs while the block runs (one line each)."""
     collected: list[str] = []
 
@@ -356,7 +377,8 @@ def _logged_warnings() -> Iterator[list[str]]:
 
 
 @contextmanager
-def _reporter(config: MissionConfig, progress: bool) -> Iterator[ConsoleProgress | None]:
+def progress_reporter(config: MissionConfig, progress: bool) -> Iterator[ConsoleProgress | None]:
+    """The console progress of a run of ``config`` while the block runs (None: ``progress`` off)."""
     if not progress:
         yield None
         return

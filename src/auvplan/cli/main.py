@@ -34,7 +34,9 @@ from auvplan._version import __version__
 from auvplan.errors import AuvplanError
 
 #: Modules of :mod:`auvplan.cli` that provide a verb, in help order.
-COMMAND_MODULES = ("maps", "plan", "export", "evaluate", "sweep", "vehicle", "keys", "scenarios")
+COMMAND_MODULES = (
+    "maps", "plan", "replan", "export", "evaluate", "sweep", "vehicle", "keys", "scenarios",
+)  # fmt: skip
 
 EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 128 + signal.SIGINT

@@ -115,11 +115,11 @@ def _run(config: Any, args: argparse.Namespace) -> int:
         moos_frame=getattr(args, "moos_frame", "utm"),
     )
     if not args.quiet:
-        _print_report(saved.result, saved.written)
-    return _exit_code(saved.result.problem)
+        print_report(saved.result, saved.written)
+    return exit_code(saved.result.problem)
 
 
-def _exit_code(problem: str | None) -> int:
+def exit_code(problem: str | None) -> int:
     """0 for a plan that converged with every constraint met between samples; otherwise 3.
 
     The outputs are still written (the best plan found), the summary records the status and
@@ -131,7 +131,8 @@ def _exit_code(problem: str | None) -> int:
     return EXIT_NOT_CONVERGED
 
 
-def _print_report(result: Any, written: tuple[Path, ...]) -> None:
+def print_report(result: Any, written: tuple[Path, ...]) -> None:
+    """Print the stage timings, the plan and its comparisons, and the files written."""
     out = sys.stdout
     print(f"stage: {result.stage.value}", file=out)
     for name, seconds in result.timings.items():

@@ -17,6 +17,7 @@ names the vehicle or key.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time as wallclock
 from collections.abc import Callable
@@ -25,7 +26,7 @@ from enum import Enum
 from typing import Any
 
 from auvplan.errors import InputError, SolverError
-from auvplan.mission.assembly import assemble_problem
+from auvplan.mission.assembly import WarmStart, assemble_problem
 from auvplan.mission.config import MissionConfig
 from auvplan.mission.evaluation import OptimizedPlan, evaluate_plan
 from auvplan.mission.fleet import FleetLayout
@@ -136,11 +137,7 @@ def run_mission(
     progress = with_checkpoints(progress)
 
     def timed(name: str, work: Callable[[], Any]) -> Any:
-        started = wallclock.perf_counter()
-        with progress(name):
-            value = work()
-        timings[name] = wallclock.perf_counter() - started
-        return value
+        return timed_stage(progress, timings, name, work)
 
     preplan = timed("preplan", lambda: run_preplan(config, progress=progress))
     if stage is Stage.PREPLAN:
@@ -199,6 +196,17 @@ def run_mission(
     )  # fmt: skip
 
 
+def timed_stage(
+    progress: ProgressReporter, timings: dict[str, float], name: str, work: Callable[[], Any]
+) -> Any:
+    """Run ``work`` as the stage ``name`` of ``progress``; its wall seconds go to ``timings``."""
+    started = wallclock.perf_counter()
+    with progress(name):
+        value = work()
+    timings[name] = wallclock.perf_counter() - started
+    return value
+
+
 def _compare_no_current(
     config: MissionConfig,
     layout: FleetLayout,
@@ -245,19 +253,25 @@ def run_optimization(
     terrain_weight: float,
     *,
     callback: Callable[[Any], None] | None = None,
+    warm_start: WarmStart | None = None,
 ) -> OptimizedPlan:
-    """Stage 3: PRONTO with barrier continuation from the projected desired trajectories."""
+    """Stage 3: PRONTO with barrier continuation from the projected desired trajectories.
+
+    A ``warm_start`` with a guess (a replan: the old plan from the replanning time) starts at
+    the last barrier level ``eps_final`` and at the guess's ``δ``: the guess solves that
+    level already.
+    """
     assembled = assemble_problem(
         layout, preplan, deconfliction,
         weights=config.weights, terrain_weight=terrain_weight,
         safety_radius=config.fleet.safety_radius, comms=config.comms, current=preplan.current,
+        warm_start=warm_start,
     )  # fmt: skip
-    result = solve_pronto(
-        assembled.problem,
-        assembled.guess,
-        options=config.solver.pronto_options(),
-        callback=callback,
-    )
+    options = config.solver.pronto_options()
+    if warm_start is not None and warm_start.guess is not None:
+        delta = options.delta_initial if warm_start.delta is None else warm_start.delta
+        options = dataclasses.replace(options, eps_initial=options.eps_final, delta_initial=delta)
+    result = solve_pronto(assembled.problem, assembled.guess, options=options, callback=callback)
     logger.info(
         "PRONTO (terrain weight %g): %s after %d iterations, cost %.1f",
         terrain_weight,

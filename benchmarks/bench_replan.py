@@ -1,0 +1,104 @@
+"""Replanning against planning from scratch: 4 MEDUSAs for an hour, replanned at 30 min.
+
+The mission is ``fleet-4-3600-1`` of :mod:`_fleet` (four MEDUSAs on crossing lanes, 1 h,
+``dt_s`` 1 s). It is planned once to fill the kernel cache, then planned again (timed: the
+plan from scratch) and saved; the saved folder is replanned at ``t = 1800 s`` with vehicle
+``v0`` 30 m east of where its plan has it (``auvplan.load(folder).replan``: the mission is
+planned again up to stage 2 from the folder, then the rest is optimised), and the plan in
+memory is replanned the same way (no stage 1-2 again). Target: the replan within 25 % of the
+plan from scratch. Run as a script (minutes; ``nice`` it on a shared machine)::
+
+    nice .venv/bin/python benchmarks/bench_replan.py
+
+It prints one JSON line per measurement and a summary table.
+"""
+
+from __future__ import annotations
+
+import json
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import auvplan
+from _fleet import lane_mission  # the script's folder is on sys.path
+
+#: The mission, the replanning time [s], the vehicle moved and by how much (north, east) [m].
+CASE = (4, 3600.0, 1.0)
+AT = 1800.0
+MOVED = ("v0", 0.0, 30.0)
+TARGET = 0.25
+
+
+def _outcome(plan: auvplan.MissionPlan, wall: float, label: str) -> dict[str, Any]:
+    assert plan.result is not None
+    optimized = plan.result.plan
+    return {
+        "run": label,
+        "wall_s": wall,
+        "timings_s": plan.result.timings,
+        "status": plan.status,
+        "problem": plan.result.problem,
+        "iterations": None if optimized is None else optimized.result.n_iter,
+        "objective_J": None if optimized is None else optimized.costs.total,
+        "energy_J": None if optimized is None else float(np.sum(optimized.energy)),
+        "schedule": plan.summary.get("replan", {}).get("schedule"),
+    }
+
+
+def states_file(plan: auvplan.MissionPlan, folder: Path) -> Path:
+    """``STATES.csv`` with :data:`MOVED`'s vehicle moved from its plan's state at :data:`AT`."""
+    name, north, east = MOVED
+    frame = plan.to_dataframe()
+    row = frame[(frame["vehicle"] == name) & (np.isclose(frame["t"], AT))].iloc[0]
+    path = folder / "states.csv"
+    path.write_text(
+        "vehicle,north,east,heading_deg,speed\n"
+        f"{name},{row['north'] + north},{row['east'] + east},{row['heading']},{row['u']}\n"
+    )
+    return path
+
+
+def measure(scratch: Path) -> list[dict[str, Any]]:
+    """Plan from scratch, save, replan from the folder and in memory (module notes)."""
+    mission = lane_mission(*CASE, scratch)
+    auvplan.plan(mission, progress=False)  # fills the kernel cache
+    started = time.perf_counter()
+    parent = auvplan.plan(mission, progress=False)
+    records = [_outcome(parent, time.perf_counter() - started, "plan from scratch")]
+    folder = scratch / "parent"
+    parent.save(folder, figures=False)
+    states = states_file(parent, scratch)
+    started = time.perf_counter()
+    replanned = auvplan.load(folder).replan(AT, states, progress=False)
+    records.append(_outcome(replanned, time.perf_counter() - started, "replan from folder"))
+    started = time.perf_counter()
+    in_memory = parent.replan(AT, states, progress=False)
+    records.append(_outcome(in_memory, time.perf_counter() - started, "replan in memory"))
+    return records
+
+
+def report(records: list[dict[str, Any]]) -> None:
+    """Print each record as a JSON line and the table of wall-time ratios."""
+    for record in records:
+        print(json.dumps(record), flush=True)
+    scratch = records[0]["wall_s"]
+    n, horizon, dt = CASE
+    print(
+        f"\n{n} MEDUSAs x {horizon:g} s (dt {dt:g} s), replanned at {AT:g} s with {MOVED[0]} "
+        f"moved ({MOVED[1]:g}, {MOVED[2]:g}) m; target replan <= {TARGET:.0%} of scratch"
+    )
+    for record in records:
+        print(
+            f"  {record['run']:<20s} {record['wall_s']:8.1f} s  {record['wall_s'] / scratch:6.1%}"
+            f"  {record['status']}  {record['iterations']} it  objective "
+            f"{record['objective_J']:.0f} J  schedule {record['schedule']}"
+        )
+
+
+if __name__ == "__main__":
+    with tempfile.TemporaryDirectory() as work:
+        report(measure(Path(work)))
