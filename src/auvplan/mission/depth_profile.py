@@ -117,15 +117,27 @@ def clearance_seabed(bathymetry: BathymetryGrid, north: FloatArray, east: FloatA
     """The shallowest seabed [m] from each sample's predecessor to its successor.
 
     The straight segments between the samples ``north``, ``east`` ``(n_t,)`` [m] are
-    sampled every quarter of the grid's finer spacing (:data:`SEABED_SAMPLES_PER_CELL`, at most
-    :data:`MAX_SEABED_SAMPLES` a segment); NaN where no sample has a seabed.
+    sampled every quarter of the grid's finer spacing, and at least at
+    :data:`SEABED_SAMPLES_PER_CELL` points besides their start (at most
+    :data:`MAX_SEABED_SAMPLES`), and where they cross a row or column of grid nodes: there
+    the bilinear surface has its kinks, and a crest between two samples would be missed.
+    Between those points the surface along a segment is quadratic. NaN where no sample has a
+    seabed.
     """
     geometry = bathymetry.geometry
     step = min(geometry.spacing_north, geometry.spacing_east) / SEABED_SAMPLES_PER_CELL
     lengths = np.hypot(np.diff(north), np.diff(east))
     longest = float(np.max(lengths, initial=0.0))
-    n_samples = min(max(math.ceil(longest / step), 1), MAX_SEABED_SAMPLES) + 1
-    fraction = np.linspace(0.0, 1.0, n_samples)[None, :]
+    n_samples = min(max(math.ceil(longest / step), SEABED_SAMPLES_PER_CELL), MAX_SEABED_SAMPLES) + 1
+    row, col = geometry.to_fractional_index(north, east)
+    fraction = np.concatenate(
+        [
+            np.broadcast_to(np.linspace(0.0, 1.0, n_samples), (north.size - 1, n_samples)),
+            _node_crossings(row),
+            _node_crossings(col),
+        ],
+        axis=1,
+    )
     along_north = north[:-1, None] + fraction * np.diff(north)[:, None]
     along_east = east[:-1, None] + fraction * np.diff(east)[:, None]
     seabed = depth_at(bathymetry, along_north, along_east)
@@ -136,6 +148,22 @@ def clearance_seabed(bathymetry: BathymetryGrid, north: FloatArray, east: FloatA
     after = np.concatenate([segment, [np.inf]])
     shallowest = np.fmin(before, after)
     return np.asarray(np.where(np.isinf(shallowest), np.nan, shallowest), dtype=np.float64)
+
+
+def _node_crossings(index: FloatArray) -> FloatArray:
+    """Where each segment crosses a row or column of grid nodes (an integer fractional index).
+
+    ``index`` ``(n,)`` are the samples' fractional rows (or columns); returns the crossings as
+    fractions of each segment in (0, 1), NaN padded, shape ``(n - 1, k)``.
+    """
+    low, high = np.minimum(index[:-1], index[1:]), np.maximum(index[:-1], index[1:])
+    first = np.floor(low) + 1.0
+    count = int(np.clip(np.max(np.ceil(high) - first, initial=0.0), 0, MAX_SEABED_SAMPLES))
+    nodes = first[:, None] + np.arange(count)[None, :]
+    step = np.diff(index)[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        fraction = (nodes - index[:-1, None]) / step
+    return np.where((nodes < high[:, None]) & (step != 0.0), fraction, np.nan)
 
 
 def depth_profile(
