@@ -282,6 +282,25 @@ def test_export_without_georeference_is_moos_in_the_local_frame_only(
         assert np.min(np.hypot(*(samples - [x, y]).T)) < 0.01
 
 
+@pytest.mark.slow
+def test_plan_on_the_synthetic_bank_exports_moos_in_the_local_frame(tmp_path: Path) -> None:
+    """plan --export moos --moos-frame local works without georeference (a plan: ~10 s)."""
+    mission = tmp_path / "mission.toml"
+    mission.write_text(MISSION.replace('file = "grid.nc"', "synthetic = true"))
+    out = tmp_path / "out"
+    arguments = ["-q", "plan", str(mission), "-o", str(out), "--no-figures"]
+    assert main([*arguments, "--export", "moos", "--moos-frame", "local"]) == 0
+    assert sorted(p.name for p in (out / "export").iterdir()) == [
+        "blue.bhv", "green.bhv", "origin.moos",
+    ]  # fmt: skip
+    table = pd.read_csv(out / "trajectories.csv")
+    green = table[table["vehicle"] == "green"]
+    _, legs = parse_moos((out / "export" / "green.bhv").read_text())
+    (x, y) = moos_points([leg["points"] for leg in legs if "points" in leg][-1])[0]
+    # the last waypoint is the last sample, as x = east, y = north of the plan's frame
+    assert (x, y) == pytest.approx((green["east"].iloc[-1], green["north"].iloc[-1]), abs=0.01)
+
+
 def test_plan_export_refuses_before_planning(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -77,7 +77,7 @@ def run_export(args: argparse.Namespace) -> int:
     record = read_record(args.folder)
     plan = export_plan(record)
     if not plan.is_georeferenced:
-        check_georeference(formats, args.moos_frame, f"the terrain {record.summary.terrain.name}")
+        check_georeference(formats, args.moos_frame, f"the terrain {record.summary.terrain.name!r}")
     target = args.output if args.output is not None else args.folder / EXPORT_FOLDER
     with staged_output_dir(target) as staging:
         written = write_exports(
