@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import rasterio
 import rioxarray  # noqa: F401  (the .rio accessor)
 import xarray as xr
 from pyproj import CRS
@@ -95,6 +96,13 @@ def test_rioxarray_places_the_maps(tmp_path: Path, maps_with_projection: Terrain
             west, south, east, north = raster.bounds()
             assert (south, north) == pytest.approx(geometry.north_bounds, abs=1e-9)
             assert (west, east) == pytest.approx(geometry.east_bounds, abs=1e-9)
+            # GDAL (QGIS) places each grid too, by the axes' `axis` attributes
+            with rasterio.open(f"netcdf:{path}:{name}") as dataset:
+                bounds = dataset.bounds
+            assert (bounds.left, bounds.right) == pytest.approx(geometry.east_bounds, abs=1e-6)
+            assert sorted((bounds.bottom, bounds.top)) == pytest.approx(
+                geometry.north_bounds, abs=1e-6
+            )
 
 
 def test_cf_compliance_checker_finds_no_error(

@@ -153,7 +153,12 @@ def _axes(
     """The CF coordinate variables ``north<suffix>``, ``east<suffix>`` [m] of a grid.
 
     With a grid mapping, CF checkers (IOOS) accept a single variable per standard name
-    ``projection_x/y_coordinate``, so only the fine grid's axes carry one then.
+    ``projection_x/y_coordinate``, so only the fine grid's axes carry one then. Every axis
+    keeps ``axis`` X/Y: without it (or the standard name) GDAL gives the block maps an
+    identity geotransform and rioxarray finds no x/y dimension. The IOOS checker (6.1) takes
+    an ``axis`` Y/X variable without a projection standard name for latitude/longitude and
+    warns that ``north_block``/``east_block`` lack degree units (2 warnings, georeferenced
+    maps only): CF itself allows both (ioos/compliance-checker#691).
     """
     import xarray as xr
 
