@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from auvplan.errors import InputError
+from auvplan.mission.checks import seabed_violations
 from auvplan.mission.depth_profile import depth_profile, rate_limited_depth
 from auvplan.navigation.depth import depth_at
 from auvplan.terrain import BathymetryGrid, GridGeometry
@@ -121,3 +122,18 @@ def test_samples_off_the_map_take_the_nearest_seabed() -> None:
     assert np.all(profile.depth == 45.0)
     with pytest.raises(InputError, match="off the map"):
         depth_profile(time, np.full(time.size, 1e4), east, flat, altitude=5.0, limits=DepthLimits())
+
+
+def test_a_shoal_under_the_minimum_altitude_is_a_named_seabed_violation() -> None:
+    grid = _ridge(height=97.0)  # 3 m deep at the crest, the minimum altitude is 4 m
+    time = np.arange(0.0, 400.0, 1.0)
+    north, east = _straight(time)
+    limits = DepthLimits(0.5, 0.5, 4.0)
+    shoal = depth_profile(time, north, east, grid, altitude=10.0, limits=limits)
+    (violation,) = seabed_violations(("blue",), (shoal,))
+    assert violation.who == "blue"
+    assert violation.value == pytest.approx(3.0, abs=0.01)
+    assert violation.time == pytest.approx(280.0, abs=1.0)  # the crest, east = 300 m
+    assert violation.describe().startswith("seabed clearance: blue at 3.00 m < 4 m (t = 2")
+    deep = depth_profile(time, north, east, _ridge(), altitude=10.0, limits=limits)
+    assert seabed_violations(("blue",), (deep,)) == []

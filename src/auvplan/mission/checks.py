@@ -25,6 +25,7 @@ import numpy as np
 from auvplan._typing import FloatArray
 from auvplan.io.vehicle_tables import UNITS
 from auvplan.mission.config import AREA_NAME, MissionConfig
+from auvplan.mission.depth_profile import DepthProfile
 from auvplan.mission.navigation import NavigationChoice, budget_of, smallest_budget
 from auvplan.navigation.prediction import ErrorPrediction
 from auvplan.optimization import ProntoResult
@@ -137,6 +138,7 @@ def judge_plan(
     predicted: tuple[ErrorPrediction, ...] = (),
     routes: tuple[NavigationChoice, ...] | None = None,
     battery: BatteryUse | None = None,
+    depth_profiles: tuple[DepthProfile, ...] | None = None,
 ) -> PlanVerdict:
     """Check a plan's constraints on the fine replay and give its verdict.
 
@@ -145,7 +147,9 @@ def judge_plan(
     ``arrival_error`` ``(n_vehicles,)`` [m]; ``predicted`` the predicted TAN error of each
     vehicle along its replayed track, ``routes`` how each route was chosen (the smallest
     feasible budget, when the mission's cannot be met); ``battery`` the energy each vehicle
-    has used over time and its capacity (None: no battery check).
+    has used over time and its capacity (None: no battery check); ``depth_profiles`` each
+    vehicle's depth profile of ``[mission] altitude_m`` (None: a constant depth, checked by
+    the pre-planner).
     """
     radius = config.fleet.safety_radius
     violations: list[Violation] = []
@@ -185,6 +189,8 @@ def judge_plan(
         violations += _navigation_violations(config, names, budget, predicted, routes)
     if battery is not None:
         violations += _battery_violations(config, names, battery)
+    if depth_profiles is not None:
+        violations += seabed_violations(names, depth_profiles)
     if not result.success:
         status = PlanStatus.NOT_CONVERGED
         message = (
@@ -198,6 +204,29 @@ def judge_plan(
     else:
         status, message = PlanStatus.CONVERGED, "every constraint holds between samples"
     return PlanVerdict(status, tuple(violations), message)
+
+
+def seabed_violations(
+    names: tuple[str, ...], profiles: tuple[DepthProfile, ...]
+) -> list[Violation]:
+    """Vehicles whose depth profile comes nearer the seabed than their ``min_altitude`` [m].
+
+    The profile (:mod:`auvplan.mission.depth_profile`) keeps the bound wherever the seabed
+    between neighbouring samples is at least ``min_altitude`` deep; over a shallower seabed
+    it stays at the surface, closer than allowed.
+    """
+    violations = []
+    for name, profile in zip(names, profiles, strict=True):
+        value, when = _worst(profile.clearance, profile.time, largest=False)
+        if value < profile.min_altitude - DISTANCE_TOLERANCE:
+            advice = (
+                "the seabed there is shallower than the vehicle's [vertical] min_altitude: add "
+                "an obstacle over the shoal, move the start or goal, or lower min_altitude"
+            )
+            violations.append(
+                Violation("seabed clearance", name, value, profile.min_altitude, when, advice)
+            )
+    return violations
 
 
 def _battery_violations(

@@ -62,15 +62,23 @@ MAX_SEABED_SAMPLES: Final = 256
 class DepthProfile:
     """One vehicle's depth profile on its track's samples.
 
-    ``depth`` [m] positive down, ``altitude`` [m] = ``seabed - depth``, ``seabed`` [m] the
-    seabed depth under each sample, ``clearance_seabed`` [m] the shallowest seabed from the
-    previous sample to the next (:math:`H_i` of the module notes); all of shape ``(n_t,)``.
+    ``time`` [s], ``depth`` [m] positive down, ``altitude`` [m] = ``seabed - depth``,
+    ``seabed`` [m] the seabed depth under each sample, ``clearance_seabed`` [m] the shallowest
+    seabed from the previous sample to the next (:math:`H_i` of the module notes); all of
+    shape ``(n_t,)``. ``min_altitude`` [m] is the hard bound the profile was built for.
     """
 
+    time: FloatArray
     depth: FloatArray
     altitude: FloatArray
     seabed: FloatArray
     clearance_seabed: FloatArray
+    min_altitude: float
+
+    @property
+    def clearance(self) -> FloatArray:
+        """Height [m] above the shallowest seabed between neighbouring samples, ``H - z``."""
+        return np.asarray(self.clearance_seabed - self.depth, dtype=np.float64)
 
 
 def rate_limited_depth(
@@ -218,7 +226,7 @@ def depth_profile(
     depth = rate_limited_depth(
         time, target, climb_rate=limits.climb_rate, dive_rate=limits.dive_rate
     )
-    return DepthProfile(depth, seabed - depth, seabed, nearest)
+    return DepthProfile(time, depth, seabed - depth, seabed, nearest, limits.min_altitude)
 
 
 def fleet_depth_profiles(

@@ -161,6 +161,7 @@ def evaluate_plan(
             predicted,
             preplan.navigation,
             BatteryUse(time, used, tuple(model.vehicle.battery_capacity for model in models)),
+            profiles,
         ),
     )
 
