@@ -84,6 +84,18 @@ def test_battery_and_its_range_at_the_cruise(
     assert medusa["cruise_range"] is None
 
 
+def test_vertical_limits_are_reported(capsys: pytest.CaptureFixture[str]) -> None:
+    """The [vertical] table of the packaged REMUS 100: climb, dive and minimum altitude."""
+    assert main(["vehicle", "remus100", "--json"]) == 0
+    document = json.loads(capsys.readouterr().out)
+    table = document["characteristics"]
+    assert (table["climb_rate"], table["dive_rate"], table["min_altitude"]) == (0.35, 0.35, 3.0)
+    assert document["units"]["min_altitude"] == "m"
+    assert main(["vehicle", "remus100"]) == 0
+    line = next(row for row in capsys.readouterr().out.splitlines() if row.startswith("depth"))
+    assert "climb 0.35 m/s, dive 0.35 m/s, at least 3 m above the seabed" in line
+
+
 @pytest.mark.parametrize(
     ("argument", "message"),
     [

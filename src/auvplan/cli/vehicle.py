@@ -113,6 +113,11 @@ def _print_table(table: VehicleCharacteristics, propeller: Propeller) -> None:
         f"turning radius             {table.turning_radius:.2f} m "
         f"(full steering at the cruise speed {table.cruise_speed:.2f} m/s)"
     )
+    print(
+        f"depth profile              climb {table.climb_rate:.2f} m/s, dive "
+        f"{table.dive_rate:.2f} m/s, at least {table.min_altitude:g} m above the seabed "
+        "([vertical]; [mission] altitude_m)"
+    )
     if table.battery_capacity is None or table.cruise_range is None:
         print("battery                    unknown (no [power] battery_capacity: no reserve check)")
     else:

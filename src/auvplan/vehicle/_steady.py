@@ -149,6 +149,9 @@ CHARACTERISTIC_UNITS: Final = {
     "n_at_1_0": "rev/s",
     "max_yaw_rate": "rad/s",
     "turning_radius": "m",
+    "climb_rate": "m/s",
+    "dive_rate": "m/s",
+    "min_altitude": "m",
     "battery_capacity": "J",
     "cruise_range": "m",
 }
@@ -190,6 +193,12 @@ class VehicleCharacteristics:
     """Steady yaw rate at full steering (:func:`max_yaw_rate`) [rad/s]."""
     turning_radius: float
     """Radius of the steady turn at full steering at the cruise speed [m]."""
+    climb_rate: float
+    """Largest rate of ascent of a depth profile (``[vertical]``) [m/s]."""
+    dive_rate: float
+    """Largest rate of descent of a depth profile [m/s]."""
+    min_altitude: float
+    """Smallest height above the seabed of a depth profile [m]."""
     battery_capacity: float | None = None
     """Energy of a full battery, None when the vehicle file gives none [J]."""
     cruise_range: float | None = None

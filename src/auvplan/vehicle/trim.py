@@ -418,6 +418,9 @@ def vehicle_characteristics(model: VehicleModel) -> VehicleCharacteristics:
         n_at_1_0=fast.n,
         max_yaw_rate=max_yaw_rate(model),
         turning_radius=tightest_turn(model, cruise.speed).radius,
+        climb_rate=model.vehicle.depth_limits.climb_rate,
+        dive_rate=model.vehicle.depth_limits.dive_rate,
+        min_altitude=model.vehicle.depth_limits.min_altitude,
         battery_capacity=battery,
         cruise_range=None if battery is None else battery / cruise.energy_per_metre,
     )
