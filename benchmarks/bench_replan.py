@@ -8,7 +8,8 @@ planned again up to stage 2 from the folder, then the rest is optimised), and th
 memory is replanned the same way (no stage 1-2 again). Target: the replan within 25 % of the
 plan from scratch. Run as a script (minutes; ``nice`` it on a shared machine)::
 
-    nice .venv/bin/python benchmarks/bench_replan.py
+    nice .venv/bin/python benchmarks/bench_replan.py           # 4 MEDUSAs x 1 h at 30 min
+    nice .venv/bin/python benchmarks/bench_replan.py --quick   # 4 MEDUSAs x 10 min at 5 min
 
 It prints one JSON line per measurement and a summary table.
 """
@@ -16,6 +17,7 @@ It prints one JSON line per measurement and a summary table.
 from __future__ import annotations
 
 import json
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -26,9 +28,9 @@ import numpy as np
 import auvplan
 from _fleet import lane_mission  # the script's folder is on sys.path
 
-#: The mission, the replanning time [s], the vehicle moved and by how much (north, east) [m].
-CASE = (4, 3600.0, 1.0)
-AT = 1800.0
+#: The missions (vehicles, horizon [s], dt [s]) and their replanning times [s].
+CASES = {"full": ((4, 3600.0, 1.0), 1800.0), "quick": ((4, 600.0, 1.0), 300.0)}
+#: The vehicle moved and by how much (north, east) [m].
 MOVED = ("v0", 0.0, 30.0)
 TARGET = 0.25
 
@@ -49,11 +51,11 @@ def _outcome(plan: auvplan.MissionPlan, wall: float, label: str) -> dict[str, An
     }
 
 
-def states_file(plan: auvplan.MissionPlan, folder: Path) -> Path:
-    """``STATES.csv`` with :data:`MOVED`'s vehicle moved from its plan's state at :data:`AT`."""
+def states_file(plan: auvplan.MissionPlan, at: float, folder: Path) -> Path:
+    """``STATES.csv`` with :data:`MOVED`'s vehicle moved from its plan's state at ``at`` [s]."""
     name, north, east = MOVED
     frame = plan.to_dataframe()
-    row = frame[(frame["vehicle"] == name) & (np.isclose(frame["t"], AT))].iloc[0]
+    row = frame[(frame["vehicle"] == name) & (np.isclose(frame["t"], at))].iloc[0]
     path = folder / "states.csv"
     path.write_text(
         "vehicle,north,east,heading_deg,speed\n"
@@ -62,33 +64,33 @@ def states_file(plan: auvplan.MissionPlan, folder: Path) -> Path:
     return path
 
 
-def measure(scratch: Path) -> list[dict[str, Any]]:
-    """Plan from scratch, save, replan from the folder and in memory (module notes)."""
-    mission = lane_mission(*CASE, scratch)
+def measure(case: tuple[int, float, float], at: float, scratch: Path) -> list[dict[str, Any]]:
+    """Plan ``case`` from scratch, save, replan at ``at`` from the folder and in memory."""
+    mission = lane_mission(*case, scratch)
     auvplan.plan(mission, progress=False)  # fills the kernel cache
     started = time.perf_counter()
     parent = auvplan.plan(mission, progress=False)
     records = [_outcome(parent, time.perf_counter() - started, "plan from scratch")]
     folder = scratch / "parent"
     parent.save(folder, figures=False)
-    states = states_file(parent, scratch)
+    states = states_file(parent, at, scratch)
     started = time.perf_counter()
-    replanned = auvplan.load(folder).replan(AT, states, progress=False)
+    replanned = auvplan.load(folder).replan(at, states, progress=False)
     records.append(_outcome(replanned, time.perf_counter() - started, "replan from folder"))
     started = time.perf_counter()
-    in_memory = parent.replan(AT, states, progress=False)
+    in_memory = parent.replan(at, states, progress=False)
     records.append(_outcome(in_memory, time.perf_counter() - started, "replan in memory"))
     return records
 
 
-def report(records: list[dict[str, Any]]) -> None:
+def report(case: tuple[int, float, float], at: float, records: list[dict[str, Any]]) -> None:
     """Print each record as a JSON line and the table of wall-time ratios."""
     for record in records:
         print(json.dumps(record), flush=True)
     scratch = records[0]["wall_s"]
-    n, horizon, dt = CASE
+    n, horizon, dt = case
     print(
-        f"\n{n} MEDUSAs x {horizon:g} s (dt {dt:g} s), replanned at {AT:g} s with {MOVED[0]} "
+        f"\n{n} MEDUSAs x {horizon:g} s (dt {dt:g} s), replanned at {at:g} s with {MOVED[0]} "
         f"moved ({MOVED[1]:g}, {MOVED[2]:g}) m; target replan <= {TARGET:.0%} of scratch"
     )
     for record in records:
@@ -100,5 +102,6 @@ def report(records: list[dict[str, Any]]) -> None:
 
 
 if __name__ == "__main__":
+    case, at = CASES["quick" if "--quick" in sys.argv[1:] else "full"]
     with tempfile.TemporaryDirectory() as work:
-        report(measure(Path(work)))
+        report(case, at, measure(case, at, Path(work)))

@@ -9,16 +9,18 @@ that offset fading out over ``τ_i``,
 
 .. math::
 
-    q_i(t) = p_i(a + t) + d_i \max(1 - t / τ_i, 0), \qquad 0 \le t \le T - a,
+    q_i(t) = p_i(a + t) + d_i\, φ(t / τ_i), \qquad
+    φ(s) = \tfrac12 \bigl(1 + \cos(π \min(s, 1))\bigr), \qquad 0 \le t \le T - a,
 
-so that from ``t = τ_i`` on it is where the old schedule had it at ``a + t``. The fade-out
-needs at most ``‖d_i‖ / τ_i`` on top of the old speed: ``τ_i = min(‖d_i‖ / v_spare,i,
-T - a)`` with ``v_spare,i = max(v_max,i - max ṡ_i, 0.1 v_max,i)`` (``v_max,i`` the speed
-limit of stage 2). As a schedule (:class:`~auvplan.deconfliction.CoordinationProblem`): the
-remainder path ``R_i`` is the polyline through ``q_i`` at the old grid's times up to ``τ_i``,
-then the old path beyond ``s_i(a + τ_i)``; the progress is the arc length along it (linear
-in arc length between samples, which the separation certificate assumes). With ``d = 0`` it
-is the old schedule itself. :func:`shift_schedule` returns it with its continuous separation
+so that it leaves its new start along the old path's direction and from ``t = τ_i`` on is
+where the old schedule had it at ``a + t``. The fade-out needs at most ``π ‖d_i‖ / (2 τ_i)``
+on top of the old speed: ``τ_i = min(π ‖d_i‖ / (2 v_spare,i), T - a)`` with ``v_spare,i =
+max(v_max,i - max ṡ_i, 0.1 v_max,i)`` (``v_max,i`` the speed limit of stage 2). As a
+schedule (:class:`~auvplan.deconfliction.CoordinationProblem`): the remainder path ``R_i`` is
+the polyline through ``q_i`` at the old grid's times up to ``τ_i``, then the old path beyond
+``s_i(a + τ_i)``; the progress is the arc length along it (linear in arc length between
+samples, which the separation certificate assumes). With ``d = 0`` it is the old schedule
+itself. :func:`shift_schedule` returns it with its continuous separation
 certificate (:func:`auvplan.deconfliction.certify_separation`).
 """
 
@@ -54,18 +56,17 @@ class Remainder:
     deviations: FloatArray
     fade_times: FloatArray
 
-    def offsets(self, time: FloatArray) -> FloatArray:
-        """``d_i max(1 - t / τ_i, 0)`` [m] at ``time`` [s], shape ``(n_vehicles, n_t, 2)``."""
-        return fade_factors(time, self.fade_times)[:, :, None] * self.deviations[:, None, :]
-
 
 def fade_factors(time: FloatArray, fade_times: FloatArray) -> FloatArray:
-    """``max(1 - t / τ_i, 0)`` at ``time`` [s], shape ``(n_vehicles, n_t)``; 0 if ``τ_i = 0``."""
+    """``φ(t / τ_i)`` (module notes) at ``time`` [s], shape ``(n_vehicles, n_t)``.
+
+    0 where ``τ_i = 0`` (no offset to fade out).
+    """
     ratio = np.divide(
         time[None, :], fade_times[:, None], out=np.ones((fade_times.size, time.size)),
         where=fade_times[:, None] > 0.0,
     )  # fmt: skip
-    return np.asarray(np.maximum(1.0 - ratio, 0.0), dtype=np.float64)
+    return np.asarray(0.5 * (1.0 + np.cos(np.pi * np.minimum(ratio, 1.0))), dtype=np.float64)
 
 
 #: Smallest spare speed for the fade-out, as a fraction of the speed limit [-] (module notes).
@@ -110,7 +111,7 @@ def shift_schedule(
     law = np.stack([progress_at(coordination, i, grid) for i in vehicles])
     fastest = np.max(np.diff(law, axis=1) / np.diff(grid), axis=1, initial=0.0)
     spare = np.maximum(speed_limits - fastest, MIN_SPARE_FRACTION * speed_limits)
-    fade_times = np.minimum(offsets / spare, remaining)
+    fade_times = np.minimum(0.5 * np.pi * offsets / spare, remaining)
     grid = np.unique(np.concatenate([grid, at + fade_times]))
     law = np.stack([progress_at(coordination, i, grid) for i in vehicles])
     elapsed = grid - at

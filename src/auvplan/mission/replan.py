@@ -44,14 +44,18 @@ from auvplan.errors import InfeasibleError, InputError, SolverError
 from auvplan.mission.assembly import WarmStart
 from auvplan.mission.config import MissionConfig
 from auvplan.mission.evaluation import OptimizedPlan
-from auvplan.mission.fleet import FleetLayout
 from auvplan.mission.outputs import plan_record
 from auvplan.mission.parent import ParentPlan
 from auvplan.mission.pipeline import MissionResult, Stage, run_optimization, timed_stage
 from auvplan.mission.progress import ProgressReporter, no_progress, with_checkpoints
 from auvplan.mission.remainder import Remainder, shift_schedule
 from auvplan.mission.tables import StartPose
-from auvplan.mission.timing import SPEED_MARGIN, DeconflictStage, run_deconfliction
+from auvplan.mission.timing import (
+    SPEED_MARGIN,
+    DeconflictStage,
+    desired_states,
+    run_deconfliction,
+)
 from auvplan.mission.zones import resolve_position
 from auvplan.ocean import CurrentField
 from auvplan.optimization import Trajectory
@@ -274,14 +278,11 @@ def replan_mission(
     guess: Trajectory | None = None
     if remainder.schedule.success:
         time = stage2.time[step:] - at
+        desired, guess = kept_schedule(parent, step, remainder, time, starts, current)
         timed = DeconflictStage(
             layout, remaining, dt, stage2.cruise_speeds, remainder.problem, remainder.schedule,
-            time, led_in(layout, [d[step:] for d in stage2.desired_states], remainder, time),
+            time, desired,
         )  # fmt: skip
-        guess = Trajectory(
-            states=layout.stack(led_in(layout, [x[step:] for x in parent.states], remainder, time)),
-            inputs=layout.stack([u[step:] for u in parent.inputs]),
-        )
     else:
         origin = dataclasses.replace(origin, schedule="deconflicted")
         try:
@@ -317,22 +318,34 @@ def replan_mission(
     return Replan(result, origin)
 
 
-def led_in(
-    layout: FleetLayout, states: Sequence[FloatArray], remainder: Remainder, time: FloatArray
-) -> tuple[FloatArray, ...]:
-    """Each vehicle's ``states`` on ``time`` [s] with its position offset fading out.
+def kept_schedule(
+    parent: ParentPlan,
+    step: int,
+    remainder: Remainder,
+    time: FloatArray,
+    starts: NewStarts,
+    current: CurrentField | None,
+) -> tuple[tuple[FloatArray, ...], Trajectory]:
+    """The desired trajectories and PRONTO's guess on ``time`` [s] when the schedule is kept.
 
-    ``north, east += d_i max(1 - t / τ_i, 0)`` (:meth:`~auvplan.mission.remainder.Remainder.
-    offsets`): the old desired or optimised trajectory from the replanning time, led in from
-    the new start as the kept schedule is.
+    A vehicle where its plan has it keeps its old desired and optimised trajectories from
+    ``step``; a vehicle moved gets the reference states along its led-in remainder path
+    (:func:`auvplan.mission.timing.desired_states`, turning from its new heading) as both,
+    with zero inputs, so that the projection starts it on a trajectory it can fly.
     """
-    offsets = remainder.offsets(time)
-    moved = []
-    for i, (model, x) in enumerate(zip(layout.models, states, strict=True)):
-        x = x.copy()
-        x[:, [model.index("north"), model.index("east")]] += offsets[i]
-        moved.append(x)
-    return tuple(moved)
+    layout = parent.deconfliction.layout
+    moved = np.hypot(*remainder.deviations.T) > 0.0
+    fresh: tuple[FloatArray, ...] = ()
+    if np.any(moved):
+        ends = (starts.poses[:, 2], parent.preplan.goals[:, 2])
+        fresh = desired_states(layout, remainder.problem, remainder.schedule, time, ends, current)
+    old = parent.deconfliction.desired_states
+    desired = tuple(fresh[i] if moved[i] else old[i][step:] for i in range(layout.n_vehicles))
+    states = [fresh[i] if moved[i] else x[step:] for i, x in enumerate(parent.states)]
+    inputs = [
+        np.zeros_like(u[step:]) if moved[i] else u[step:] for i, u in enumerate(parent.inputs)
+    ]
+    return desired, Trajectory(states=layout.stack(states), inputs=layout.stack(inputs))
 
 
 def unreachable(
@@ -367,7 +380,7 @@ __all__ = [
     "ReplanOrigin",
     "ShiftedCurrent",
     "continued_mission",
-    "led_in",
+    "kept_schedule",
     "new_starts",
     "replan_mission",
     "replan_record",
