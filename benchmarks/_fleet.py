@@ -115,8 +115,9 @@ def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, An
     building the model: loading or compiling kernels). ``ipopt``/``ipopt-mx``: CasADi + IPOPT
     on the same discretised problem from PRONTO's projected initial trajectory, hard
     constraints, the NLP expanded to SX (fastest evaluation, memory grows with the horizon) or
-    kept as MX; ``fatrop``/``fatrop-c``: CasADi + FATROP alike (SX), on CasADi's virtual
-    machine or with the NLP's functions compiled to C (``solve_s``: the solve alone).
+    kept as MX; ``fatrop``/``fatrop-c``: CasADi + FATROP alike on the MX NLP (expanded, the
+    crossing's took > 10 GB to build and compile), on CasADi's virtual machine or with the
+    NLP's functions compiled to C (``solve_s``: the solve alone).
     ``max_iter`` caps PRONTO's iterations (for per-iteration timing).
     """
     with tempfile.TemporaryDirectory() as scratch:
@@ -135,7 +136,7 @@ def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, An
         if solver.startswith("ipopt"):
             result = solve_ipopt(problem, initial, expand=solver == "ipopt")
         else:
-            result = solve_fatrop(problem, initial, compiled=solver == "fatrop-c")
+            result = solve_fatrop(problem, initial, expand=False, compiled=solver == "fatrop-c")
         record.update(
             status=str(result.status), iterations=result.n_iter, cost=result.cost,
             solve_s=result.solve_time,

@@ -152,18 +152,20 @@ def solve_fatrop(
     hard_constraints: bool = True,
     tol: float = 1e-8,
     max_iter: int = 3000,
+    expand: bool = True,
     compiled: bool = False,
 ) -> IpoptResult:
     """Solve the discretised problem with FATROP (module notes), as :func:`solve_ipopt`.
 
-    The NLP is expanded to SX and FATROP detects its stage structure (``structure_detection
-    = "auto"``, the rows' ``equality`` flags); ``compiled=True`` has CasADi generate C for the
-    NLP's functions and compile them with the system compiler (``jit``, ``gcc -O1``) before
-    solving. ``tol`` is FATROP's ``tol``. Parameters, returns and errors otherwise as for
-    :func:`solve_ipopt`.
+    FATROP detects the NLP's stage structure (``structure_detection = "auto"``, the rows'
+    ``equality`` flags); ``compiled=True`` has CasADi generate C for the NLP's functions and
+    compile them with the system compiler (``jit``, ``gcc -O1``) before solving. ``tol`` is
+    FATROP's ``tol``; ``expand`` as for :func:`solve_ipopt` (an expanded NLP of thousands of
+    stacked-fleet stages takes more than 10 GB to build and compile: keep it mapped there).
+    Parameters, returns and errors otherwise as for :func:`solve_ipopt`.
     """
     options: dict[str, Any] = {
-        "expand": True,
+        "expand": expand,
         "structure_detection": "auto",
         "debug": False,
         "fatrop.print_level": 0,
