@@ -269,7 +269,7 @@ def _own_columns(
     filled = [
         name
         for name, cell in zip(header[1:], first_row[1:], strict=True)
-        if cell.strip() and name not in ("t", "power")
+        if cell.strip() and name not in ("t", "power", *PROFILE_COLUMNS)
     ]
     return (
         tuple(name for name in filled if not name.startswith("c_")),
