@@ -595,7 +595,10 @@ class CurrentConfig(TableModel):
         json_schema_extra=_unit("m/s"),
     )  # fmt: skip
     file: Path | None = Field(
-        None, description="NetCDF current file (CF names, or uo/vo, water_u/water_v, u/v)"
+        None,
+        description="NetCDF current file as an ocean model publishes it: HYCOM, Copernicus "
+        "Marine, NOAA RTOFS, ROMS/CROCO or any CF eastward/northward_sea_water_velocity; "
+        "linear in depth at depth_m, sliced to the mission's time window",
     )
 
     @model_validator(mode="after")
