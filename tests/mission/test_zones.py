@@ -133,7 +133,10 @@ polygon = [{lat_lon_vertices(projection, CORRIDOR)}]
 
 
 def preplan(mission: Path) -> dict[str, Any]:
-    out = mission.parent / "out"
+    return preplan_into(mission, mission.parent / "out")
+
+
+def preplan_into(mission: Path, out: Path) -> dict[str, Any]:
     argv = ["-q", "plan", str(mission), "-o", str(out), "--stage", "preplan", "--no-figures"]
     assert main(argv) == 0
     summary: dict[str, Any] = json.loads((out / "summary.json").read_text(encoding="utf-8"))
@@ -175,6 +178,20 @@ def test_gis_zones_and_a_lat_lon_area_shape_the_preplanned_path(tmp_path: Path) 
     for name, ring in (("wreck feature 0", WRECK), (AREA_NAME, CORRIDOR)):
         drawn = np.array([(v["north"], v["east"]) for v in shapes[name]["vertices"]])
         assert local(drawn).symmetric_difference(local(ring)).area < 1e-3 * local(ring).length
+
+
+def test_an_output_folder_carries_its_zone_files_and_reruns_without_them(tmp_path: Path) -> None:
+    """summary.json fingerprints the GIS files; the folder's mission.toml names its copies."""
+    mission = reef_wreck_corridor(tmp_path)
+    first = preplan(mission)
+    assert [zone["path"] for zone in first["inputs"]["zones"]] == ["reef.geojson", "wreck.shp"]
+    for path in tmp_path.glob("*"):  # the inputs go: only the output folder is left
+        if path.is_file():
+            path.unlink()
+    rerun = tmp_path / "out" / "mission.toml"
+    again = preplan_into(rerun, tmp_path / "again")
+    assert again["obstacles"] == first["obstacles"]
+    np.testing.assert_allclose(path_of(again), path_of(first))
 
 
 def test_an_l_shaped_area_file_keeps_the_path_off_the_short_cut(tmp_path: Path) -> None:

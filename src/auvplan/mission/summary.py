@@ -196,8 +196,12 @@ def environment() -> dict[str, Any]:
 def _inputs(config: MissionConfig, vehicle_types: Sequence[str]) -> dict[str, Any]:
     """Name and SHA-256 of every file the run read: mission, bathymetry, current, vehicles.
 
-    The vehicle files by their ``vehicle_types`` (as the folder's ``mission.toml`` names them).
+    The vehicle files by their ``vehicle_types`` (as the folder's ``mission.toml`` names them);
+    ``zones``, the GIS files of ``[[obstacle]]`` and ``[area]``, when the mission has any.
     """
+    zones = [obstacle.file for obstacle in config.obstacles if obstacle.file is not None]
+    if config.area is not None and config.area.file is not None:
+        zones.append(config.area.file)
     return {
         "mission": None if config.source is None else _fingerprint(config.source),
         "bathymetry": None if config.terrain.path is None else _fingerprint(config.terrain.path),
@@ -208,6 +212,7 @@ def _inputs(config: MissionConfig, vehicle_types: Sequence[str]) -> dict[str, An
             kind: _fingerprint(vehicle_file(vehicle.type))
             for kind, vehicle in zip(vehicle_types, config.vehicles, strict=True)
         },
+        **({"zones": [_fingerprint(zone) for zone in zones]} if zones else {}),
     }
 
 
