@@ -27,10 +27,10 @@ pytestmark = pytest.mark.slow
 
 CLIMB_RATE = 0.2
 MIN_ALTITUDE = 4.0
-#: Round-off allowed on a rate [m/s] and on the clearance between samples [m] (the seabed is
-#: sampled where a step crosses grid nodes and at 4 points a step; checked here at 20).
+#: Round-off allowed on a rate [m/s] and on the clearance between samples [m] (the profile
+#: samples the seabed where a step crosses grid nodes and at 4 points a step; checked at 20).
 RATE_TOLERANCE = 1e-9
-CLEARANCE_TOLERANCE = 1e-3
+CLEARANCE_TOLERANCE = 1e-6
 
 MISSION = """
 [terrain]
