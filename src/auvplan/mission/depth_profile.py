@@ -13,9 +13,10 @@ rate :math:`d`, minimum altitude :math:`m`), with :math:`h` the seabed depth of 
 bathymetry (the bilinear surface of :func:`~auvplan.navigation.depth.depth_at`).
 
 **Constraints.** (i) clearance, hard: :math:`z_i \le H_i - m`, where :math:`H_i` is the
-shallowest seabed along the track from :math:`t_{i-1}` to :math:`t_{i+1}`, sampled at a
-quarter of the grid spacing, so that the straight line between two samples, flown as
-``depth`` is interpolated, keeps the clearance between them too; (ii) the surface,
+shallowest seabed along the track from :math:`t_{i-1}` to :math:`t_{i+1}`, sampled where it
+crosses a row or column of grid nodes (the bilinear surface's kinks) and at least every
+quarter cell (:func:`clearance_seabed`), so that the straight line between two samples, flown
+as ``depth`` is interpolated, keeps the clearance between them too; (ii) the surface,
 :math:`z_i \ge 0`; (iii) the rates, :math:`z_i - z_{i+1} \le c\,\Delta t_i` and
 :math:`z_{i+1} - z_i \le d\,\Delta t_i`.
 
@@ -32,9 +33,10 @@ non-negative step, so :math:`z \ge 0` (ii). On a flat seabed :math:`T` is consta
 :math:`z = z^d` exactly (no arithmetic touches a sample that needs no lowering).
 
 Where :math:`H_i < m` (a seabed shallower than the minimum altitude) no depth meets (i); the
-pre-planner refuses such paths (:func:`auvplan.mission.preplan.check_seabed_clearance`), and
-the profile stays at the surface there. Where the track leaves the map, the seabed is that
-of the nearest sample with one.
+pre-planner refuses such paths (:func:`auvplan.mission.preplan.check_seabed_clearance`); if
+the optimised track still crosses one, the profile stays at the surface there and the plan's
+verdict names it (:func:`auvplan.mission.checks.seabed_violations`, exit 3). Where the track
+leaves the map, the seabed is that of the nearest sample with one.
 """
 
 from __future__ import annotations
