@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from auvplan._figures import DEFAULT_DPI
+from auvplan._typing import FloatArray
 from auvplan.errors import InputError
 from auvplan.export import DEFAULT_TOLERANCE_M, MoosFrame
 from auvplan.io.output import staged_output_dir
@@ -185,15 +186,19 @@ class MissionPlan:
             [(o["center"]["north"], o["center"]["east"], o["radius_m"])
              for o in obstacles if o["shape"] == "circle"]
         ).reshape(-1, 3)  # fmt: skip
-        polygons = [
-            np.array([(p["north"], p["east"]) for p in o["vertices"]])
-            for o in obstacles
-            if o["shape"] == "polygon"
-        ]
+
+        def rings(obstacle: dict[str, Any]) -> tuple[FloatArray, ...]:
+            return tuple(
+                np.array([(p["north"], p["east"]) for p in ring], dtype=float)
+                for ring in (obstacle["vertices"], *obstacle.get("holes", ()))
+            )
+
+        polygons = [rings(o) for o in obstacles if o["shape"] == "polygon"]
+        area = next((rings(o) for o in obstacles if o["shape"] == "area"), ())
         return plot_mission_paths(
             self.bathymetry, self.names, planned, tracks,
             safety_radius=self._summary["fleet"]["safety_radius_m"],
-            circles=circles, polygons=polygons,
+            circles=circles, polygons=polygons, area=area,
         )  # fmt: skip
 
     def replan(

@@ -14,7 +14,8 @@ from typing import Final
 import numpy as np
 from matplotlib.colors import Colormap
 from matplotlib.figure import Figure
-from matplotlib.patches import Circle, Polygon
+from matplotlib.patches import Circle, PathPatch
+from matplotlib.path import Path as MplPath
 
 from auvplan._typing import FloatArray
 from auvplan.terrain.grid import BathymetryGrid
@@ -37,7 +38,8 @@ def plot_mission_paths(
     *,
     safety_radius: float,
     circles: FloatArray | None = None,
-    polygons: Sequence[FloatArray] = (),
+    polygons: Sequence[FloatArray | tuple[FloatArray, ...]] = (),
+    area: Sequence[FloatArray] = (),
     background: FloatArray | None = None,
     background_label: str = "depth [m]",
     cmap: str | Colormap = "viridis_r",
@@ -61,8 +63,12 @@ def plot_mission_paths(
         ``r_c`` [m].
     circles : ndarray of shape (n, 3), optional
         Circular obstacles ``north, east, radius`` [m].
-    polygons : sequence of ndarray of shape (n_k, 2)
-        Polygon obstacles, vertices ``north, east`` [m].
+    polygons : sequence of ndarray of shape (n_k, 2), or of tuples of them
+        Polygon obstacles, vertices ``north, east`` [m]: a ring, or the exterior ring and its
+        holes (left open).
+    area : sequence of ndarray of shape (n_k, 2)
+        The operating area's rings (exterior, then its islands): the map outside it is
+        greyed, its islands filled like obstacles. Empty: no area.
     background : ndarray, optional
         Field to draw instead of depth (e.g. the cost map on its own grid is not supported:
         pass a field on the bathymetry grid).
@@ -93,9 +99,16 @@ def plot_mission_paths(
                                       ec=colors[k], lw=1.0))  # fmt: skip
     for north, east, radius in np.asarray(circles if circles is not None else []).reshape(-1, 3):
         axes.add_patch(Circle((east, north), radius, fc="0.3", ec="k", alpha=0.7))
-    for vertices in polygons:
-        axes.add_patch(Polygon(np.column_stack([vertices[:, 1], vertices[:, 0]]), fc="0.3",
-                               ec="k", alpha=0.7))  # fmt: skip
+    for rings in polygons:
+        rings = (rings,) if isinstance(rings, np.ndarray) else rings
+        axes.add_patch(PathPatch(_region(*rings), fc="0.3", ec="k", alpha=0.7))
+    if len(area):
+        (n0, n1), (e0, e1) = g.north_bounds, g.east_bounds
+        frame = np.array([[n0, e0], [n1, e0], [n1, e1], [n0, e1]])
+        axes.add_patch(PathPatch(_region(frame, area[0]), fc="w", ec="none", alpha=0.5))
+        axes.add_patch(PathPatch(_region(area[0]), fill=False, ec="k", ls="--", lw=1.2))
+        for island in area[1:]:
+            axes.add_patch(PathPatch(_region(island), fc="0.3", ec="k", alpha=0.7))
     axes.set_aspect("equal")
     axes.set_xlabel("east [m]")
     axes.set_ylabel("north [m]")
@@ -106,6 +119,23 @@ def plot_mission_paths(
     if bathymetry.projection is not None:
         add_geographic_axes(axes, bathymetry.projection)
     return plain_tick_labels(figure)
+
+
+def _region(exterior: FloatArray, *holes: FloatArray) -> MplPath:
+    """A polygon ``north, east`` [m] with holes as a matplotlib path in ``(east, north)``.
+
+    The exterior is wound counter-clockwise and the holes clockwise, so that the nonzero fill
+    rule leaves the holes open.
+    """
+
+    def ring(vertices: FloatArray, counter_clockwise: bool) -> MplPath:
+        xy = np.column_stack([vertices[:, 1], vertices[:, 0]])
+        area = np.sum(xy[:, 0] * np.roll(xy[:, 1], -1) - np.roll(xy[:, 0], -1) * xy[:, 1])
+        if (area > 0.0) != counter_clockwise:
+            xy = xy[::-1]
+        return MplPath(np.vstack([xy, xy[:1]]), closed=True)
+
+    return MplPath.make_compound_path(ring(exterior, True), *(ring(h, False) for h in holes))
 
 
 def plot_time_series(

@@ -18,7 +18,7 @@ from auvplan.io.writing import writing
 from auvplan.mission.evaluation import OptimizedPlan
 from auvplan.mission.navigation import budget_of
 from auvplan.mission.pipeline import MissionResult
-from auvplan.planning import CircleObstacle, PolygonObstacle
+from auvplan.planning import CircleObstacle, OperatingArea, PolygonObstacle
 from auvplan.vehicle import positions
 from auvplan.viz._notices import notices_as_debug
 from auvplan.viz.coordination import plot_coordination_space
@@ -109,7 +109,8 @@ def figure_builders(result: MissionResult) -> dict[str, Callable[[], Figure]]:
     circles = np.array(
         [(o.north, o.east, o.radius) for o in preplan.obstacles if isinstance(o, CircleObstacle)]
     ).reshape(-1, 3)
-    polygons = [o.vertices for o in preplan.obstacles if isinstance(o, PolygonObstacle)]
+    polygons = [o.rings for o in preplan.obstacles if isinstance(o, PolygonObstacle)]
+    area = next((o.region.rings for o in preplan.obstacles if isinstance(o, OperatingArea)), ())
     planned = [route.points for route in preplan.routes]
     stage2 = result.deconfliction
     plan = result.plan
@@ -119,7 +120,7 @@ def figure_builders(result: MissionResult) -> dict[str, Callable[[], Figure]]:
         return plot_mission_paths(
             preplan.bathymetry, preplan.names, planned,
             None if tracks is None else _tracks(result, tracks.states), safety_radius=radius,
-            circles=circles, polygons=polygons, **options,
+            circles=circles, polygons=polygons, area=area, **options,
         )  # fmt: skip
 
     builders: dict[str, Callable[[], Figure]] = {
@@ -145,7 +146,8 @@ def figure_builders(result: MissionResult) -> dict[str, Callable[[], Figure]]:
         builders["paths_paper"] = lambda: plot_mission_paths(
             preplan.bathymetry, preplan.names, [route.points for route in paper.preplan.routes],
             _tracks(paper, paper_plan.states), safety_radius=radius, circles=circles,
-            polygons=polygons, title="The paper's plan: information-map routes and their optimum",
+            polygons=polygons, area=area,
+            title="The paper's plan: information-map routes and their optimum",
         )  # fmt: skip
     if plan is not None:
         builders["navigation_predicted"] = lambda: _predicted_error(result)
