@@ -91,6 +91,7 @@ def test_multipolygon_parts_are_zones_of_their_own_and_points_are_skipped(tmp_pa
         ("EPSG:32610", "ESRI Shapefile", ".shp"),  # UTM zone 10 N, metres
         ("EPSG:3857", "GPKG", ".gpkg"),  # web Mercator (scale 1.25 here)
         ("EPSG:4326", "GPKG", ".gpkg"),
+        ("EPSG:4326", "KML", ".kml"),
     ],
 )
 def test_files_in_any_crs_are_reprojected(

@@ -408,3 +408,34 @@ def test_lat_lon_zones_on_terrain_without_a_geographic_reference_are_one_line(
         "auvplan: error: operating area is given in lat/lon but the terrain has no geographic "
         "reference"
     )
+
+
+def test_zone_tables_survive_the_resolved_document(tmp_path: Path) -> None:
+    """Files become absolute, lat/lon vertices stay tables: parsing the document gives back
+    the mission (as the output folder's mission.toml does)."""
+    from auvplan.mission.config import resolved_document
+
+    document = tomllib.loads(
+        """
+[terrain]
+synthetic = true
+[fleet]
+horizon_s = 100.0
+safety_radius_m = 5.0
+[[vehicle]]
+start = { north = 10.0, east = 10.0 }
+goal = { north = 50.0, east = 10.0 }
+[[obstacle]]
+file = "zones/reef.geojson"
+layer = "reefs"
+[[obstacle]]
+polygon = [{ lat = 36.79, lon = -121.81 }, { lat = 36.791, lon = -121.81 }, { lat = 36.79, lon = -121.809 }]
+[area]
+polygon = [[0.0, 0.0], [0.0, 100.0], [100.0, 100.0]]
+"""  # noqa: E501
+    )
+    config = parse_mission(document, base_dir=tmp_path)
+    assert config.obstacles[0].file == tmp_path / "zones" / "reef.geojson"
+    resolved = resolved_document(config)
+    assert resolved["obstacle"][1]["polygon"][0] == {"lat": 36.79, "lon": -121.81}
+    assert parse_mission(resolved) == config
