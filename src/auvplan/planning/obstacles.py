@@ -18,11 +18,10 @@ obstacle's (dilated) bounding box.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
-from typing import TypeAlias
+from dataclasses import dataclass, field
+from typing import Any, TypeAlias
 
 import numpy as np
-from matplotlib.path import Path as MplPath
 
 from auvplan._typing import BoolArray, FloatArray
 from auvplan.errors import InputError
@@ -80,10 +79,16 @@ class PolygonObstacle:
 
     vertices: FloatArray
     holes: tuple[FloatArray, ...] = ()
+    _shape: Any = field(init=False, repr=False)  # shapely Polygon, prepared: (east, north)
 
     def __post_init__(self) -> None:
+        import shapely
+
         object.__setattr__(self, "vertices", _ring(self.vertices, "polygon"))
         object.__setattr__(self, "holes", tuple(_ring(hole, "polygon hole") for hole in self.holes))
+        shape = shapely.Polygon(self.vertices[:, ::-1], [hole[:, ::-1] for hole in self.holes])
+        shapely.prepare(shape)
+        object.__setattr__(self, "_shape", shape)
 
     @property
     def rings(self) -> tuple[FloatArray, ...]:
@@ -91,12 +96,13 @@ class PolygonObstacle:
         return (self.vertices, *self.holes)
 
     def contains(self, north: FloatArray, east: FloatArray) -> BoolArray:
-        """Whether each point [m] (same shape) lies inside the exterior and in no hole."""
-        points = np.column_stack((np.ravel(north), np.ravel(east)))
-        inside = MplPath(self.vertices).contains_points(points)
-        for hole in self.holes:
-            inside &= ~MplPath(hole).contains_points(points)
-        return np.asarray(inside.reshape(np.shape(north)))
+        """Whether each point [m] (same shape) lies inside the exterior and in no hole.
+
+        Points on the boundary may go either way (their distance to the boundary is 0).
+        """
+        import shapely
+
+        return np.asarray(shapely.contains_xy(self._shape, east, north), dtype=np.bool_)
 
 
 def _ring(vertices: FloatArray, what: str) -> FloatArray:
@@ -211,7 +217,7 @@ def obstacle_mask(
         if isinstance(obstacle, OperatingArea):  # every cell: the no-go region is unbounded
             north, east = np.meshgrid(geometry.north, geometry.east, indexing="ij")
             rim = _rings_rectangle_distance(
-                obstacle.region.rings, north, east, half_north, half_east
+                obstacle.region.rings, north, east, half_north, half_east, clearance
             )
             mask |= ~obstacle.region.contains(north, east) | (rim < clearance) | (rim == 0.0)
             continue
@@ -236,7 +242,9 @@ def obstacle_mask(
             hit = np.hypot(gap_north, gap_east) < obstacle.radius + clearance
         else:
             north, east = np.broadcast_arrays(north, east)
-            distance = _rings_rectangle_distance(obstacle.rings, north, east, half_north, half_east)
+            distance = _rings_rectangle_distance(
+                obstacle.rings, north, east, half_north, half_east, clearance
+            )
             distance[obstacle.contains(north, east)] = 0.0
             hit = (distance < clearance) | (distance == 0.0)
         mask[rows, cols] |= hit
@@ -266,80 +274,34 @@ def _point_segment_distance(
     return np.asarray(np.hypot(north - (a[0] + t * d_north), east - (a[1] + t * d_east)))
 
 
-def _point_rectangle_distance(
-    north: float,
-    east: float,
-    centre_north: FloatArray,
-    centre_east: FloatArray,
-    half_north: float,
-    half_east: float,
-) -> FloatArray:
-    """Distance [m] from one point to each axis-aligned rectangle (0 inside)."""
-    gap_north = np.maximum(np.abs(north - centre_north) - half_north, 0.0)
-    gap_east = np.maximum(np.abs(east - centre_east) - half_east, 0.0)
-    return np.asarray(np.hypot(gap_north, gap_east))
-
-
-def _segment_hits_rectangle(
-    a: FloatArray,
-    b: FloatArray,
-    centre_north: FloatArray,
-    centre_east: FloatArray,
-    half_north: float,
-    half_east: float,
-) -> BoolArray:
-    """Whether segment ``a -> b`` intersects each rectangle (Liang–Barsky clipping)."""
-    direction = (b[0] - a[0], b[1] - a[1])
-    t_low = np.zeros(centre_north.shape)
-    t_high = np.ones(centre_north.shape)
-    is_hit = np.ones(centre_north.shape, dtype=np.bool_)
-    for axis, centre, half in ((0, centre_north, half_north), (1, centre_east, half_east)):
-        for p, q in (
-            (-direction[axis], a[axis] - (centre - half)),
-            (direction[axis], (centre + half) - a[axis]),
-        ):
-            if p == 0.0:
-                is_hit &= q >= 0.0
-            elif p < 0.0:
-                t_low = np.maximum(t_low, q / p)
-            else:
-                t_high = np.minimum(t_high, q / p)
-    return np.asarray(is_hit & (t_low <= t_high))
-
-
 def _rings_rectangle_distance(
     rings: tuple[FloatArray, ...],
     centre_north: FloatArray,
     centre_east: FloatArray,
     half_north: float,
     half_east: float,
+    reach: float,
 ) -> FloatArray:
     """Distance [m] between a polygon's boundary (its rings) and each cell rectangle.
 
-    Two disjoint convex sets are closest at a vertex of one of them, so for each ring edge
-    the distance to a rectangle is 0 if they intersect, else the least of the edge-endpoint to
-    rectangle and rectangle-corner to edge distances. A rectangle that meets no edge lies
-    wholly inside or wholly outside the polygon (its centre tells which).
+    Exact where it is at most ``reach`` [m] (0 where an edge meets the rectangle), ``inf``
+    beyond. The edges within ``reach`` of each rectangle are found with an STR-tree and their
+    distance to it computed by GEOS (shapely), so that a boundary of thousands of vertices
+    costs about as much as a few edges per cell. A rectangle that meets no edge lies wholly
+    inside or wholly outside the polygon (its centre tells which).
     """
-    distance = np.full(centre_north.shape, np.inf)
-    corners = [
-        (centre_north + s_north * half_north, centre_east + s_east * half_east)
-        for s_north in (-1.0, 1.0)
-        for s_east in (-1.0, 1.0)
-    ]
-    edges = [
-        (a, b) for ring in rings for a, b in zip(ring, np.roll(ring, -1, axis=0), strict=True)
-    ]
-    for a, b in edges:
-        edge = _point_rectangle_distance(
-            a[0], a[1], centre_north, centre_east, half_north, half_east
-        )
-        edge = np.minimum(
-            edge,
-            _point_rectangle_distance(b[0], b[1], centre_north, centre_east, half_north, half_east),
-        )
-        for corner_north, corner_east in corners:
-            edge = np.minimum(edge, _point_segment_distance(corner_north, corner_east, a, b))
-        edge[_segment_hits_rectangle(a, b, centre_north, centre_east, half_north, half_east)] = 0.0
-        distance = np.minimum(distance, edge)
-    return distance
+    import shapely
+
+    north, east = np.broadcast_arrays(centre_north, centre_east)
+    boxes = shapely.box(
+        (east - half_east).ravel(),
+        (north - half_north).ravel(),
+        (east + half_east).ravel(),
+        (north + half_north).ravel(),
+    )
+    ends = [np.stack((ring, np.roll(ring, -1, axis=0)), axis=1)[..., ::-1] for ring in rings]
+    segments = shapely.linestrings(np.concatenate(ends))  # (east, north) edges
+    cells, edges = shapely.STRtree(segments).query(boxes, predicate="dwithin", distance=reach)
+    distance = np.full(boxes.shape, np.inf)
+    np.minimum.at(distance, cells, shapely.distance(boxes[cells], segments[edges]))
+    return distance.reshape(north.shape)
