@@ -91,6 +91,12 @@ OPTIONAL: dict[Path_, Any] = {
     ("comm",): [{"pair": ["blue", "green"], "max_range_m": 400.0}],
     ("mission", "start_time"): "2026-05-01T08:00:00Z",
     ("mission", "depth_m"): 3.0,
+    ("mission", "altitude_m"): 5.0,
+    ("mission", "reserve_fraction"): 0.2,
+    ("navigation", "max_error_m"): 20.0,
+    ("metadata", "creator_name"): "A. Operator",
+    ("metadata", "creator_email"): "operator@example.org",
+    ("area", "polygon"): [[-50.0, 250.0], [-50.0, 700.0], [700.0, 700.0], [700.0, 250.0]],
 }
 #: Factors a number is scaled by (a slip of units or of the decimal point, or worse).
 SCALES = (1e-6, 1e-3, 0.1, 10.0, 1e3, 1e6)
