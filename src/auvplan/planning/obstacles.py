@@ -12,7 +12,9 @@ comes within ``clearance`` of an obstacle:
 
 So a vehicle that stays in unblocked cells keeps at least ``clearance`` from every obstacle
 at every point of those cells. All computations are vectorised over the cells of the
-obstacle's (dilated) bounding box.
+obstacle's (dilated) bounding box (every cell for an area); a polygon's edges are indexed in
+an STR-tree (shapely), so that a GIS boundary of thousands of vertices costs about ``log n``
+per cell or point.
 """
 
 from __future__ import annotations
@@ -79,7 +81,10 @@ class PolygonObstacle:
 
     vertices: FloatArray
     holes: tuple[FloatArray, ...] = ()
-    _shape: Any = field(init=False, repr=False)  # shapely Polygon, prepared: (east, north)
+    # shapely, in (east, north): the prepared polygon, its edges and their STR-tree
+    _shape: Any = field(init=False, repr=False)
+    _edges: Any = field(init=False, repr=False)
+    _edge_tree: Any = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         import shapely
@@ -88,7 +93,11 @@ class PolygonObstacle:
         object.__setattr__(self, "holes", tuple(_ring(hole, "polygon hole") for hole in self.holes))
         shape = shapely.Polygon(self.vertices[:, ::-1], [hole[:, ::-1] for hole in self.holes])
         shapely.prepare(shape)
+        ends = [np.stack((r, np.roll(r, -1, axis=0)), axis=1)[..., ::-1] for r in self.rings]
+        edges = shapely.linestrings(np.concatenate(ends))
         object.__setattr__(self, "_shape", shape)
+        object.__setattr__(self, "_edges", edges)
+        object.__setattr__(self, "_edge_tree", shapely.STRtree(edges))
 
     @property
     def rings(self) -> tuple[FloatArray, ...]:
@@ -103,6 +112,49 @@ class PolygonObstacle:
         import shapely
 
         return np.asarray(shapely.contains_xy(self._shape, east, north), dtype=np.bool_)
+
+    def boundary_distance(self, north: FloatArray, east: FloatArray) -> FloatArray:
+        """Distance [m] from each point (same shape) to the nearest edge of any ring.
+
+        The nearest edge is found in an STR-tree of the edges (shapely), so that a boundary of
+        thousands of vertices costs about ``log n`` per point.
+        """
+        import shapely
+
+        points = shapely.points(np.ravel(east), np.ravel(north))
+        pairs, distance = self._edge_tree.query_nearest(points, return_distance=True)
+        nearest = np.full(points.shape, np.inf)
+        np.minimum.at(nearest, pairs[0], distance)  # ties give several edges per point
+        return nearest.reshape(np.shape(north))
+
+    def cell_distance(
+        self,
+        centre_north: FloatArray,
+        centre_east: FloatArray,
+        half: tuple[float, float],
+        reach: float,
+    ) -> FloatArray:
+        """Distance [m] between the boundary (every ring) and each cell rectangle.
+
+        The rectangles are centred on ``centre_north, centre_east`` [m] with half-sizes
+        ``half = (north, east)`` [m]. Exact where at most ``reach`` [m] (0 where an edge meets
+        the rectangle), ``inf`` beyond: the edges within ``reach`` of each rectangle come from
+        the STR-tree and their distance to it from GEOS. A rectangle that meets no edge lies
+        wholly inside or wholly outside the polygon (its centre tells which).
+        """
+        import shapely
+
+        north, east = np.broadcast_arrays(centre_north, centre_east)
+        boxes = shapely.box(
+            (east - half[1]).ravel(),
+            (north - half[0]).ravel(),
+            (east + half[1]).ravel(),
+            (north + half[0]).ravel(),
+        )
+        cells, edges = self._edge_tree.query(boxes, predicate="dwithin", distance=reach)
+        distance = np.full(boxes.shape, np.inf)
+        np.minimum.at(distance, cells, shapely.distance(boxes[cells], self._edges[edges]))
+        return distance.reshape(north.shape)
 
 
 def _ring(vertices: FloatArray, what: str) -> FloatArray:
@@ -171,10 +223,7 @@ def distance_to_obstacle(obstacle: Obstacle, north: FloatArray, east: FloatArray
         return np.asarray(np.hypot(north - obstacle.north, east - obstacle.east) - obstacle.radius)
     if isinstance(obstacle, OperatingArea):
         return -distance_to_obstacle(obstacle.region, north, east)
-    distance = np.full(north.shape, np.inf)
-    for ring in obstacle.rings:
-        for a, b in zip(ring, np.roll(ring, -1, axis=0), strict=True):
-            distance = np.minimum(distance, _point_segment_distance(north, east, a, b))
+    distance = obstacle.boundary_distance(north, east)
     return np.asarray(np.where(obstacle.contains(north, east), -distance, distance))
 
 
@@ -216,9 +265,7 @@ def obstacle_mask(
     for obstacle in obstacles:
         if isinstance(obstacle, OperatingArea):  # every cell: the no-go region is unbounded
             north, east = np.meshgrid(geometry.north, geometry.east, indexing="ij")
-            rim = _rings_rectangle_distance(
-                obstacle.region.rings, north, east, half_north, half_east, clearance
-            )
+            rim = obstacle.region.cell_distance(north, east, (half_north, half_east), clearance)
             mask |= ~obstacle.region.contains(north, east) | (rim < clearance) | (rim == 0.0)
             continue
         if isinstance(obstacle, CircleObstacle):
@@ -242,9 +289,7 @@ def obstacle_mask(
             hit = np.hypot(gap_north, gap_east) < obstacle.radius + clearance
         else:
             north, east = np.broadcast_arrays(north, east)
-            distance = _rings_rectangle_distance(
-                obstacle.rings, north, east, half_north, half_east, clearance
-            )
+            distance = obstacle.cell_distance(north, east, (half_north, half_east), clearance)
             distance[obstacle.contains(north, east)] = 0.0
             hit = (distance < clearance) | (distance == 0.0)
         mask[rows, cols] |= hit
@@ -261,47 +306,3 @@ def _overlapping(
     if inside.size == 0:
         return slice(0, 0)
     return slice(int(inside[0]), int(inside[-1]) + 1)
-
-
-def _point_segment_distance(
-    north: FloatArray, east: FloatArray, a: FloatArray, b: FloatArray
-) -> FloatArray:
-    """Distance [m] from points to the segment ``a -> b`` (``[north, east]``)."""
-    d_north, d_east = b[0] - a[0], b[1] - a[1]
-    length2 = d_north * d_north + d_east * d_east
-    t = (north - a[0]) * d_north + (east - a[1]) * d_east
-    t = np.clip(t / length2, 0.0, 1.0) if length2 > 0.0 else np.zeros_like(north)
-    return np.asarray(np.hypot(north - (a[0] + t * d_north), east - (a[1] + t * d_east)))
-
-
-def _rings_rectangle_distance(
-    rings: tuple[FloatArray, ...],
-    centre_north: FloatArray,
-    centre_east: FloatArray,
-    half_north: float,
-    half_east: float,
-    reach: float,
-) -> FloatArray:
-    """Distance [m] between a polygon's boundary (its rings) and each cell rectangle.
-
-    Exact where it is at most ``reach`` [m] (0 where an edge meets the rectangle), ``inf``
-    beyond. The edges within ``reach`` of each rectangle are found with an STR-tree and their
-    distance to it computed by GEOS (shapely), so that a boundary of thousands of vertices
-    costs about as much as a few edges per cell. A rectangle that meets no edge lies wholly
-    inside or wholly outside the polygon (its centre tells which).
-    """
-    import shapely
-
-    north, east = np.broadcast_arrays(centre_north, centre_east)
-    boxes = shapely.box(
-        (east - half_east).ravel(),
-        (north - half_north).ravel(),
-        (east + half_east).ravel(),
-        (north + half_north).ravel(),
-    )
-    ends = [np.stack((ring, np.roll(ring, -1, axis=0)), axis=1)[..., ::-1] for ring in rings]
-    segments = shapely.linestrings(np.concatenate(ends))  # (east, north) edges
-    cells, edges = shapely.STRtree(segments).query(boxes, predicate="dwithin", distance=reach)
-    distance = np.full(boxes.shape, np.inf)
-    np.minimum.at(distance, cells, shapely.distance(boxes[cells], segments[edges]))
-    return distance.reshape(north.shape)
