@@ -269,12 +269,16 @@ def test_the_optimised_replay_keeps_clear_of_gis_zones_and_inside_the_area(
     """The full plan: exit 0, converged, the replay r_c from each zone and inside the area."""
     mission = reef_wreck_corridor(tmp_path)
     out = tmp_path / "out"
-    assert main(["-q", "plan", str(mission), "-o", str(out), "--no-figures"]) == 0
+    argv = ["-q", "plan", str(mission), "-o", str(out), "--no-figures", "--export", "geojson"]
+    assert main(argv) == 0
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
     assert summary["optimization"]["plan_status"] == "CONVERGED"
     minima = summary["optimization"]["vehicles"]["blue"]["min_separation_m"]
     assert set(minima) == {"reef feature 0", "wreck feature 0", AREA_NAME}
     assert min(minima.values()) >= SAFETY_RADIUS - 1e-3
+    zones = json.loads((out / "export" / "obstacles.geojson").read_text(encoding="utf-8"))
+    names = sorted(feature["properties"]["name"] for feature in zones["features"])
+    assert names == ["reef feature 0", "wreck feature 0"]  # the area is kept in, not out
 
 
 BOWTIE = np.array([[100.0, 100.0], [150.0, 150.0], [100.0, 150.0], [150.0, 100.0]])
