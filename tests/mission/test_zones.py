@@ -28,6 +28,7 @@ from auvplan.io.bathymetry import read_bathymetry
 from auvplan.mission.checks import PlanStatus, judge_plan
 from auvplan.mission.config import AREA_NAME, parse_mission
 from auvplan.record.labels import Pair
+from auvplan.scenarios import check
 from auvplan.terrain import LocalProjection
 
 SAFETY_RADIUS = 5.0
@@ -276,6 +277,13 @@ def test_the_optimised_replay_keeps_clear_of_gis_zones_and_inside_the_area(
     minima = summary["optimization"]["vehicles"]["blue"]["min_separation_m"]
     assert set(minima) == {"reef feature 0", "wreck feature 0", AREA_NAME}
     assert min(minima.values()) >= SAFETY_RADIUS - 1e-3
+    report = check(out)  # independent of the solver, from the folder's own mission.toml
+    assert report.failures == ()
+    independent = report.min_obstacle_clearance_m
+    assert set(independent) == {
+        "blue / obstacle 0 feature 0", "blue / obstacle 1 feature 0", f"blue / {AREA_NAME}"
+    }  # fmt: skip
+    assert min(independent.values()) >= SAFETY_RADIUS
     zones = json.loads((out / "export" / "obstacles.geojson").read_text(encoding="utf-8"))
     names = sorted(feature["properties"]["name"] for feature in zones["features"])
     assert names == ["reef feature 0", "wreck feature 0"]  # the area is kept in, not out

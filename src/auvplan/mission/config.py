@@ -43,9 +43,8 @@ from auvplan.mission.tables import (
     WeightsConfig,
     WindowConfig,
 )
+from auvplan.record.labels import AREA_NAME
 
-#: The label of the operating area among the obstacles (messages, separations, summary).
-AREA_NAME: Final = "operating area"
 #: Most solver steps a mission may ask for (``horizon_s / dt_s``) before anything is allocated.
 MAX_SOLVER_STEPS: Final = 200_000
 

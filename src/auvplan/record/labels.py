@@ -14,6 +14,9 @@ from typing import Final
 
 #: Between the two names of a pair, as written.
 SEPARATOR: Final = " / "
+#: The name of the operating area (``[area]``) as the second of a pair: its clearance is the
+#: distance to its boundary from inside.
+AREA_NAME: Final = "operating area"
 
 
 @dataclass(frozen=True, order=True)

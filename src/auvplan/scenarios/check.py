@@ -1,13 +1,14 @@
 """Independent checks of a ``plan`` output folder, not trusting the solver's own report.
 
 :func:`check` reads only ``trajectories.csv``, ``summary.json`` (goals resolved to the local
-frame, safety radius, solver settings, status) and the mission file (obstacles, communication
-pairs; ``maps.nc`` only for the projection when an obstacle centre is in lat/lon), and checks:
+frame, safety radius, solver settings, status) and the mission file (obstacles and their GIS
+files, the operating area, communication pairs; ``maps.nc`` only for the projection when an
+obstacle is in lat/lon or a GIS file), and checks:
 
 (a) **constraints between samples**: positions interpolated by a cubic spline per coordinate
     on a grid ``refinement`` times finer than the plan's; every pair keeps ``>= 2 r_c``, every
-    vehicle keeps ``>= r_c`` from every obstacle's edge, every communication pair stays within
-    its range;
+    vehicle keeps ``>= r_c`` from every obstacle's edge and inside the operating area's, every
+    communication pair stays within its range;
 (b) **dynamics**: the per-step defect of the samples against an independent plain-numpy
     model of each vehicle's own type, integrated with the input held
     (:mod:`auvplan.scenarios._model`, read by :mod:`auvplan.scenarios._vehicle_file`), in
@@ -39,11 +40,13 @@ from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError, InputError
 from auvplan.io.currents import read_current
 from auvplan.io.results import read_trajectories_csv
+from auvplan.io.zones import read_zones
 from auvplan.ocean import CurrentField, UniformCurrent
 from auvplan.record.files import MAIN_PLAN, MAPS_FILE, MISSION_FILE, PLAN_FILES, SUMMARY_FILE
-from auvplan.record.labels import Pair
+from auvplan.record.labels import AREA_NAME, Pair
 from auvplan.scenarios._model import ReferenceModel, step_defects
 from auvplan.scenarios._vehicle_file import read_reference_model
+from auvplan.terrain.projection import LocalProjection
 
 #: Largest per-step position defect [m] accepted (issue 11: 10 mm).
 DEFECT_TOLERANCE_M: Final = 0.01
@@ -200,7 +203,7 @@ def check(
                     "separation", f"{pair} {distance:.3f} m apart < 2 r_c = {2 * radius:g} m"
                 )
             )
-    clearances = _obstacle_clearances(fine, document, output_dir)
+    clearances = _obstacle_clearances(fine, document, output_dir, mission_path.parent)
     for label, clearance in clearances.items():
         if clearance < radius - GEOMETRY_SLACK_M:
             failures.append(
@@ -318,32 +321,76 @@ def _pair_distances(fine: Mapping[str, FloatArray], names: list[str]) -> dict[st
 
 
 def _obstacle_clearances(
-    fine: Mapping[str, FloatArray], document: Mapping[str, Any], output_dir: Path
+    fine: Mapping[str, FloatArray], document: Mapping[str, Any], output_dir: Path, mission_dir: Path
 ) -> dict[str, float]:
-    """Smallest signed distance [m] of each vehicle to each obstacle's edge (< 0 inside)."""
-    clearances = {}
+    """Smallest signed distance [m] of each vehicle to each obstacle's edge (< 0 inside).
+
+    A GIS ``file`` gives one zone per polygon (``"a / obstacle k feature K"``); the operating
+    area counts from inside its boundary (``"a / operating area"``, < 0 outside it).
+    Polygons are shapely's in ``(north, east)``, holes included.
+    """
+    zones: list[tuple[str, Any]] = []  # a shapely polygon, or a circle (centre, radius)
     for k, obstacle in enumerate(document.get("obstacle", [])):
+        if "center" in obstacle:
+            circle = (_local(obstacle["center"], output_dir), float(obstacle["radius_m"]))
+            zones.append((f"obstacle {k}", circle))
+        else:
+            zones += [
+                (f"obstacle {k}{label}", shape)
+                for label, shape in _polygons(obstacle, output_dir, mission_dir)
+            ]
+    if "area" in document:
+        ((_, area),) = _polygons(document["area"], output_dir, mission_dir)
+        zones.append((AREA_NAME, area))
+    clearances = {}
+    for label, zone in zones:
         for name, track in fine.items():
-            if "polygon" in obstacle:
-                shape = shapely.Polygon(np.asarray(obstacle["polygon"], dtype=np.float64))
-                points = shapely.points(track)
-                distance = shapely.distance(shape.boundary, points)
-                signed = np.where(shapely.contains(shape, points), -distance, distance)
+            if isinstance(zone, tuple):
+                signed = np.hypot(*(track - zone[0]).T) - zone[1]
             else:
-                centre = _local(obstacle["center"], output_dir)
-                signed = np.hypot(*(track - centre).T) - float(obstacle["radius_m"])
-            clearances[f"{name} / obstacle {k}"] = float(np.min(signed))
+                points = shapely.points(track)
+                distance = shapely.distance(zone.boundary, points)
+                signed = np.where(shapely.contains(zone, points), -distance, distance)
+            sign = -1.0 if label == AREA_NAME else 1.0  # the area is kept in
+            clearances[f"{name} / {label}"] = float(np.min(sign * signed))
     return clearances
+
+
+def _polygons(
+    table: Mapping[str, Any], output_dir: Path, mission_dir: Path
+) -> list[tuple[str, Any]]:
+    """The polygons of an ``[[obstacle]]`` or ``[area]`` table, each with a label suffix.
+
+    A ``polygon``'s vertices are ``[north, east]`` pairs or positions (:func:`_local`); a
+    ``file`` (relative to ``mission_dir``) is read by :func:`~auvplan.io.zones.read_zones`.
+    """
+    if "polygon" in table:
+        vertices = [
+            _local(v, output_dir) if isinstance(v, Mapping) else (float(v[0]), float(v[1]))
+            for v in table["polygon"]
+        ]
+        return [("", shapely.Polygon(vertices))]
+    zones = read_zones(
+        mission_dir / table["file"], _projection(output_dir), layer=table.get("layer")
+    )
+    return [(f" {zone.label}", shapely.Polygon(zone.exterior, zone.holes)) for zone in zones]
+
+
+def _projection(output_dir: Path) -> LocalProjection:
+    """The local frame of the folder's ``maps.nc`` (refused when it has none)."""
+    from auvplan.io.bathymetry import read_bathymetry
+
+    projection = read_bathymetry(output_dir / MAPS_FILE).projection
+    if projection is None:
+        raise DataFormatError(f"{output_dir}/maps.nc has no projection for lat/lon obstacles")
+    return projection
 
 
 def _local(position: Mapping[str, float], output_dir: Path) -> tuple[float, float]:
     """``(north, east)`` [m] of a mission position; lat/lon via the projection in ``maps.nc``."""
     if "north" in position:
         return float(position["north"]), float(position["east"])
-    from auvplan.io.bathymetry import read_bathymetry
-
-    projection = read_bathymetry(output_dir / MAPS_FILE).projection
-    if projection is None:
-        raise DataFormatError(f"{output_dir}/maps.nc has no projection for a lat/lon obstacle")
-    north, east = projection.to_local(np.array([position["lat"]]), np.array([position["lon"]]))
+    north, east = _projection(output_dir).to_local(
+        np.array([position["lat"]]), np.array([position["lon"]])
+    )
     return float(north[0]), float(east[0])
