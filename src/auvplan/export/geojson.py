@@ -25,7 +25,7 @@ from typing import Any, Final
 import numpy as np
 
 from auvplan._typing import FloatArray
-from auvplan.export.kml import zone_outline
+from auvplan.export.kml import zone_holes, zone_outline
 from auvplan.export.plan import ExportPlan, utc_text
 from auvplan.export.waypoints import Waypoints
 
@@ -91,14 +91,23 @@ def waypoint_features(plan: ExportPlan, fleet: Sequence[Waypoints]) -> list[dict
 
 
 def obstacle_features(plan: ExportPlan) -> list[dict[str, Any]]:
-    """One ``Polygon`` feature per keep-out zone, exterior ring counter-clockwise."""
+    """One ``Polygon`` feature per keep-out zone, holes included.
+
+    Exterior rings are counter-clockwise and holes clockwise (RFC 7946 §3.1.6).
+    """
+
+    def wound(outline: list[tuple[float, float]], counter_clockwise: bool) -> list[list[float]]:
+        ring = np.array(outline)
+        lon, lat = ring[:, 0], ring[:, 1]
+        area = np.dot(lon, np.roll(lat, -1)) - np.dot(lat, np.roll(lon, -1))
+        if (area > 0.0) != counter_clockwise:
+            lon, lat = lon[::-1], lat[::-1]
+        return _positions(lon, lat)
+
     features = []
     for zone in plan.zones:
-        ring = np.array(zone_outline(zone))
-        lon, lat = ring[:, 0], ring[:, 1]
-        if np.dot(lon, np.roll(lat, -1)) - np.dot(lat, np.roll(lon, -1)) < 0.0:  # clockwise
-            lon, lat = lon[::-1], lat[::-1]
-        geometry = {"type": "Polygon", "coordinates": [_positions(lon, lat)]}
+        rings = [wound(zone_outline(zone), True), *(wound(h, False) for h in zone_holes(zone))]
+        geometry = {"type": "Polygon", "coordinates": rings}
         properties = {"name": zone.name, "kind": "keep-out"}
         features.append({"type": "Feature", "properties": properties, "geometry": geometry})
     return features

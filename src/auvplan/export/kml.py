@@ -19,6 +19,7 @@ from typing import Final
 import numpy as np
 from lxml import etree
 
+from auvplan._typing import FloatArray
 from auvplan._version import __version__
 from auvplan.export.plan import CircleZone, ExportPlan, PolygonZone, utc_text
 from auvplan.export.waypoints import Waypoints
@@ -41,6 +42,16 @@ def zone_outline(zone: CircleZone | PolygonZone) -> list[tuple[float, float]]:
         lat, lon = LocalProjection(zone.lat, zone.lon).to_geographic(
             zone.radius * np.cos(angle), zone.radius * np.sin(angle)
         )
+    return _closed(lon, lat)
+
+
+def zone_holes(zone: CircleZone | PolygonZone) -> list[list[tuple[float, float]]]:
+    """``(lon, lat)`` [deg] of each closed ring of a zone's holes (none for a circle)."""
+    return [_closed(lon, lat) for lat, lon in zone.holes] if isinstance(zone, PolygonZone) else []
+
+
+def _closed(lon: FloatArray, lat: FloatArray) -> list[tuple[float, float]]:
+    """``(lon, lat)`` [deg] pairs of a ring, its first vertex repeated at the end."""
     ring = [(float(x), float(y)) for x, y in zip(lon, lat, strict=True)]
     return [*ring, ring[0]]
 
@@ -87,12 +98,13 @@ def kml_document(plan: ExportPlan, fleet: Sequence[Waypoints]) -> str:
             placemark = _child(obstacles, _kml("Placemark"), id=f"obstacle_{number}")
             _child(placemark, _kml("name"), zone.name)
             _child(placemark, _kml("styleUrl"), "#zone_outline")
-            ring = _child(
-                _child(_child(placemark, _kml("Polygon")), _kml("outerBoundaryIs")),
-                _kml("LinearRing"),
-            )
-            points = " ".join(f"{lon!r},{lat!r},0" for lon, lat in zone_outline(zone))
-            _child(ring, _kml("coordinates"), points)
+            polygon = _child(placemark, _kml("Polygon"))
+            rings = [("outerBoundaryIs", zone_outline(zone))]
+            rings += [("innerBoundaryIs", hole) for hole in zone_holes(zone)]
+            for boundary, outline in rings:
+                ring = _child(_child(polygon, _kml(boundary)), _kml("LinearRing"))
+                points = " ".join(f"{lon!r},{lat!r},0" for lon, lat in outline)
+                _child(ring, _kml("coordinates"), points)
     text: bytes = etree.tostring(root, xml_declaration=True, encoding="UTF-8", pretty_print=True)
     return text.decode()
 
@@ -102,4 +114,4 @@ def render(plan: ExportPlan, fleet: Sequence[Waypoints]) -> dict[str, str]:
     return {"trajectories.kml": kml_document(plan, fleet)}
 
 
-__all__ = ["CIRCLE_VERTICES", "kml_document", "render", "zone_outline"]
+__all__ = ["CIRCLE_VERTICES", "kml_document", "render", "zone_holes", "zone_outline"]

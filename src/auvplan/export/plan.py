@@ -75,11 +75,16 @@ class CircleZone:
 
 @dataclass(frozen=True)
 class PolygonZone:
-    """A polygonal keep-out zone: vertices ``lat, lon`` [deg], in order, closing edge implied."""
+    """A polygonal keep-out zone: vertices ``lat, lon`` [deg], in order, closing edge implied.
+
+    ``holes`` are the ``(lat, lon)`` rings of free water inside it (GeoJSON and KML write
+    them; a format without holes, such as a QGroundControl fence, keeps out of them too).
+    """
 
     name: str
     lat: FloatArray
     lon: FloatArray
+    holes: tuple[tuple[FloatArray, FloatArray], ...] = ()
 
 
 @dataclass(frozen=True)

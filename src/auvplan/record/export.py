@@ -70,18 +70,16 @@ def export_plan(record: PlanRecord) -> ExportPlan:
 
 
 def _zone(obstacle: CircleObstacle | PolygonObstacle) -> CircleZone | PolygonZone:
-    """A keep-out zone from an obstacle of ``summary.json`` (lat/lon required).
-
-    A polygon's holes are not exported: its zone keeps out of them too (on the safe side).
-    """
+    """A keep-out zone from an obstacle of ``summary.json`` (lat/lon required), holes kept."""
     if isinstance(obstacle, PolygonObstacle):
-        corners = [(v.lat, v.lon) for v in obstacle.vertices]
-        if any(lat is None or lon is None for lat, lon in corners):
-            raise InputError(f"obstacle {obstacle.name!r} has no lat/lon in summary.json")
+        rings = []
+        for ring in (obstacle.vertices, *obstacle.holes):
+            corners = [(v.lat, v.lon) for v in ring]
+            if any(lat is None or lon is None for lat, lon in corners):
+                raise InputError(f"obstacle {obstacle.name!r} has no lat/lon in summary.json")
+            rings.append(np.array(corners, dtype=np.float64).T)
         return PolygonZone(
-            obstacle.name,
-            np.array([lat for lat, _ in corners], dtype=np.float64),
-            np.array([lon for _, lon in corners], dtype=np.float64),
+            obstacle.name, rings[0][0], rings[0][1], tuple((h[0], h[1]) for h in rings[1:])
         )
     center = obstacle.center
     if center.lat is None or center.lon is None:
