@@ -23,6 +23,9 @@ from auvplan.vehicle import build_vehicle_model
 GOLDEN = Path(__file__).parent / "regression" / "golden_mission.toml"
 #: Declared names a plain ``auvplan plan`` does not write: other verbs write them.
 WRITTEN_BY_OTHER_VERBS = {files.NAVIGATION_FILE, files.RUN_RECORD_FILE, files.EXPORT_FOLDER}
+#: Declared names written only when the mission names input files to carry (the golden
+#: mission's terrain and vehicles are packaged; tests/api/test_portable_folder.py writes it).
+WRITTEN_WITH_INPUT_FILES = {files.INPUTS_FOLDER}
 
 
 def test_every_declared_output_file_is_written_and_every_written_file_declared(
@@ -33,7 +36,10 @@ def test_every_declared_output_file_is_written_and_every_written_file_declared(
     written = {path.name for path in out.iterdir()}
     main_plan = files.PLAN_FILES[files.MAIN_PLAN]
     single = {getattr(files, name) for name in files.__all__ if name.endswith(("_FILE", "_FOLDER"))}
-    declared = (single - WRITTEN_BY_OTHER_VERBS) | {main_plan.csv, main_plan.netcdf}
+    declared = (single - WRITTEN_BY_OTHER_VERBS - WRITTEN_WITH_INPUT_FILES) | {
+        main_plan.csv,
+        main_plan.netcdf,
+    }
     assert written == declared
 
 
