@@ -198,3 +198,34 @@ def test_undecodable_time_is_one_line(
     with pytest.raises(DataFormatError, match=message) as raised:
         _read(tmp_path / "roms.nc", depth=0.0)
     assert "\n" not in str(raised.value)
+
+
+@pytest.mark.parametrize(
+    ("variable", "value", "message"),
+    [
+        ("water_u", 1e30, r"water_u holds 1e\+27 m/s at \d+ of its \d+ values, faster than any"),
+        ("water_v", np.inf, r"water_v holds inf m/s"),
+        ("depth", np.nan, "a depth level is not a finite number"),
+        ("lat", np.nan, r"lat holds \d+ of 17 values that are not numbers"),
+    ],
+)
+def test_values_no_current_has_are_one_line_errors(
+    tmp_path: Path, variable: str, value: float, message: str
+) -> None:
+    """Absurd speeds (fill without a _FillValue, a units slip), infinite ones and non-finite
+    levels or coordinates are refused naming the variable, not planned (fuzzing found them)."""
+    import xarray as xr
+
+    with xr.open_dataset(write_hycom(tmp_path / "clean.nc"), decode_cf=False) as opened:
+        dataset = opened.load()
+    values = np.array(dataset[variable].values, dtype=np.float64)
+    values[tuple(slice(0, max(1, n // 2)) for n in values.shape)] = value
+    if variable.startswith("water"):  # raw int16 of scale 0.001: write the decoded floats
+        dataset[variable] = (dataset[variable].dims, 0.001 * values, {"units": "m/s"})
+    else:
+        dataset = dataset.assign_coords(
+            {variable: (dataset[variable].dims, values, dataset[variable].attrs)}
+        )
+    dataset.to_netcdf(tmp_path / "damaged.nc")
+    with pytest.raises(DataFormatError, match=message):
+        _read(tmp_path / "damaged.nc", depth=5.0)

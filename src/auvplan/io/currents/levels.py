@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from auvplan._typing import FloatArray
+from auvplan.errors import DataFormatError
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -65,8 +66,17 @@ def at_depth(values: FloatArray, depths: FloatArray, depth: float) -> FloatArray
     Returns
     -------
     ndarray of shape ``values.shape[1:]``
+
+    Raises
+    ------
+    DataFormatError
+        If a level's depth is not a finite number or two levels share a depth.
     """
     depths = np.broadcast_to(depths, values.shape)
+    if not np.all(np.isfinite(depths)):
+        raise DataFormatError("a depth level is not a finite number")
+    if np.any(np.diff(depths, axis=0) <= 0.0):
+        raise DataFormatError("two depth levels share a depth")
     if values.shape[0] == 1:
         return np.asarray(values[0], dtype=np.float64)
     levels = np.arange(values.shape[0]).reshape(-1, *([1] * (values.ndim - 1)))

@@ -22,7 +22,12 @@ from auvplan.io.currents import curvilinear, lattice
 from auvplan.io.currents.levels import at_depth, vertical_dimension
 from auvplan.io.currents.roms import rho_currents
 from auvplan.io.currents.times import time_dimension, time_window
-from auvplan.io.currents.variables import Components, find_components, velocity_factor
+from auvplan.io.currents.variables import (
+    Components,
+    find_components,
+    finite_values,
+    velocity_values,
+)
 from auvplan.ocean import GriddedCurrent
 from auvplan.terrain.grid import GridGeometry
 from auvplan.terrain.spline import SplineSurface
@@ -104,7 +109,15 @@ def read_current(
             return _convert(dataset, projection, extent, start_time, depth, water, horizon)
     except AuvplanError as error:
         raise type(error)(f"current file {path.name}: {error}") from None
-    except (ValueError, KeyError, TypeError, IndexError, OSError, RuntimeError) as error:
+    except (
+        ValueError,
+        KeyError,
+        TypeError,
+        IndexError,
+        OSError,
+        RuntimeError,
+        OverflowError,
+    ) as error:
         raise DataFormatError(
             f"current file {path.name}: malformed ({first_line(error)})"
         ) from None
@@ -160,15 +173,14 @@ def _on_nodes(
     if latlon is not None:
         if projection is None:
             raise InputError("it is on lat/lon but the terrain has no lat/lon reference")
-        lat, lon = (np.asarray(dataset[name].values, dtype=np.float64) for name in latlon)
+        lat, lon = (finite_values(dataset, name) for name in latlon)
         window = curvilinear.crop(lat, lon, projection, extent)
         row_dim, col_dim = map(str, dataset[latlon[0]].dims)
         slices = [_load(dataset, d, time, depth, (row_dim, col_dim), window) for d in data]
         lat, lon = lat[window], lon[window]
         return (*curvilinear.resample(lat, lon, slices, projection, extent), lattice.IDENTITY)
     row_name, col_name, is_latlon = _horizontal_axes(dataset, data[0], components.north)
-    rows = np.asarray(dataset[row_name].values, dtype=np.float64)
-    cols = np.asarray(dataset[col_name].values, dtype=np.float64)
+    rows, cols = finite_values(dataset, row_name), finite_values(dataset, col_name)
     crs = lattice.file_crs(dataset, data[0], is_latlon, rows, cols, row_name)
     if crs is not None and crs.is_geographic:
         cols = np.unwrap(cols, period=360.0)  # a 0..360 subset across the prime meridian
@@ -227,10 +239,9 @@ def _load(
     Raises
     ------
     DataFormatError
-        Unknown units, or dimensions other than time, depth, the two horizontal ones and
-        singletons.
+        Unknown units, absurd values (:func:`~.variables.velocity_values`), or dimensions
+        other than time, depth, the two horizontal ones and singletons.
     """
-    factor = velocity_factor(data)
     if time is not None:
         data = data.isel({time[0]: time[1]})
     data = data.isel(dict(zip(horizontal, window, strict=True)))
@@ -241,7 +252,7 @@ def _load(
         raise DataFormatError(f"{data.name} has unexpected dimensions {extra}")
     order = [d for d in (level, time[0] if time else None, *horizontal) if d]
     data = data.squeeze([d for d in data.dims if d not in order]).transpose(*order)
-    values = factor * np.asarray(data.values, dtype=np.float64)
+    values = velocity_values(data, data.values)
     if time is None:
         values = values[:, None] if level else values[None]
     if level is None:

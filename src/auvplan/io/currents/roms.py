@@ -28,7 +28,7 @@ import numpy as np
 from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError
 from auvplan.io.currents.levels import at_depth
-from auvplan.io.currents.variables import Components, velocity_factor
+from auvplan.io.currents.variables import Components, finite_values, velocity_values
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -71,7 +71,7 @@ def rho_currents(
             f"{components.east}/{components.north} are on a ROMS C-grid but {missing} are "
             "missing (the ρ points' lat_rho, lon_rho and the grid's angle [rad])"
         )
-    lat, lon, angle = (np.asarray(dataset[name].values, dtype=np.float64) for name in _GRID)
+    lat, lon, angle = (finite_values(dataset, name) for name in _GRID)
     n_eta, n_xi = lat.shape
     u, s_dim = _load(dataset, components.east, ("eta_u", "xi_u"), (n_eta, n_xi - 1), time)
     v, _ = _load(dataset, components.north, ("eta_v", "xi_v"), (n_eta - 1, n_xi), time)
@@ -111,8 +111,9 @@ def _load(
         )
     s_dim = s_dims[0] if s_dims else None
     order = [d for d in (time[0] if time else None, s_dim, *horizontal) if d]
-    values = np.asarray(data.squeeze([d for d in others if d not in order]).transpose(*order))
-    values = values.astype(np.float64) * velocity_factor(data)
+    values = velocity_values(
+        data, data.squeeze([d for d in others if d not in order]).transpose(*order)
+    )
     if time is None:
         values = values[None]
     if s_dim is None:

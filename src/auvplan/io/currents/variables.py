@@ -12,12 +12,22 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Final
 
+import numpy as np
+
+from auvplan._typing import FloatArray
 from auvplan.errors import DataFormatError
 
 if TYPE_CHECKING:
     import xarray as xr
 
-__all__ = ["CURRENT_NAMES", "Components", "find_components", "velocity_factor"]
+__all__ = [
+    "CURRENT_NAMES",
+    "MAX_CURRENT",
+    "Components",
+    "find_components",
+    "finite_values",
+    "velocity_values",
+]
 
 #: ``(east, north)`` names tried in order after the CF standard names: Copernicus Marine,
 #: HYCOM, NOAA RTOFS 2-D files, then RTOFS 3-D files, ROMS/CROCO and plain files.
@@ -28,6 +38,10 @@ CURRENT_NAMES: Final = (
     ("u", "v"),
 )
 _STANDARD_NAMES: Final = ("eastward_sea_water_velocity", "northward_sea_water_velocity")
+#: Fastest current [m/s] a file may hold: above every ocean and tidal current measured (the
+#: Saltstraumen tidal race, about 11 m/s); beyond it the values are fill without a declared
+#: ``_FillValue``, or the units are wrong.
+MAX_CURRENT: Final = 15.0
 _GRID_STANDARD_NAMES: Final = (
     "sea_water_x_velocity_at_u_location",
     "sea_water_y_velocity_at_v_location",
@@ -83,15 +97,42 @@ def find_components(dataset: xr.Dataset) -> Components:
     )
 
 
-def velocity_factor(data: xr.DataArray) -> float:
-    """Factor [-] from the variable's ``units`` to m/s (no units: m/s).
+def velocity_values(data: xr.DataArray, values: object) -> FloatArray:
+    """``values`` of the component ``data`` in m/s, each NaN or within :data:`MAX_CURRENT`.
+
+    The factor comes from the variable's ``units`` (none: m/s); NaN is land or fill.
 
     Raises
     ------
     DataFormatError
-        If the units are not a velocity this module knows.
+        If the units are not a velocity this module knows, or a value is infinite or faster
+        than :data:`MAX_CURRENT` (naming the variable, the first value and the count).
     """
     units = str(data.attrs.get("units", "m s-1")).strip()
     if units not in _UNITS:
         raise DataFormatError(f"{data.name} has units {units!r}, not a velocity (m s-1)")
-    return _UNITS[units]
+    speeds = _UNITS[units] * np.asarray(values, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        wild = np.abs(speeds) > MAX_CURRENT
+    if np.any(wild):
+        raise DataFormatError(
+            f"{data.name} holds {speeds[wild].flat[0]:g} m/s at {np.count_nonzero(wild)} of its "
+            f"{speeds.size} values, faster than any current ({MAX_CURRENT:g} m/s): fill values "
+            "without a _FillValue, or wrong units?"
+        )
+    return speeds
+
+
+def finite_values(dataset: xr.Dataset, name: str) -> FloatArray:
+    """The values of the coordinate or grid variable ``name``, all finite numbers.
+
+    Raises
+    ------
+    DataFormatError
+        If one is not (naming the coordinate and the count).
+    """
+    values = np.asarray(dataset[name].values, dtype=np.float64)
+    bad = np.count_nonzero(~np.isfinite(values))
+    if bad:
+        raise DataFormatError(f"{name} holds {bad} of {values.size} values that are not numbers")
+    return values
