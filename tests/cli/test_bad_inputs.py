@@ -26,7 +26,9 @@ import xarray as xr
 from _cli import run_cli
 
 from auvplan.cli.main import EXIT_TERMINATED
-from conftest import PlanFolderWriter
+
+#: The ``write_plan_folder`` fixture of ``tests/conftest.py``.
+PlanFolderWriter = Callable[..., Path]
 
 MEDUSA = resources.files("auvplan").joinpath("data", "vehicles", "medusa.toml").read_text()
 DEMO = resources.files("auvplan").joinpath("data", "missions", "demo.toml").read_text()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +13,9 @@ from auvplan.errors import DataFormatError
 from auvplan.record import VehicleTrajectory, export_plan, read_record
 from auvplan.terrain import BathymetryGrid, GridGeometry, LocalProjection, compute_terrain_maps
 from auvplan.vehicle import INPUT_NAMES, STATE_NAMES
-from conftest import PlanFolderWriter
+
+#: The ``write_plan_folder`` fixture of ``tests/conftest.py``.
+PlanFolderWriter = Callable[..., Path]
 
 ORIGIN = {"north": 0.0, "east": 0.0, "lat": 36.8, "lon": -121.81}
 
