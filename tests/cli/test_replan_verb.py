@@ -51,7 +51,7 @@ def test_replan_writes_a_plan_that_starts_from_the_states_and_names_its_parent(
     summary = json.loads((child / "summary.json").read_text())
     parent = json.loads((parent_folder / "summary.json").read_text())
     assert summary["replan"] == {
-        "parent": str(parent_folder),
+        "parent": parent_folder.name,
         "parent_digest": parent["digest"]["trajectories.csv"],
         "at_s": 60.0,
         "schedule": "kept",

@@ -35,6 +35,7 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from datetime import timedelta
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -68,7 +69,8 @@ from auvplan.vehicle import headings, positions, reference_states, top_speed
 class ReplanOrigin:
     """The plan a replan continues (``summary.json``'s ``replan``).
 
-    ``parent`` is its output folder (None: planned in memory), ``parent_digest`` the SHA-256
+    ``parent`` is its output folder (None: planned in memory; ``summary.json`` keeps its name
+    only, no path: folders travel), ``parent_digest`` the SHA-256
     of its ``trajectories.csv``, ``at`` [s] the time of the parent plan that is the new
     plan's ``t = 0``; ``schedule`` is ``"kept"`` when the parent's time laws, shifted, are
     still certified for the new starts, ``"deconflicted"`` when they were planned again.
@@ -82,7 +84,7 @@ class ReplanOrigin:
     def document(self) -> dict[str, Any]:
         """The ``replan`` entry of ``summary.json``."""
         return {
-            "parent": self.parent,
+            "parent": None if self.parent is None else Path(self.parent).name,
             "parent_digest": self.parent_digest,
             "at_s": self.at,
             "schedule": self.schedule,
