@@ -18,10 +18,13 @@ PREPLAN = RunOptions(stage="preplan", quiet_logs=False)
 
 @pytest.fixture
 def client(monkeypatch: pytest.MonkeyPatch) -> Iterator[Any]:
-    """A client of a one-worker in-process cluster; the sweep may not make a cluster of its own."""
+    """A client of a one-worker in-process cluster of two threads (runs in one process take
+    turns: two NetCDF writers at once crash HDF5); the sweep may not make a cluster of its own."""
     distributed = pytest.importorskip("distributed")
     with (
-        distributed.LocalCluster(n_workers=1, processes=False, dashboard_address=":0") as cluster,
+        distributed.LocalCluster(
+            n_workers=1, threads_per_worker=2, processes=False, dashboard_address=":0"
+        ) as cluster,
         distributed.Client(cluster) as caller,
     ):
 

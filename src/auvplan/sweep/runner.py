@@ -113,6 +113,13 @@ class SweepProgress:
     record: RunRecord | None = None
 
 
+#: One run at a time per process. Runs given to the threads of one worker (a threaded
+#: ``LocalCluster(processes=False)`` client) would write NetCDF through HDF5 at once, which
+#: is not thread-safe (a segmentation fault), and share the process's warning and log capture
+#: and peak-memory counter; they take turns instead (reentrant: a run evaluates its plan).
+_ONE_RUN_AT_A_TIME: Final = threading.RLock()
+
+
 def run_folder(directory: Path, run: SweepRun) -> Path:
     """``directory/runs/<run-id>``: where ``run`` writes its output."""
     return directory / RUNS_FOLDER / run.run_id
@@ -244,8 +251,15 @@ def execute_run(run: SweepRun, folder: Path, options: RunOptions) -> RunRecord:
 
     Every exception becomes a failed :class:`RunRecord` (status: the exception's class, reason:
     its one-line message; an exception that is not an :class:`~auvplan.errors.AuvplanError` is
-    a bug and its reason says where it was raised), so one run never ends the sweep.
+    a bug and its reason says where it was raised), so one run never ends the sweep. Runs in
+    the threads of one process take turns (:data:`_ONE_RUN_AT_A_TIME`).
     """
+    with _ONE_RUN_AT_A_TIME:
+        return _plan_run(run, folder, options)
+
+
+def _plan_run(run: SweepRun, folder: Path, options: RunOptions) -> RunRecord:
+    """:func:`execute_run`'s work, with the process to itself."""
     from auvplan.io.output import staged_output_dir
     from auvplan.io.results import write_json
     from auvplan.mission.config import parse_mission
@@ -286,6 +300,12 @@ def execute_shared(plan: RunRecord, run: SweepRun, folder: Path, options: RunOpt
     without a folder gives ``run`` the same status and reason. Other failures are records,
     as in :func:`execute_run`.
     """
+    with _ONE_RUN_AT_A_TIME:
+        return _share_plan(plan, run, folder, options)
+
+
+def _share_plan(plan: RunRecord, run: SweepRun, folder: Path, options: RunOptions) -> RunRecord:
+    """:func:`execute_shared`'s work, with the process to itself."""
     from auvplan.io.output import link_entries, staged_output_dir
     from auvplan.io.results import write_json
 
@@ -354,7 +374,8 @@ def execute_evaluation(
     if options is None or record.folder is None:
         return record
     try:
-        evaluate_run_folder(record.folder, _run_options(options, run))
+        with _ONE_RUN_AT_A_TIME:
+            evaluate_run_folder(record.folder, _run_options(options, run))
     except Exception as error:  # noqa: BLE001 (a failed evaluation is the row's note)
         return replace(record, navigation_error=_reason(error))
     return record
