@@ -16,12 +16,6 @@ there before (``closed[cell]`` keeps the lowest closed bin). A label is thus exp
 it is better in error than every cheaper label at its cell: at most ``n_bins`` per cell.
 After the settling distance a move whose predicted σ exceeds ``max_error`` is not made.
 
-In cost mode a new label is not even created when a label already queued at its cell has a
-lower or equal cost and a lower or equal bin: that label pops first (its key is lower or
-equal) and closes the cell at its bin, so the new one would be skipped when popped. Two
-queued labels per cell are kept for the comparison, the cheapest and the one of the lowest
-bin. This keeps the search's result (up to ties) and cuts the labels created and the heap.
-
 A move ``u → v`` of length ℓ [m] with the move factor ``f`` (e.g. the time ratio in a
 current) costs ``ℓ f (c_u + c_v) / 2 + λ ℓ (σ_u² + σ_v²) / 2`` and takes
 ``n = ℓ · updates_per_metre`` TAN updates: drift over ℓ, white variance ``n q`` and
@@ -172,11 +166,6 @@ def belief_search(
     """
     offsets, crossed, length = moves(width, spacing_north, spacing_east, n_moves)
     closed = np.full(cost.shape[0], n_bins, np.int32)
-    # queued references per cell (cost mode): the cheapest label and the lowest-bin label
-    cheapest_g = np.full(cost.shape[0] if not bottleneck else 0, np.inf)
-    cheapest_bin = np.full(cheapest_g.shape[0], n_bins, np.int32)
-    lowest_bin = np.full(cheapest_g.shape[0], n_bins, np.int32)
-    lowest_g = np.full(cheapest_g.shape[0], np.inf)
     capacity = 1024
     table = np.empty((capacity, 7))
     cells = np.empty(capacity, np.int64)
@@ -241,15 +230,6 @@ def belief_search(
                 peak = max(peak, sigma_v)
             g = row[_G] + ell * move * 0.5 * (cost[u] + c_v)
             g += error_weight * ell * 0.5 * (sigma_u * sigma_u + sigma_v * sigma_v)
-            if not bottleneck:
-                if (g >= cheapest_g[v] and bin_v >= cheapest_bin[v]) or (
-                    bin_v >= lowest_bin[v] and g >= lowest_g[v]
-                ):
-                    continue
-                if g < cheapest_g[v]:
-                    cheapest_g[v], cheapest_bin[v] = g, bin_v
-                if bin_v < lowest_bin[v] or (bin_v == lowest_bin[v] and g < lowest_g[v]):
-                    lowest_bin[v], lowest_g[v] = bin_v, g
             if n_labels == max_labels:
                 return TOO_MANY_LABELS, np.empty(0, np.int64), np.empty(0), 0.0, 0.0, n_labels
             if n_labels == table.shape[0]:
