@@ -141,14 +141,15 @@ def _level_depths(
     names = [n for n in _S_NAMES if n in dataset.variables and dataset[n].dims == (s_dim,)]
     if s_dim is None or not names or not all(n in dataset.variables for n in ("Cs_r", "h", "hc")):
         return None
-    s = np.asarray(dataset[names[0]].values, dtype=np.float64)[:, None, None]
-    stretching = np.asarray(dataset["Cs_r"].values, dtype=np.float64)[:, None, None]
-    h = np.asarray(dataset["h"].values, dtype=np.float64)[interior][None]
-    hc = float(dataset["hc"].values)
+    s = finite_values(dataset, names[0])[:, None, None]
+    stretching = finite_values(dataset, "Cs_r")[:, None, None]
+    h = finite_values(dataset, "h")[interior][None]
+    hc = float(finite_values(dataset, "hc"))
     if "Vtransform" in dataset.variables:
         transform = int(dataset["Vtransform"].values)
     else:
         transform = 2 if str(dataset.attrs.get("VertCoordType", "")).upper() == "NEW" else 1
-    if transform == 2:
-        return -h * (hc * s + h * stretching) / (hc + h)
-    return -(hc * s + (h - hc) * stretching)
+    with np.errstate(divide="ignore", invalid="ignore"):  # a zero h + hc: non-finite depths,
+        if transform == 2:  # which at_depth refuses in one line
+            return -h * (hc * s + h * stretching) / (hc + h)
+        return -(hc * s + (h - hc) * stretching)
