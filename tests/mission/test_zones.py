@@ -19,7 +19,6 @@ from typing import Any
 import numpy as np
 import pytest
 import shapely
-import xarray as xr
 from pyproj import Transformer
 from shapely.geometry import LineString, Polygon, mapping
 
@@ -30,6 +29,7 @@ from auvplan.mission.config import AREA_NAME, parse_mission
 from auvplan.record.labels import Pair
 from auvplan.scenarios import check
 from auvplan.terrain import LocalProjection
+from export._plans import write_geographic_grid
 
 SAFETY_RADIUS = 5.0
 #: Zones and areas as local ``[north, east]`` [m] rings on the 500 m grid of ``write_grid``.
@@ -39,19 +39,8 @@ CORRIDOR = np.array([[30.0, 170.0], [30.0, 330.0], [290.0, 330.0], [290.0, 170.0
 
 
 def write_grid(path: Path) -> LocalProjection:
-    """A 500 m x 500 m lat/lon grid (about 5 m cells), depths 20-40 m; its local frame."""
-    lat = np.linspace(36.790, 36.7945, 91)
-    lon = np.linspace(-121.815, -121.8094, 101)
-    north = (lat[:, None] - lat[0]) * 111_000.0
-    east = (lon[None, :] - lon[0]) * 89_000.0
-    elevation = -(30.0 + 10.0 * np.sin(north / 40.0) * np.cos(east / 55.0))
-    xr.Dataset(
-        {"elevation": (("lat", "lon"), elevation, {"units": "m"})},
-        coords={
-            "lat": ("lat", lat, {"units": "degrees_north"}),
-            "lon": ("lon", lon, {"units": "degrees_east"}),
-        },
-    ).to_netcdf(path)
+    """The exports' 500 m x 500 m lat/lon grid (depths 20-40 m) at ``path``; its local frame."""
+    write_geographic_grid(path)
     projection = read_bathymetry(path).projection
     assert projection is not None
     return projection
