@@ -163,7 +163,9 @@ def run_deconfliction(
     slowest = np.array([minimum_useful_speed(model) for model in layout.models])
     cruise = None
     if current is not None:
-        limits, slowest, cruise = speeds_in_current(fleet, names, paths, limits, slowest, current)
+        limits, slowest, cruise = speeds_in_current(
+            fleet, names, paths, lengths, (limits, slowest), current
+        )
     speeds, horizon = _nominal_speeds(fleet, lengths, limits, names, cruise)
     accelerations = np.array([max_surge_acceleration(model) for model in layout.models])
     for _attempt in range(HORIZON_ATTEMPTS):
@@ -217,8 +219,8 @@ def speeds_in_current(
     fleet: FleetConfig,
     names: tuple[str, ...],
     paths: tuple[FloatArray, ...],
-    fastest: FloatArray,
-    slowest: FloatArray,
+    lengths: FloatArray,
+    through_water: tuple[FloatArray, FloatArray],
     current: CurrentField,
 ) -> tuple[FloatArray, FloatArray, FloatArray | None]:
     """Ground-speed limits, and cruise ground speeds, in a current that changes in time.
@@ -228,11 +230,12 @@ def speeds_in_current(
     ``fleet.cruise_speed`` the vehicle passes at that speed through the water
     (:func:`~auvplan.mission.current.mean_ground_speed`) or, where that is above the limit, at
     the limit, so limits and speeds are iterated (:data:`LIMIT_ROUNDS`) until they agree to
-    0.1 %. Returns the upper and lower limits [m/s] of :func:`ground_speed_limits` and the
-    cruise ground speeds (None with a fixed horizon).
+    0.1 %. ``lengths`` [m] are the paths' lengths, ``through_water`` the fastest and slowest
+    speeds [m/s] through the water. Returns the upper and lower limits [m/s] of
+    :func:`ground_speed_limits` and the cruise ground speeds (None with a fixed horizon).
     """
+    fastest, slowest = through_water
     if fleet.horizon is not None:
-        lengths = np.array([path_length(path) for path in paths])
         return (
             *ground_speed_limits(names, paths, fastest, slowest, current, lengths / fleet.horizon),
             None,
