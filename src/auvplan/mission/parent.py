@@ -2,9 +2,13 @@
 
 A plan made in this session (:func:`parent_from_result`) holds them already. A plan read from
 its output folder (:func:`parent_from_record`) has its mission (``mission.toml``, every
-default filled in) planned again up to stage 2, which gives the same maps, paths and time laws
-as its own run; the maps, the pre-planned paths and the time grid are checked against the
-folder's, so a terrain file that changed since is refused rather than replanned on.
+default filled in) pre-planned again (stage 1), which gives the same maps and paths as its own
+run, and its stage-2 schedule read from ``summary.json`` (:func:`recorded_deconfliction`: the
+time laws, their speeds and the schedule's outcome as written, the desired states sampled from
+them as stage 2 samples them); a folder whose ``summary.json`` does not hold the laws' speeds
+(written before they were) has stage 2 planned again. The maps, the pre-planned paths, the
+time laws' path lengths and the time grid are checked against the folder's, so a terrain file
+that changed since is refused rather than replanned on.
 """
 
 from __future__ import annotations
@@ -16,14 +20,28 @@ from pathlib import Path
 import numpy as np
 
 from auvplan._typing import FloatArray
+from auvplan.deconfliction import (
+    CoordinationResult,
+    CoordinationStatus,
+    DeconflictionMethod,
+    SeparationCertificate,
+)
 from auvplan.errors import DataFormatError, InputError
 from auvplan.mission.config import MissionConfig, parse_mission
+from auvplan.mission.fleet import FleetLayout
 from auvplan.mission.pipeline import MissionResult, fleet_layout, timed_stage
 from auvplan.mission.preplan import PreplanStage, run_preplan
 from auvplan.mission.progress import ProgressReporter, no_progress, with_checkpoints
-from auvplan.mission.timing import DeconflictStage, run_deconfliction
+from auvplan.mission.timing import (
+    DeconflictStage,
+    coordination_problem,
+    run_deconfliction,
+    sampled_stage,
+    speed_range,
+)
+from auvplan.planning import path_length
 from auvplan.record import PlanRecord
-from auvplan.record.files import MAIN_PLAN, MISSION_FILE, PLAN_FILES
+from auvplan.record.files import MAIN_PLAN, MISSION_FILE, PLAN_FILES, SUMMARY_FILE
 from auvplan.terrain import TerrainMaps
 
 #: The terrain maps compared by :func:`same_maps` (besides the depth).
@@ -122,7 +140,8 @@ def parent_from_record(
     layout = fleet_layout(config)
     stage2 = timed_stage(
         progress, timings, "deconflict",
-        lambda: run_deconfliction(
+        lambda: recorded_deconfliction(record, config, layout, preplan, where=where)
+        or run_deconfliction(
             layout, preplan.paths, preplan.starts[:, 2], preplan.goals[:, 2], fleet=config.fleet,
             settings=config.deconfliction, dt=config.solver.dt, current=preplan.current,
         ),
@@ -145,6 +164,80 @@ def parent_from_record(
         tuple(table.inputs for table in tables), folder,
         (record.summary.digest or {}).get(PLAN_FILES[MAIN_PLAN].csv), _final_delta(record),
         timings,
+    )  # fmt: skip
+
+
+def recorded_deconfliction(
+    record: PlanRecord,
+    config: MissionConfig,
+    layout: FleetLayout,
+    preplan: PreplanStage,
+    *,
+    where: str,
+) -> DeconflictStage | None:
+    """Stage 2 of the plan of folder ``where`` as its ``summary.json`` records it.
+
+    The coordination problem is that of :func:`~auvplan.mission.timing.run_deconfliction`
+    on the paths ``preplan`` gives again at the recorded nominal speeds [m/s]; the schedule
+    (time grid [s], progress [m] and speeds [m/s] of each time law, arrival times and delays
+    [s], certificate, status, method, weight, message) is the one written, whose JSON
+    numbers read back to the same floats; the desired states are sampled from it on the
+    solver grid (:func:`~auvplan.mission.timing.sampled_stage`). None when the time laws
+    have no ``speed_m_s`` (a folder written before they had).
+
+    Raises
+    ------
+    DataFormatError
+        If the time laws do not have one sample per time, or do not end at the lengths of
+        the paths planned again.
+    """
+    document = record.summary.deconfliction
+    timings = [vehicle.timing or {} for vehicle in record.summary.vehicles]
+    if document is None or any("speed_m_s" not in t.get("time_law", {}) for t in timings):
+        return None
+    laws = [t["time_law"] for t in timings]
+    time = np.asarray(laws[0]["t_s"], dtype=np.float64)
+    lengths = np.array([path_length(path) for path in preplan.paths])
+    speeds = [law["speed_m_s"] for law in laws]
+    samples = {len(law["progress_m"]) for law in laws} | {len(v) for v in speeds if v is not None}
+    stale = DataFormatError(
+        f"{where}/{SUMMARY_FILE}: its time laws are not those of the paths its mission gives "
+        "now: plan the mission again"
+    )
+    if time.size < 2 or samples != {time.size} or len({v is None for v in speeds}) != 1:
+        raise stale
+    progress = np.array([law["progress_m"] for law in laws], dtype=np.float64)
+    if not np.allclose(progress[:, -1], lengths, rtol=1e-9, atol=1e-9):
+        raise stale
+    _, slowest, _ = speed_range(
+        layout, preplan.paths, lengths, fleet=config.fleet, current=preplan.current
+    )
+    nominal = np.array([t["nominal_speed_m_s"] for t in timings], dtype=np.float64)
+    problem = coordination_problem(
+        layout, preplan.paths, nominal, slowest, fleet=config.fleet,
+        settings=config.deconfliction,
+    )  # fmt: skip
+    certificate = document["certificate"]
+    coordination = CoordinationResult(
+        status=CoordinationStatus[document["status"]],
+        message=document["message"],
+        method=DeconflictionMethod(document["method"]),
+        weight=math.nan if document["weight"] is None else float(document["weight"]),
+        time=time,
+        progress=progress,
+        arrival_times=np.array([t["arrival_time_s"] for t in timings], dtype=np.float64),
+        delays=np.array([t["delay_s"] for t in timings], dtype=np.float64),
+        certificate=SeparationCertificate(**{**certificate, "pair": tuple(certificate["pair"])}),
+        n_expanded=int(document["n_expanded"]),
+        objective=(float(document["objective"][0]), float(document["objective"][1])),
+        fallback=document["fallback"],
+        speeds=None if speeds[0] is None else np.array(speeds, dtype=np.float64),
+        within_limits=tuple(document["within_speed_limits"]),
+    )
+    ends = (preplan.starts[:, 2], preplan.goals[:, 2])
+    return sampled_stage(
+        layout, problem, coordination, float(document["horizon_s"]), config.solver.dt, ends,
+        preplan.current,
     )  # fmt: skip
 
 
@@ -177,5 +270,6 @@ __all__ = [
     "parent_from_record",
     "parent_from_result",
     "record_mission",
+    "recorded_deconfliction",
     "same_maps",
 ]

@@ -329,6 +329,7 @@ def mission_summary(
             "objective": coordination.objective,
             "n_expanded": coordination.n_expanded,
             "method": str(coordination.method),
+            "weight": coordination.weight,
             "fallback": coordination.fallback,
             "within_speed_limits": list(coordination.within_limits),
             "certified_min_separation_m": coordination.certificate.min_separation,
@@ -340,7 +341,11 @@ def mission_summary(
                 "nominal_speed_m_s": stage2.cruise_speeds[i],
                 "arrival_time_s": coordination.arrival_times[i],
                 "delay_s": coordination.delays[i],
-                "time_law": {"t_s": coordination.time, "progress_m": coordination.progress[i]},
+                "time_law": {
+                    "t_s": coordination.time,
+                    "progress_m": coordination.progress[i],
+                    "speed_m_s": None if coordination.speeds is None else coordination.speeds[i],
+                },
             }
             vehicle.update(
                 type_name=model.vehicle.name,

@@ -159,24 +159,11 @@ def run_deconfliction(
     """
     names = layout.names
     lengths = np.array([path_length(path) for path in paths])
-    limits = np.array([SPEED_MARGIN * top_speed(model) for model in layout.models])
-    slowest = np.array([minimum_useful_speed(model) for model in layout.models])
-    cruise = None
-    if current is not None:
-        limits, slowest, cruise = speeds_in_current(
-            fleet, names, paths, lengths, (limits, slowest), current
-        )
+    limits, slowest, cruise = speed_range(layout, paths, lengths, fleet=fleet, current=current)
     speeds, horizon = _nominal_speeds(fleet, lengths, limits, names, cruise)
-    accelerations = np.array([max_surge_acceleration(model) for model in layout.models])
     for _attempt in range(HORIZON_ATTEMPTS):
-        problem = CoordinationProblem(
-            paths=paths,
-            safety_radius=fleet.safety_radius,
-            cruise_speeds=speeds,
-            time_step=settings.time_step,
-            names=names,
-            min_speeds=np.minimum(slowest, speeds),
-            max_accelerations=accelerations,
+        problem = coordination_problem(
+            layout, paths, speeds, slowest, fleet=fleet, settings=settings
         )
         coordination = deconflict(
             problem,
@@ -198,11 +185,10 @@ def run_deconfliction(
             )
     else:
         raise InfeasibleError(f"horizon_s = {horizon:g} s is too short after deconfliction")
-    n_steps = solver_steps(horizon, dt)
+    solver_steps(horizon, dt)  # refused before the retiming when dt does not divide it
     coordination = retime_for_arrival(coordination, problem, horizon)
-    time = dt * np.arange(n_steps + 1, dtype=np.float64)
-    desired = desired_states(
-        layout, problem, coordination, time, (start_headings, goal_headings), current
+    stage = sampled_stage(
+        layout, problem, coordination, horizon, dt, (start_headings, goal_headings), current
     )
     logger.info(
         "deconfliction (%s%s): horizon %.1f s, delays %s s, min separation %.2f m",
@@ -212,7 +198,76 @@ def run_deconfliction(
         ", ".join(f"{delay:.1f}" for delay in np.round(coordination.delays, 1) + 0.0),  # no -0.0
         coordination.certificate.min_separation,
     )
-    return DeconflictStage(layout, horizon, dt, speeds, problem, coordination, time, desired)
+    return stage
+
+
+def speed_range(
+    layout: FleetLayout,
+    paths: tuple[FloatArray, ...],
+    lengths: FloatArray,
+    *,
+    fleet: FleetConfig,
+    current: CurrentField | None,
+) -> tuple[FloatArray, FloatArray, FloatArray | None]:
+    """Each vehicle's speed limit and slowest useful speed [m/s] on its path, and cruise speed.
+
+    In still water the limit is :data:`SPEED_MARGIN` times the top speed and the slowest
+    speed :func:`~auvplan.vehicle.minimum_useful_speed`, and there is no cruise ground speed
+    (None); in a current they are ground speeds along the paths of lengths ``lengths`` [m]
+    (:func:`speeds_in_current`).
+    """
+    limits = np.array([SPEED_MARGIN * top_speed(model) for model in layout.models])
+    slowest = np.array([minimum_useful_speed(model) for model in layout.models])
+    if current is None:
+        return limits, slowest, None
+    return speeds_in_current(fleet, layout.names, paths, lengths, (limits, slowest), current)
+
+
+def coordination_problem(
+    layout: FleetLayout,
+    paths: tuple[FloatArray, ...],
+    speeds: FloatArray,
+    slowest: FloatArray,
+    *,
+    fleet: FleetConfig,
+    settings: DeconflictionConfig,
+) -> CoordinationProblem:
+    """Stage 2's coordination problem: ``paths`` flown at nominal ``speeds`` [m/s].
+
+    The minimum speeds are ``min(slowest, speeds)`` [m/s] (``slowest`` of
+    :func:`speed_range`), the acceleration bounds the vehicles' surge accelerations [m/s²]
+    (:func:`~auvplan.vehicle.max_surge_acceleration`).
+    """
+    return CoordinationProblem(
+        paths=paths,
+        safety_radius=fleet.safety_radius,
+        cruise_speeds=speeds,
+        time_step=settings.time_step,
+        names=layout.names,
+        min_speeds=np.minimum(slowest, speeds),
+        max_accelerations=np.array([max_surge_acceleration(model) for model in layout.models]),
+    )
+
+
+def sampled_stage(
+    layout: FleetLayout,
+    problem: CoordinationProblem,
+    coordination: CoordinationResult,
+    horizon: float,
+    dt: float,
+    end_headings: tuple[FloatArray, FloatArray],
+    current: CurrentField | None,
+) -> DeconflictStage:
+    """Stage 2 of a retimed schedule: its desired states on the solver grid ``k dt`` [s].
+
+    ``coordination`` arrives at ``horizon`` [s] (:func:`auvplan.deconfliction.
+    retime_for_arrival`); ``end_headings`` and ``current`` as for :func:`desired_states`.
+    """
+    time = dt * np.arange(solver_steps(horizon, dt) + 1, dtype=np.float64)
+    desired = desired_states(layout, problem, coordination, time, end_headings, current)
+    return DeconflictStage(
+        layout, horizon, dt, problem.cruise_speeds, problem, coordination, time, desired
+    )
 
 
 def speeds_in_current(
