@@ -32,6 +32,21 @@ from ._readers import cf_findings, checker_passes, checker_report, moos_points, 
 ALL = ",".join(FORMATS)
 
 
+def test_maps_netcdf_passes_the_cf_checker(planned_folder: Path, tmp_path: Path) -> None:
+    """Issue 25: ``compliance-checker --test cf:1.8 maps.nc`` exits 0 (no error, no warning)
+    for a plan on a georeferenced grid and for one on the synthetic bank (no grid mapping)."""
+    (tmp_path / "mission.toml").write_text(MISSION.replace('file = "grid.nc"', "synthetic = true"))
+    local = tmp_path / "local"
+    arguments = ["-q", "plan", str(tmp_path / "mission.toml"), "-o", str(local), "--no-figures"]
+    assert main([*arguments, "--stage", "preplan"]) == 0
+    for folder, georeferenced in ((planned_folder, True), (local, False)):
+        path = folder / "maps.nc"
+        assert checker_passes(path, tmp_path / "cf.json", "cf:1.8"), folder.name
+        assert cf_findings(path, tmp_path / "cf.json") == {"high": [], "medium": [], "low": []}
+        with xr.open_dataset(path) as dataset:
+            assert ("crs" in dataset.variables) == georeferenced
+
+
 def test_trajectories_netcdf_is_a_cf_trajectory_file(planned_folder: Path, tmp_path: Path) -> None:
     path = planned_folder / "trajectories.nc"
     # `compliance-checker --test cf:1.8` exits 0: no error and no warning

@@ -10,10 +10,13 @@ Layout:
   ``excitation``, ``cost`` and ``shifted_cost``;
 * when the grid is georeferenced: the grid mapping variable ``crs`` (the local frame's
   :attr:`~auvplan.terrain.projection.LocalProjection.crs`, written by rioxarray's
-  ``write_crs`` from :meth:`pyproj.CRS.to_cf`, with its WKT), referenced by every data
-  variable's ``grid_mapping``, and the 2-D auxiliary coordinates ``lat``/``lon`` and
-  ``lat_block``/``lon_block`` [deg, WGS 84], so GIS software (QGIS, GDAL, rioxarray) places
-  the maps;
+  ``write_crs`` from :meth:`pyproj.CRS.to_cf`, with its WKT) of the fine maps, the same
+  frame as ``crs_block`` of the block maps, and the 2-D auxiliary coordinates ``lat``/``lon``
+  and ``lat_block``/``lon_block`` [deg, WGS 84], so GIS software (QGIS, GDAL, rioxarray)
+  places the maps. The block axes then carry no ``axis``/``standard_name`` (see
+  :func:`_axes`): GDAL places the block maps by ``crs_block``'s ``GeoTransform``
+  (rioxarray's ``write_transform``), rioxarray once told their dimensions
+  (``.rio.set_spatial_dims("east_block", "north_block")``);
 * global attributes: the map parameters (``information_exponent``, ``block_north``,
   ``block_east``, ``omega``, ``weight``), the fine spacing, ``source``, ``Conventions``.
 
@@ -39,8 +42,13 @@ from auvplan.terrain.projection import LocalProjection
 if TYPE_CHECKING:
     import xarray as xr
 
-#: Name of the CF grid mapping variable of the local frame.
+#: Name of the CF grid mapping variable of the local frame (fine maps).
 GRID_MAPPING: Final = "crs"
+#: Name of the CF grid mapping variable of the block maps: the same frame, with the block
+#: grid's GDAL ``GeoTransform``.
+BLOCK_GRID_MAPPING: Final = "crs_block"
+#: The maps on the coarse (block) grid.
+_BLOCK_MAPS: Final = ("excitation", "cost", "shifted_cost")
 
 
 def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
@@ -65,12 +73,9 @@ def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
     parameters = maps.parameters
     projection = maps.bathymetry.projection
     coords = {
-        **_axes(fine, "", "of the map origin", has_standard_name=True),
+        **_axes(fine, "", "of the map origin", is_cf_axis=True),
         **_axes(
-            coarse,
-            "_block",
-            "of the map origin (block centre)",
-            has_standard_name=projection is None,
+            coarse, "_block", "of the map origin (block centre)", is_cf_axis=projection is None
         ),
     }
     fine_dims, coarse_dims = ("north", "east"), ("north_block", "east_block")
@@ -140,33 +145,38 @@ def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
     }
     for name in dataset.coords:  # CF: no _FillValue on coordinates
         encoding[str(name)]["_FillValue"] = None
-    if GRID_MAPPING in dataset.coords:
-        encoding[GRID_MAPPING]["dtype"] = "int32"  # CF 1.8 has no 64-bit integers
+    for name in (GRID_MAPPING, BLOCK_GRID_MAPPING):
+        if name in dataset.coords:
+            encoding[name]["dtype"] = "int32"  # CF 1.8 has no 64-bit integers
     with writing(Path(path)):
         dataset.to_netcdf(path, format="NETCDF4", engine="netcdf4", encoding=encoding)
     return path
 
 
 def _axes(
-    geometry: GridGeometry, suffix: str, where: str, *, has_standard_name: bool
+    geometry: GridGeometry, suffix: str, where: str, *, is_cf_axis: bool
 ) -> dict[str, xr.Variable]:
-    """The CF coordinate variables ``north<suffix>``, ``east<suffix>`` [m] of a grid.
+    """The coordinate variables ``north<suffix>``, ``east<suffix>`` [m] of a grid.
 
-    With a grid mapping, CF checkers (IOOS) accept a single variable per standard name
-    ``projection_x/y_coordinate``, so only the fine grid's axes carry one then. Every axis
-    keeps ``axis`` X/Y: without it (or the standard name) GDAL gives the block maps an
-    identity geotransform and rioxarray finds no x/y dimension. The IOOS checker (6.1) takes
-    an ``axis`` Y/X variable without a projection standard name for latitude/longitude and
-    warns that ``north_block``/``east_block`` lack degree units (2 warnings, georeferenced
-    maps only): CF itself allows both (ioos/compliance-checker#691).
+    A CF axis (``is_cf_axis``) also carries ``axis`` Y/X and the standard name
+    ``projection_y/x_coordinate``, by which GDAL and rioxarray find the grid's position.
+    With a grid mapping only the fine grid's axes are CF axes: the IOOS compliance checker
+    (6.1) accepts a single variable per standard name ``projection_x/y_coordinate``
+    (ioos/compliance-checker#691, although CF 1.8 allows several) and takes an ``axis`` Y/X
+    variable without one for latitude/longitude, so the block axes are then plain
+    coordinate variables (``units``, ``long_name``) and the block maps are placed by their
+    own grid mapping ``crs_block`` (:func:`_georeference`).
     """
     import xarray as xr
 
     variables = {}
     for axis, cf_axis, values in (("north", "Y", geometry.north), ("east", "X", geometry.east)):
-        attributes = {"units": "m", "long_name": f"distance {axis} {where}", "axis": cf_axis}
-        if has_standard_name:
-            attributes["standard_name"] = f"projection_{cf_axis.lower()}_coordinate"
+        attributes = {"units": "m", "long_name": f"distance {axis} {where}"}
+        if is_cf_axis:
+            attributes |= {
+                "axis": cf_axis,
+                "standard_name": f"projection_{cf_axis.lower()}_coordinate",
+            }
         variables[f"{axis}{suffix}"] = xr.Variable((f"{axis}{suffix}",), values, attributes)
     return variables
 
@@ -174,9 +184,16 @@ def _axes(
 def _georeference(
     dataset: xr.Dataset, projection: LocalProjection, fine: GridGeometry, coarse: GridGeometry
 ) -> xr.Dataset:
-    """Add the grid mapping variable ``crs`` and 2-D ``lat``/``lon`` auxiliary coordinates."""
+    """Add the grid mapping variables and the 2-D ``lat``/``lon`` auxiliary coordinates.
+
+    ``crs`` (the local frame) is the grid mapping of the fine maps; ``crs_block``, the same
+    frame with the GDAL ``GeoTransform`` of the block grid (west and south cell edges,
+    spacings > 0: rows run south to north as stored), that of the block maps, whose axes
+    are not CF axes (:func:`_axes`).
+    """
     import rioxarray  # noqa: F401  (registers the .rio accessor)
     import xarray as xr
+    from affine import Affine
 
     for geometry, suffix in ((fine, ""), (coarse, "_block")):
         north, east = np.meshgrid(geometry.north, geometry.east, indexing="ij")
@@ -192,10 +209,27 @@ def _georeference(
                 ),
             }
         )
+    # rioxarray sets a grid_mapping on the variables whose x/y dimensions it finds: the
+    # fine maps here, the block maps once their dimensions are named.
     georeferenced: xr.Dataset = dataset.rio.write_crs(
         projection.crs, grid_mapping_name=GRID_MAPPING
     )
-    return georeferenced
+    # x = west + spacing_east * column, y = south + spacing_north * row
+    south_up = Affine(
+        coarse.spacing_east,
+        0.0,
+        coarse.east_bounds[0],
+        0.0,
+        coarse.spacing_north,
+        coarse.north_bounds[0],
+    )
+    blocks: xr.Dataset = (
+        georeferenced[list(_BLOCK_MAPS)]
+        .rio.set_spatial_dims(x_dim="east_block", y_dim="north_block")
+        .rio.write_crs(projection.crs, grid_mapping_name=BLOCK_GRID_MAPPING)
+        .rio.write_transform(south_up, grid_mapping_name=BLOCK_GRID_MAPPING)
+    )
+    return georeferenced.assign(blocks.data_vars)
 
 
 def read_maps_netcdf(path: str | Path) -> TerrainMaps:
