@@ -192,16 +192,18 @@ def _vehicle_table(
         )
     index = {name: header.index(name) for name in own}
     others = [k for k, name in enumerate(header) if k and name not in index]
-    table = np.empty((len(rows), len(own)))
-    for i, (line, row) in enumerate(rows):
-        for j, name in enumerate(own):
-            table[i, j] = _number(row[index[name]], f"{path} line {line}", vehicle.name, name)
-        filled = next((k for k in others if row[k].strip()), None)
-        if filled is not None:
-            raise DataFormatError(
-                f"{path} line {line}: vehicle {vehicle.name!r} has no state "
-                f"{header[filled]!r}, but the cell holds {row[filled]!r}"
-            )
+    table = _finite_table(rows, list(index.values()))
+    if table is None or others:  # a fault: the first one, line by line, named
+        for line, row in rows:
+            for name, k in index.items() if table is None else ():
+                _number(row[k], f"{path} line {line}", vehicle.name, name)
+            filled = next((k for k in others if row[k].strip()), None)
+            if filled is not None:
+                raise DataFormatError(
+                    f"{path} line {line}: vehicle {vehicle.name!r} has no state "
+                    f"{header[filled]!r}, but the cell holds {row[filled]!r}"
+                )
+    assert table is not None  # else a cell that is not a finite number was named above
     if profile and profile != PROFILE_COLUMNS:
         raise DataFormatError(f"{path}: {profile[0]!r} without {PROFILE_COLUMNS}")
     n_x, n_p = len(state_names), len(profile)
@@ -275,6 +277,19 @@ def _own_columns(
         tuple(name for name in filled if not name.startswith("c_")),
         tuple(name for name in filled if name.startswith("c_")),
     )
+
+
+def _finite_table(rows: list[tuple[int, list[str]]], columns: list[int]) -> FloatArray | None:
+    """The cells ``columns`` of ``rows`` as floats, shape ``(n_rows, n_columns)``.
+
+    None when a cell is not a number (``float`` refuses it) or not finite: :func:`_number`
+    then names the first such cell.
+    """
+    try:
+        table = np.array([[float(row[k]) for k in columns] for _, row in rows], dtype=np.float64)
+    except ValueError:
+        return None
+    return table if np.all(np.isfinite(table)) else None
 
 
 def _number(text: str, where: str, vehicle: str, column: str) -> float:
