@@ -65,3 +65,46 @@ def test_regulator_per_subsystem_equals_the_whole(rng: np.random.Generator, coup
     np.testing.assert_allclose(parts, whole, rtol=1e-10, atol=1e-12)
     if not coupled:
         assert np.all(parts[:, 0, 3:] == 0.0)  # subsystem 0's input ignores the others
+
+
+def test_lq_sweep_by_components_equals_the_dense_sweep(rng: np.random.Generator) -> None:
+    """Weights block-diagonal but for subsystems 0 and 1 coupled at stage 25 (a near pass)."""
+    a, b = _block_diagonal_dynamics(rng)
+    w = np.zeros((N, N_X + N_U, N_X + N_U))
+    for group in _groups():
+        z = rng.normal(size=(N, group.size, group.size))
+        w[:, group[:, None], group] = z @ np.swapaxes(z, 1, 2) + np.eye(group.size)
+    coupled = np.r_[_groups()[0], _groups()[1]]
+    z = rng.normal(size=(coupled.size, coupled.size))
+    w[25, coupled[:, None], coupled] += z @ z.T
+    q, s, r = w[:, :N_X, :N_X].copy(), w[:, :N_X, N_X:].copy(), w[:, N_X:, N_X:].copy()
+    l_x, l_u = rng.normal(size=(N, N_X)), rng.normal(size=(N, N_U))
+    p_final, m_x = np.diag(rng.uniform(1.0, 2.0, N_X)), rng.normal(size=N_X)
+    args = (a, b, q, s, r, l_x, l_u, p_final, m_x)
+    dense = _kernels.lq_backward(*args, np.array([[0, N_X]]), np.array([[0, N_U]]))
+    parts = _kernels.lq_backward(*args, *block_ranges(_groups(), N_X, N_U))
+    assert dense[2] == parts[2] == -1
+    np.testing.assert_allclose(parts[0], dense[0], rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(parts[1], dense[1], rtol=1e-10, atol=1e-12)
+    # subsystems 0 and 1 are coupled up to the near pass, independent after it; 2 never
+    inputs_0, states_1, states_2 = slice(0, 1), slice(3, 8), slice(8, 12)
+    assert np.all(np.abs(dense[0][:26, inputs_0, states_1]) > 0.0)
+    assert np.all(dense[0][26:, inputs_0, states_1] == 0.0)
+    assert np.all(dense[0][:, inputs_0, states_2] == 0.0)
+
+
+def test_regulator_on_replaced_stages_equals_the_regulator_on_the_edited_linearisation(
+    rng: np.random.Generator,
+) -> None:
+    a, b = _block_diagonal_dynamics(rng)
+    other_a, other_b = _block_diagonal_dynamics(rng)
+    stages = np.array([3, 17, N - 1])
+    edited_a, edited_b = a.copy(), b.copy()
+    edited_a[stages], edited_b[stages] = other_a[stages], other_b[stages]
+    q_r, r_r = np.diag(rng.uniform(0.5, 2.0, N_X)), np.diag(rng.uniform(0.5, 2.0, N_U))
+    blocks = block_ranges(_groups(), N_X, N_U)
+    expected = design_regulator(edited_a, edited_b, q_r, r_r, blocks=blocks)
+    replaced = (stages, other_a[stages], other_b[stages])
+    given = design_regulator(a, b, q_r, r_r, blocks=blocks, replaced=replaced)
+    np.testing.assert_allclose(given, expected, rtol=1e-12, atol=1e-14)
+    assert not np.allclose(given, design_regulator(a, b, q_r, r_r, blocks=blocks))

@@ -176,26 +176,44 @@ def test_constraint_and_terminal_derivatives(points: tuple[np.ndarray, ...]) -> 
     _, _, c = _model_functions()
     cons = discretize_constraints((c,), 3, 2, 2)
     X, U, P, _ = points
-    values, c_x, c_u = cons.jacobians(X, U, P)
+    values, jacobians = cons.jacobians(X, U, P)
     np.testing.assert_allclose(values, cons.values(X, U, P))
+    # row j of the Jacobian is the weighted sum with weights e_j
+    rows = [jacobians.weighted_sum(np.tile(e, (N_STAGES, 1))) for e in np.eye(2)]
+    gradients = np.stack(rows, axis=1)  # (N, n_c, n_x + n_u)
     np.testing.assert_allclose(
-        c_x,
+        gradients[:, :, :3],
         np.stack(_fd_columns(lambda Z: cons.values(Z, U, P), X, 3), axis=2),
         rtol=1e-7,
         atol=1e-8,
     )
     np.testing.assert_allclose(
-        c_u,
+        gradients[:, :, 3:],
         np.stack(_fd_columns(lambda Z: cons.values(X, Z, P), U, 2), axis=2),
         rtol=1e-7,
         atol=1e-8,
     )
     w = np.linspace(-1, 2, N_STAGES * 2).reshape(N_STAGES, 2)
-    h_xx, _, h_uu = cons.weighted_hessians(X, U, P, w)
-    fd_xx = _fd_columns(lambda Z: np.einsum("kj,kji->ki", w, cons.jacobians(Z, U, P)[1]), X, 3)
-    fd_uu = _fd_columns(lambda Z: np.einsum("kj,kji->ki", w, cons.jacobians(X, Z, P)[2]), U, 2)
+    h_xx, h_xu, h_uu = (
+        np.zeros((N_STAGES, 3, 3)),
+        np.zeros((N_STAGES, 3, 2)),
+        np.zeros((N_STAGES, 2, 2)),
+    )
+    cons.add_weighted_hessians(X, U, P, w, (h_xx, h_xu, h_uu))
+    fd_xx = _fd_columns(lambda Z: cons.jacobians(Z, U, P)[1].weighted_sum(w)[:, :3], X, 3)
+    fd_xu = _fd_columns(lambda Z: cons.jacobians(X, Z, P)[1].weighted_sum(w)[:, :3], U, 2)
+    fd_uu = _fd_columns(lambda Z: cons.jacobians(X, Z, P)[1].weighted_sum(w)[:, 3:], U, 2)
     np.testing.assert_allclose(h_xx, np.stack(fd_xx, axis=2), rtol=1e-6, atol=1e-7)
+    np.testing.assert_allclose(h_xu, np.stack(fd_xu, axis=2), rtol=1e-6, atol=1e-7)
     np.testing.assert_allclose(h_uu, np.stack(fd_uu, axis=2), rtol=1e-6, atol=1e-7)
+    # the Gauss-Newton part Σ_j w_j ∇c_j ∇c_jᵀ from the nonzeros equals the dense outer products
+    outer = (np.zeros((N_STAGES, 3, 3)), np.zeros((N_STAGES, 3, 2)), np.zeros((N_STAGES, 2, 2)))
+    jacobians.add_outer_products(w, outer)
+    dense = np.einsum("kj,kja,kjb->kab", w, gradients, gradients)
+    for block, expected in zip(
+        outer, (dense[:, :3, :3], dense[:, :3, 3:], dense[:, 3:, 3:]), strict=True
+    ):
+        np.testing.assert_allclose(block, expected, rtol=1e-12, atol=1e-12)
     x = ca.SX.sym("x", 3)
     terminal = make_terminal_cost(ca.Function("m", [x], [ca.exp(x[0]) * x[1] + x[2] ** 3]), 3)
     point = X[0]

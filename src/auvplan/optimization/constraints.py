@@ -21,9 +21,45 @@ from auvplan.optimization._casadi import (
     with_symbol_fallback,
 )
 
-__all__ = ["ConstraintModel", "discretize_constraints"]
+__all__ = ["ConstraintModel", "SparseJacobians", "discretize_constraints"]
 
 _ARGS = ["x", "u", "p"]
+
+
+@dataclass(frozen=True, eq=False)
+class SparseJacobians:
+    """Constraint Jacobians ``∂c/∂(x, u)`` at ``N`` points, kept as their structural nonzeros.
+
+    A fleet's separations touch four states each, so the dense ``(N, n_c, n_x + n_u)`` array
+    would be almost all zeros and grow with the cube of the fleet. Row ``j``'s nonzeros
+    are ``values[:, row_start[j]:row_start[j + 1]]`` at the columns
+    ``columns[row_start[j]:row_start[j + 1]]`` of ``z = (x, u)`` (compressed rows).
+    """
+
+    values: FloatArray
+    """Nonzeros, shape ``(N, nnz)``, in compressed-row order."""
+    row_start: IntArray = field(repr=False)
+    columns: IntArray = field(repr=False)
+    n_z: int
+    """Size of ``z = (x, u)``."""
+
+    def __getitem__(self, points: slice) -> SparseJacobians:
+        """The Jacobians at a slice of the points."""
+        return SparseJacobians(self.values[points], self.row_start, self.columns, self.n_z)
+
+    def weighted_sum(self, weights: FloatArray) -> FloatArray:
+        """``Σ_j w_{k,j} ∇c_j(z_k)``, shape ``(N, n_z)``; ``weights`` has shape ``(N, n_c)``."""
+        return _weighted_rows(weights, self.values, self.row_start, self.columns, self.n_z)
+
+    def add_outer_products(
+        self, weights: FloatArray, blocks: tuple[FloatArray, FloatArray, FloatArray]
+    ) -> None:
+        """Add ``Σ_j w_{k,j} ∇c_j ∇c_jᵀ`` to the blocks ``(H_xx, H_xu, H_uu)`` in place.
+
+        Only the structural nonzeros of each gradient are visited (a separation touches four
+        states of a fleet), so the cost does not grow with ``n_x²``.
+        """
+        _add_outer_products(weights, self.values, self.row_start, self.columns, *blocks)
 
 
 @dataclass(frozen=True, eq=False)
@@ -40,11 +76,9 @@ class ConstraintModel:
     n_c: int
     function: ca.Function
     _jacobians: ca.Function = field(repr=False)
-    """``(c, nonzeros of ∂c/∂(x, u))`` at one stage."""
+    """``(c, nonzeros of ∂c/∂(x, u) in compressed-row order)`` at one stage."""
     _hessian: ca.Function = field(repr=False)
     """Nonzeros of ``∇²_{(x, u)} (wᵀc)`` at one stage."""
-    jacobian_entries: tuple[IntArray, IntArray] = field(repr=False)
-    """Row and column in ``∂c/∂(x, u)`` of each Jacobian nonzero (CasADi's order)."""
     hessian_entries: tuple[IntArray, IntArray] = field(repr=False)
     """Row and column in ``∇²_{(x, u)}`` of each Hessian nonzero."""
     row_start: IntArray = field(repr=False)
@@ -63,99 +97,94 @@ class ConstraintModel:
 
     def jacobians(
         self, states: FloatArray, inputs: FloatArray, parameters: FloatArray
-    ) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """Values ``(N, n_c)`` and Jacobians ``c_x (N, n_c, n_x)``, ``c_u (N, n_c, n_u)``.
-
-        Only the structural nonzeros are evaluated (a separation touches four states).
-        """
-        rows, columns = self.jacobian_entries
+    ) -> tuple[FloatArray, SparseJacobians]:
+        """Values ``(N, n_c)`` and the Jacobians ``∂c/∂(x, u)`` by their nonzeros."""
         c, nonzeros = self._stages(
-            self._jacobians, states, inputs, parameters, [(self.n_c,), (rows.size,)]
+            self._jacobians, states, inputs, parameters, [(self.n_c,), (self.columns.size,)]
         )
-        full = _scattered(nonzeros, rows, columns, (self.n_c, self.n_x + self.n_u))
-        return (
-            c,
-            np.ascontiguousarray(full[:, :, : self.n_x]),
-            np.ascontiguousarray(full[:, :, self.n_x :]),
-        )
+        return c, SparseJacobians(nonzeros, self.row_start, self.columns, self.n_x + self.n_u)
 
-    def weighted_hessians(
+    def add_weighted_hessians(
         self,
         states: FloatArray,
         inputs: FloatArray,
         parameters: FloatArray,
         weights: FloatArray,
-    ) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """Blocks of ``Σ_j w_{k,j} ∇²c_j(x_k, u_k, p_k)``; ``weights`` has shape ``(N, n_c)``.
-
-        Only the structural nonzeros are evaluated (those of the positions in a separation).
-        """
-        rows, columns = self.hessian_entries
-        (nonzeros,) = self._stages(
-            self._hessian, states, inputs, parameters, [(rows.size,)],
-            ("weights", weights, self.n_c),
-        )  # fmt: skip
-        n_x, n_z = self.n_x, self.n_x + self.n_u
-        full = _scattered(nonzeros, rows, columns, (n_z, n_z))
-        return (
-            np.ascontiguousarray(full[:, :n_x, :n_x]),
-            np.ascontiguousarray(full[:, :n_x, n_x:]),
-            np.ascontiguousarray(full[:, n_x:, n_x:]),
-        )
-
-    def add_outer_products(
-        self,
-        weights: FloatArray,
-        c_x: FloatArray,
-        c_u: FloatArray,
         blocks: tuple[FloatArray, FloatArray, FloatArray],
     ) -> None:
-        """Add ``Σ_j w_{k,j} ∇c_j ∇c_jᵀ`` to the blocks ``(H_xx, H_xu, H_uu)`` in place.
+        """Add ``Σ_j w_{k,j} ∇²c_j(x_k, u_k, p_k)`` to the blocks ``(H_xx, H_xu, H_uu)`` in place.
 
-        Only the structural nonzeros of each gradient are visited (a separation touches four
-        states of a fleet), so the cost does not grow with ``n_x²``.
+        ``weights`` has shape ``(N, n_c)``. Only the structural nonzeros are evaluated and
+        added (those of the positions in a separation).
         """
-        _add_outer_products(weights, c_x, c_u, self.row_start, self.columns, *blocks)
+        (nonzeros,) = self._stages(
+            self._hessian, states, inputs, parameters, [(self.hessian_entries[0].size,)],
+            ("weights", weights, self.n_c),
+        )  # fmt: skip
+        _add_entries(nonzeros, *self.hessian_entries, *blocks)
 
 
-def _scattered(
-    nonzeros: FloatArray, rows: IntArray, columns: IntArray, shape: tuple[int, int]
+@numba.njit(cache=True)
+def _weighted_rows(
+    weights: FloatArray, values: FloatArray, row_start: IntArray, columns: IntArray, n_z: int
 ) -> FloatArray:
-    """``(N, *shape)`` zeros with ``nonzeros (N, nnz)`` placed at ``(rows, columns)``."""
-    full = np.zeros((nonzeros.shape[0], *shape))
-    full[:, rows, columns] = nonzeros
-    return full
+    n_points, n_c = weights.shape
+    out = np.zeros((n_points, n_z))
+    for k in range(n_points):
+        for j in range(n_c):
+            w = weights[k, j]
+            if w == 0.0:
+                continue
+            for a in range(row_start[j], row_start[j + 1]):
+                out[k, columns[a]] += w * values[k, a]
+    return out
+
+
+@numba.njit(cache=True)
+def _add_to_block(
+    k: int, row: int, column: int, value: float, h_xx: FloatArray, h_xu: FloatArray,
+    h_uu: FloatArray,
+) -> None:  # fmt: skip
+    """Add ``value`` at ``(row, column)`` of ``[[H_xx, H_xu], [·, H_uu]]`` (``H_ux`` not kept)."""
+    n_x = h_xx.shape[1]
+    if row < n_x and column < n_x:
+        h_xx[k, row, column] += value
+    elif row < n_x:
+        h_xu[k, row, column - n_x] += value
+    elif column >= n_x:
+        h_uu[k, row - n_x, column - n_x] += value
+
+
+@numba.njit(cache=True)
+def _add_entries(
+    nonzeros: FloatArray, rows: IntArray, columns: IntArray, h_xx: FloatArray,
+    h_xu: FloatArray, h_uu: FloatArray,
+) -> None:  # fmt: skip
+    for k in range(nonzeros.shape[0]):
+        for e in range(rows.size):
+            _add_to_block(k, rows[e], columns[e], nonzeros[k, e], h_xx, h_xu, h_uu)
 
 
 @numba.njit(cache=True)
 def _add_outer_products(
     weights: FloatArray,
-    c_x: FloatArray,
-    c_u: FloatArray,
+    values: FloatArray,
     row_start: IntArray,
     columns: IntArray,
     h_xx: FloatArray,
     h_xu: FloatArray,
     h_uu: FloatArray,
 ) -> None:
-    n_stages, n_c, n_x = c_x.shape
-    for k in range(n_stages):
+    n_points, n_c = weights.shape
+    for k in range(n_points):
         for j in range(n_c):
             w = weights[k, j]
             if w == 0.0:
                 continue
             for a in range(row_start[j], row_start[j + 1]):
-                col_a = columns[a]
-                g_a = w * (c_x[k, j, col_a] if col_a < n_x else c_u[k, j, col_a - n_x])
+                g_a = w * values[k, a]
                 for b in range(row_start[j], row_start[j + 1]):
-                    col_b = columns[b]
-                    g_b = c_x[k, j, col_b] if col_b < n_x else c_u[k, j, col_b - n_x]
-                    if col_a < n_x and col_b < n_x:
-                        h_xx[k, col_a, col_b] += g_a * g_b
-                    elif col_a < n_x:
-                        h_xu[k, col_a, col_b - n_x] += g_a * g_b
-                    elif col_b >= n_x:
-                        h_uu[k, col_a - n_x, col_b - n_x] += g_a * g_b
+                    _add_to_block(k, columns[a], columns[b], g_a * values[k, b], h_xx, h_xu, h_uu)
 
 
 def discretize_constraints(
@@ -196,17 +225,17 @@ def discretize_constraints(
         jacobian = ca.jacobian(c, ca.vertcat(x, u))
         hessian, _ = ca.hessian(ca.dot(weights, c), ca.vertcat(x, u))
         row_start, columns = jacobian.sparsity().get_crs()
+        # the transpose's nonzeros (column-major) are the Jacobian's in compressed-row order
         return ConstraintModel(
             n_x,
             n_u,
             n_p,
             n_c,
             dense_function("constraints", args, [c], _ARGS, ["c"]),
-            dense_function("constraint_jac", args, [c, nonzeros(jacobian)], _ARGS, ["c", "c_xu"]),
+            dense_function("constraint_jac", args, [c, nonzeros(jacobian.T)], _ARGS, ["c", "c_xu"]),
             dense_function(
                 "constraint_hess", [*args, weights], [nonzeros(hessian)], [*_ARGS, "w"], ["h"]
             ),
-            entries(jacobian),
             entries(hessian),
             np.asarray(row_start, dtype=np.int64),
             np.asarray(columns, dtype=np.int64),

@@ -31,6 +31,7 @@ def design_regulator(
     *,
     terminal: TerminalRegulator | Literal["dare", "weight"] = TerminalRegulator.DARE,
     blocks: tuple[IntArray, IntArray] | None = None,
+    replaced: tuple[IntArray, FloatArray, FloatArray] | None = None,
 ) -> FloatArray:
     """Time-varying discrete LQR along a trajectory (the projection regulator, §6.1).
 
@@ -48,6 +49,9 @@ def design_regulator(
     terminal : TerminalRegulator or {"dare", "weight"}
         ``P_N`` from :func:`scipy.linalg.solve_discrete_are` at the last stage (falls back
         to ``Q_r`` when the ARE fails) or ``Q_r``.
+    replaced : tuple, optional
+        ``(stages, A_s, B_s)``: the regulator is designed on ``A_s``, ``B_s`` at these
+        stages instead (``A`` and ``B`` are not modified, nor copied whole).
 
     Returns
     -------
@@ -61,11 +65,16 @@ def design_regulator(
     SolverError
         If the Riccati recursion breaks down (non-finite linearisation).
     """
+    stages, a_replaced, b_replaced = (
+        replaced if replaced is not None else (np.empty(0, np.int64), A[:0], B[:0])
+    )
+    last = stages.size > 0 and stages[-1] == A.shape[0] - 1
+    a_last, b_last = (a_replaced[-1], b_replaced[-1]) if last else (A[-1], B[-1])
     p_final = Q_r
     if named_choice(TerminalRegulator, terminal, "terminal") is TerminalRegulator.DARE:
         try:
             with np.errstate(all="ignore"):
-                candidate = scipy.linalg.solve_discrete_are(A[-1], B[-1], Q_r, R_r)
+                candidate = scipy.linalg.solve_discrete_are(a_last, b_last, Q_r, R_r)
             if np.all(np.isfinite(candidate)) and np.min(np.linalg.eigvalsh(candidate)) > -1e-9:
                 p_final = 0.5 * (candidate + candidate.T)
         except (np.linalg.LinAlgError, ValueError):
@@ -74,9 +83,14 @@ def design_regulator(
     gains = np.zeros((A.shape[0], B.shape[2], A.shape[1]))
     ok = True
     for states, inputs in parts:
+        a_block, b_block = A[:, states, states], B[:, states, inputs]
+        if stages.size:  # copies of this subsystem's blocks only
+            a_block, b_block = a_block.copy(), b_block.copy()
+            a_block[stages] = a_replaced[:, states, states]
+            b_block[stages] = b_replaced[:, states, inputs]
         block, block_ok = _kernels.regulator_riccati(
-            np.ascontiguousarray(A[:, states, states]),
-            np.ascontiguousarray(B[:, states, inputs]),
+            np.ascontiguousarray(a_block),
+            np.ascontiguousarray(b_block),
             np.ascontiguousarray(Q_r[states, states]),
             np.ascontiguousarray(R_r[inputs, inputs]),
             np.ascontiguousarray(p_final[states, states]),
@@ -129,6 +143,7 @@ def regulator_gains(
     stages where a state lies below its floor).
     """
     problem = model.problem
+    replaced = None
     if problem.regulator_floor is not None:
         states = trajectory.states[:-1]
         below = np.abs(states) < problem.regulator_floor
@@ -136,9 +151,11 @@ def regulator_gains(
         if stages.size:
             sign = np.where(states[stages] < 0.0, -1.0, 1.0)
             design = np.where(below[stages], sign * problem.regulator_floor, states[stages])
-            A, B = A.copy(), B.copy()
-            A[stages], B[stages] = model.discrete.jacobians(
-                design, trajectory.inputs[stages], problem.parameters[stages]
+            replaced = (
+                stages,
+                *model.discrete.jacobians(
+                    design, trajectory.inputs[stages], problem.parameters[stages]
+                ),
             )
     return design_regulator(
         A,
@@ -149,6 +166,7 @@ def regulator_gains(
         blocks=block_ranges(
             coordinate_groups(problem.blocks, problem.n_states), problem.n_states, problem.n_inputs
         ),
+        replaced=replaced,
     )
 
 

@@ -14,6 +14,7 @@ import numpy as np
 from auvplan._typing import BoolArray, FloatArray
 from auvplan.optimization import _kernels
 from auvplan.optimization.barrier import composed_barrier, hockey_stick
+from auvplan.optimization.constraints import SparseJacobians
 from auvplan.optimization.model import ProntoModel
 from auvplan.optimization.problem import Trajectory
 
@@ -156,8 +157,9 @@ class Linearization:
         Smallest scaled slack; ``min_argument`` the smallest barrier argument ``z``.
     barrier_outer : ndarray of shape (N + 1, n_c)
         ``ε dt b''(s) / scale²`` (weights of ``c_x c_xᵀ``); ``barrier_weight`` is
-        ``ε dt b'(s) / scale`` (weights of ``∇²c``); ``c_x``, ``c_u`` the constraint Jacobians;
-        at the constraint nodes ``0..N`` (:func:`constraint_nodes`; zero where not imposed).
+        ``ε dt b'(s) / scale`` (weights of ``∇²c``); ``constraint_jacobians`` the constraint
+        Jacobians (``None`` without constraints); at the constraint nodes ``0..N``
+        (:func:`constraint_nodes`; zero where not imposed).
     """
 
     A: FloatArray
@@ -173,8 +175,7 @@ class Linearization:
     delta: float
     barrier_outer: FloatArray
     barrier_weight: FloatArray
-    c_x: FloatArray
-    c_u: FloatArray
+    constraint_jacobians: SparseJacobians | None
 
 
 def linearize(
@@ -200,14 +201,13 @@ def linearize(
     n_c = model.constraints.n_c if model.constraints is not None else 0
     outer = np.zeros((n_nodes, n_c))
     weight = np.zeros((n_nodes, n_c))
-    c_x = np.zeros((n_nodes, n_c, problem.n_states))
-    c_u = np.zeros((n_nodes, n_c, problem.n_inputs))
+    jacobians = None
     barrier = 0.0
     smallest = min_argument = float("inf")
     if model.has_constraints:
         assert model.constraints is not None
         node_states, node_inputs, node_params, imposed = constraint_nodes(model, trajectory)
-        values, c_x, c_u = model.constraints.jacobians(node_states, node_inputs, node_params)
+        values, jacobians = model.constraints.jacobians(node_states, node_inputs, node_params)
         scale = model.slack_scales
         slack = values / scale
         value, first, second, argument = _barrier_terms(model, slack, delta)
@@ -215,9 +215,11 @@ def linearize(
         barrier = float(factor * np.sum(value, where=imposed))
         weight = np.where(imposed, factor * first / scale, 0.0)
         outer = np.where(imposed, factor * second / (scale * scale), 0.0)
-        l_x = l_x + np.einsum("kj,kji->ki", weight[:-1], c_x[:-1])
-        l_u = l_u + np.einsum("kj,kji->ki", weight[:-1], c_u[:-1])
-        m_x = m_x + weight[-1] @ c_x[-1]  # components free of u: no c_u at node N
+        gradient = jacobians.weighted_sum(weight)
+        n_x = problem.n_states
+        l_x = l_x + gradient[:-1, :n_x]
+        l_u = l_u + gradient[:-1, n_x:]
+        m_x = m_x + gradient[-1, :n_x]  # components free of u: no c_u at node N
         smallest = float(np.min(slack[imposed]))
         min_argument = float(np.min(argument[imposed]))
     return Linearization(
@@ -234,8 +236,7 @@ def linearize(
         delta=delta,
         barrier_outer=outer,
         barrier_weight=weight,
-        c_x=c_x,
-        c_u=c_u,
+        constraint_jacobians=jacobians,
     )
 
 
@@ -270,31 +271,31 @@ def _with_barrier_hessians(
     """``blocks`` plus the node costs' and the barrier's Hessians.
 
     The barrier Hessian is ``Σ_j [w''_j c_j' c_j'ᵀ + w'_j ∇²c_j]``, a node cost's ``dt ∇²r``;
-    the final node's barrier Hessian (in ``x`` only) is added to ``P_N = m_xx``.
+    the final node's barrier Hessian (in ``x`` only) is added to ``P_N = m_xx``. ``blocks``
+    are the caller's own arrays (fresh from the model's Hessians): the barrier's terms are
+    added to them in place.
     """
     q, s, r = blocks
     p_final = lin.m_xx
     for term in model.problem.node_costs:
-        q = q + model.problem.dt * term.derivatives(trajectory.states[:-1])[2]
+        q += model.problem.dt * term.derivatives(trajectory.states[:-1])[2]
     if model.has_constraints:
         assert model.constraints is not None
+        assert lin.constraint_jacobians is not None
         states, inputs, params, _ = constraint_nodes(model, trajectory)
         stages, final = slice(None, -1), slice(-1, None)
-        h_xx, h_xu, h_uu = model.constraints.weighted_hessians(
-            states[stages], inputs[stages], params[stages], lin.barrier_weight[stages]
+        model.constraints.add_weighted_hessians(
+            states[stages], inputs[stages], params[stages], lin.barrier_weight[stages],
+            (q, s, r),
+        )  # fmt: skip
+        lin.constraint_jacobians[stages].add_outer_products(lin.barrier_outer[stages], (q, s, r))
+        n_x, n_u = q.shape[1], r.shape[1]
+        end = (lin.m_xx[None].copy(), np.zeros((1, n_x, n_u)), np.zeros((1, n_u, n_u)))
+        model.constraints.add_weighted_hessians(
+            states[final], inputs[final], params[final], lin.barrier_weight[final], end
         )
-        q, s, r = q + h_xx, s + h_xu, r + h_uu
-        model.constraints.add_outer_products(
-            lin.barrier_outer[stages], lin.c_x[stages], lin.c_u[stages], (q, s, r)
-        )
-        end = model.constraints.weighted_hessians(
-            states[final], inputs[final], params[final], lin.barrier_weight[final]
-        )
-        end_xx = end[0] + lin.m_xx
-        model.constraints.add_outer_products(
-            lin.barrier_outer[final], lin.c_x[final], lin.c_u[final], (end_xx, end[1], end[2])
-        )
-        p_final = end_xx[0]
+        lin.constraint_jacobians[final].add_outer_products(lin.barrier_outer[final], end)
+        p_final = end[0][0]
     return StageWeights(q, s, r, p_final)
 
 
