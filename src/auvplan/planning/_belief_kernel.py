@@ -16,6 +16,16 @@ there before (``closed[cell]`` keeps the lowest closed bin). A label is thus exp
 it is better in error than every cheaper label at its cell: at most ``n_bins`` per cell.
 After the settling distance a move whose predicted σ exceeds ``max_error`` is not made.
 
+Ties. Unit-cost grids have many labels of exactly equal key (routes of the same moves in
+another order), and which of them pops first decides, through the bin dominance that ignores
+everything but σ, which route is kept. The heap therefore orders labels by the compound key
+
+.. math:: (\text{key},\ \sigma^2,\ \text{peak},\ \text{label number})
+
+lexicographically: among equal keys the lower σ first (the lower bin, then the lower σ within
+it), then the lower peak error, then the label created first. The order is total and does not
+depend on the heap's layout; the label number only ranks labels identical in cost and error.
+
 A move ``u → v`` of length ℓ [m] with the move factor ``f`` (e.g. the time ratio in a
 current) costs ``ℓ f (c_u + c_v) / 2 + λ ℓ (σ_u² + σ_v²) / 2`` and takes
 ``n = ℓ · updates_per_metre`` TAN updates: drift over ℓ, white variance ``n q`` and
@@ -90,14 +100,30 @@ def _grow_keys(values: FloatArray, size: int) -> FloatArray:  # pragma: no cover
 
 
 @njit(cache=True)
+def _precedes(
+    table: FloatArray, key_a: float, a: int, key_b: float, b: int
+) -> bool:  # pragma: no cover - compiled
+    """Whether label ``a`` (heap key ``key_a``) pops before label ``b`` (module notes: ties)."""
+    if key_a != key_b:
+        return key_a < key_b
+    variance_a = table[a, _P00] + table[a, _P11]
+    variance_b = table[b, _P00] + table[b, _P11]
+    if variance_a != variance_b:
+        return bool(variance_a < variance_b)
+    if table[a, _PEAK] != table[b, _PEAK]:
+        return bool(table[a, _PEAK] < table[b, _PEAK])
+    return a < b
+
+
+@njit(cache=True)
 def _push(
-    keys: FloatArray, items: IntArray, size: int, key: float, item: int
+    table: FloatArray, keys: FloatArray, items: IntArray, size: int, key: float, item: int
 ) -> None:  # pragma: no cover - compiled
     """Sift ``(key, item)`` up from position ``size`` (the caller has room for it)."""
     i = size
     while i > 0:
         parent = (i - 1) >> 1
-        if keys[parent] <= key:
+        if _precedes(table, keys[parent], items[parent], key, item):
             break
         keys[i] = keys[parent]
         items[i] = items[parent]
@@ -107,8 +133,10 @@ def _push(
 
 
 @njit(cache=True)
-def _pop(keys: FloatArray, items: IntArray, size: int) -> int:  # pragma: no cover - compiled
-    """Remove the smallest entry of a heap of ``size`` and return its item."""
+def _pop(
+    table: FloatArray, keys: FloatArray, items: IntArray, size: int
+) -> int:  # pragma: no cover - compiled
+    """Remove the first entry (:func:`_precedes`) of a heap of ``size`` and return its item."""
     top = items[0]
     last_key = keys[size - 1]
     last_item = items[size - 1]
@@ -118,9 +146,11 @@ def _pop(keys: FloatArray, items: IntArray, size: int) -> int:  # pragma: no cov
         child = 2 * i + 1
         if child >= n:
             break
-        if child + 1 < n and keys[child + 1] < keys[child]:
+        if child + 1 < n and _precedes(
+            table, keys[child + 1], items[child + 1], keys[child], items[child]
+        ):
             child += 1
-        if keys[child] >= last_key:
+        if _precedes(table, last_key, last_item, keys[child], items[child]):
             break
         keys[i] = keys[child]
         items[i] = items[child]
@@ -182,11 +212,11 @@ def belief_search(
     table[0, _P00], table[0, _P01], table[0, _P11] = j11 / det, -j01 / det, j00 / det
     cells[0], parents[0] = start, -1
     n_labels = 1
-    _push(keys, items, heap, 0.0 if bottleneck else heuristic[start], 0)
+    _push(table, keys, items, heap, 0.0 if bottleneck else heuristic[start], 0)
     heap += 1
     found = -1
     while heap > 0:
-        label = _pop(keys, items, heap)
+        label = _pop(table, keys, items, heap)
         heap -= 1
         u = cells[label]
         row = table[label]
@@ -244,7 +274,7 @@ def belief_search(
             table[n_labels, _GROWN] = grown
             cells[n_labels], parents[n_labels] = v, label
             key = peak * 1e9 + g if bottleneck else g + heuristic[v]
-            _push(keys, items, heap, key, n_labels)
+            _push(table, keys, items, heap, key, n_labels)
             heap += 1
             n_labels += 1
     if found < 0:
