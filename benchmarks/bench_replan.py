@@ -4,10 +4,11 @@ The mission is ``fleet-4-3600-1`` of :mod:`_fleet` (four MEDUSAs on crossing lan
 ``dt_s`` 1 s). The 10-minute case is planned first to fill the kernel cache (the same
 vehicles and settings), then the mission is planned (timed: the plan from scratch) and
 saved; the saved folder is replanned at ``t = 1800 s`` with vehicle ``v0`` 30 m east of where
-its plan has it (``auvplan.load(folder).replan``: the mission is planned again up to stage 2
-from the folder, then the rest is optimised), and the plan in memory is replanned the same
-way (no stage 1-2 again). Target: the replan within 25 % of the plan from scratch. Run as a
-script (minutes; ``nice`` it on a shared machine)::
+its plan has it (``auvplan.load(folder).replan``: the folder is read, its mission pre-planned
+again and its stage-2 schedule read from ``summary.json``, then the rest is optimised), and
+the plan in memory is replanned the same way (no stage 1 again). No timed run writes files
+or figures. Target: the replan within 25 % of the plan from scratch. Run as a script
+(minutes; ``nice`` it on a shared machine)::
 
     nice .venv/bin/python benchmarks/bench_replan.py           # 4 MEDUSAs x 1 h at 30 min
     nice .venv/bin/python benchmarks/bench_replan.py --quick   # 4 MEDUSAs x 10 min at 5 min

@@ -2,10 +2,11 @@
 
 :func:`replan` plans the rest of a plan from time ``at`` [s] (:mod:`auvplan.mission.replan`):
 the states given (``STATES.csv`` or a mapping, :mod:`auvplan.mission.states`) replace those
-the plan has at ``at``; a plan read from its folder has its mission planned again up to
-stage 2 first (:mod:`auvplan.mission.parent`). :func:`replan_to_folder` reads a folder,
-replans it and writes the new plan's output folder, a normal one whose ``summary.json`` adds
-``replan`` (the parent folder, its ``trajectories.csv`` digest, ``at_s``, ``schedule``).
+the plan has at ``at``; a plan read from its folder has its mission pre-planned again and
+its stage-2 schedule read from its ``summary.json`` first (:mod:`auvplan.mission.parent`).
+:func:`replan_to_folder` reads a folder, replans it and writes the new plan's output folder,
+a normal one whose ``summary.json`` adds ``replan`` (the parent folder, its
+``trajectories.csv`` digest, ``at_s``, ``schedule``).
 
 >>> import auvplan                                                    # doctest: +SKIP
 >>> rest = auvplan.load("out/run1").replan(1800.0, "states.csv")      # doctest: +SKIP

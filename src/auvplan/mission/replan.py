@@ -234,9 +234,9 @@ def replan_mission(
     """Replan ``parent`` at ``at`` [s] from ``states`` (vehicle -> state; module notes).
 
     ``callback`` and ``progress`` as for :func:`auvplan.mission.run_mission`. The timings [s]
-    are ``parent_preplan`` and ``parent_deconflict`` (a parent read from a folder, planned
-    again), ``schedule`` (the shifted schedule and its certificate), ``deconflict`` (when the
-    certificate fails) and ``optimize``.
+    are ``parent_preplan`` and ``parent_deconflict`` (a parent read from a folder: its mission
+    pre-planned again, its schedule read back), ``schedule`` (the shifted schedule and its
+    certificate), ``deconflict`` (when the certificate fails) and ``optimize``.
 
     Raises
     ------
