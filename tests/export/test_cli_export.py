@@ -12,6 +12,7 @@ import subprocess
 import sys
 from datetime import datetime
 from pathlib import Path
+from typing import Any
 
 import gpxpy
 import numpy as np
@@ -24,6 +25,9 @@ from auvplan.export import FORMATS
 from auvplan.io.maps_file import read_maps_netcdf, write_maps_netcdf
 from auvplan.io.vehicles import vehicle_file
 from auvplan.mission.config import load_mission, parse_mission
+from auvplan.record import read_record
+from auvplan.record.dataset import trajectories_dataset_of
+from auvplan.record.files import MAIN_PLAN
 from auvplan.terrain import LocalProjection
 
 from ._plans import MISSION
@@ -114,6 +118,81 @@ def test_trajectories_netcdf_follows_the_ncei_template_and_acdd(
         assert dataset.attrs["geospatial_lat_min"] == pytest.approx(float(dataset["lat"].min()))
         assert dataset["u"].attrs["coverage_content_type"] == "modelResult"
         assert dataset["u"].attrs["valid_max"] == pytest.approx(float(dataset["u"].max()))
+
+
+#: The ACDD-1.3 recommended attributes that say who made and distributes a file: the
+#: operator's to give in [metadata], never made up.
+WHO: frozenset[str] = frozenset(
+    {
+        "creator_name", "creator_url", "creator_email", "institution", "project", "license",
+        "naming_authority", "publisher_name", "publisher_url", "publisher_email",
+    }
+)  # fmt: skip
+
+
+def _acdd_missing(report: dict[str, Any]) -> tuple[set[str], set[str]]:
+    """The missing global attributes and the variables without a standard name of an ACDD
+    report (``compliance-checker --test acdd:1.3``)."""
+    attributes, unnamed = set(), set()
+    for result in [*report["high_priorities"], *report["medium_priorities"]]:
+        for message in result["msgs"]:
+            if message.endswith(" not present"):
+                attributes.add(message.removesuffix(" not present"))
+            elif message == "standard_name":
+                unnamed.add(result["name"].split('"')[1])
+    return attributes, unnamed
+
+
+def test_without_metadata_acdd_scores_what_the_plan_itself_tells(
+    planned_folder: Path, tmp_path: Path
+) -> None:
+    """Issue 25: without [metadata] the files carry every ACDD attribute the plan and the run
+    determine; what is missing is who made them (never invented) and the CF standard names
+    that do not exist (propeller speed, electrical power, map values, local north/east).
+    Measured: trajectories.nc 70/85 (80/85 with [metadata]), maps.nc 46/66 (56/66)."""
+    record = read_record(planned_folder)
+    anonymous = dataclasses.replace(
+        record, mission={k: v for k, v in record.mission.items() if k != "metadata"}
+    )
+    trajectories, maps = tmp_path / "trajectories.nc", tmp_path / "maps.nc"
+    trajectories_dataset_of(anonymous, MAIN_PLAN).to_netcdf(trajectories)
+    write_maps_netcdf(record.maps, maps, created=record.summary.created_at)
+    expected = {
+        trajectories: (70 / 85, {"north", "east", "n_ps", "n_sb", "power"}, set()),
+        maps: (
+            46 / 66,
+            {"information", "excitation", "cost", "shifted_cost"},
+            # maps have no time; the depth's vertical datum is the source's
+            {
+                "time_coverage_start",
+                "time_coverage_end",
+                "time_coverage_duration",
+                "time_coverage_resolution",
+                "geospatial_bounds_vertical_crs",
+            },
+        ),
+    }
+    for path, (score, unnamed, undetermined) in expected.items():
+        assert checker_passes(path, tmp_path / "cf.json", "cf:1.8"), path.name
+        report = checker_report(path, tmp_path / "acdd.json", "acdd:1.3")
+        assert report["scored_points"] / report["possible_points"] >= score, path.name
+        assert _acdd_missing(report) == (set(WHO | undetermined), unnamed), path.name
+        with xr.open_dataset(path) as dataset:
+            assert not WHO & set(dataset.attrs), path.name
+            assert dataset.attrs["date_metadata_modified"] == dataset.attrs["date_created"]
+    assert cf_findings(trajectories, tmp_path / "ncei.json", "ncei-trajectory:2.0")["high"] == []
+    # with [metadata], maps.nc names who made it as trajectories.nc does
+    with xr.open_dataset(planned_folder / "maps.nc") as dataset:
+        assert (dataset.attrs["creator_name"], dataset.attrs["license"]) == (
+            "Ada Operator", "CC-BY-4.0",
+        )  # fmt: skip
+        assert dataset.attrs["geospatial_lat_min"] == pytest.approx(float(dataset["lat"].min()))
+        assert dataset.attrs["geospatial_vertical_max"] == pytest.approx(
+            float(dataset["depth"].max())
+        )
+        assert dataset["depth"].attrs["coverage_content_type"] == "physicalMeasurement"
+    report = checker_report(planned_folder / "maps.nc", tmp_path / "acdd.json", "acdd:1.3")
+    assert report["scored_points"] / report["possible_points"] >= 56 / 66
 
 
 def test_summary_records_version_inputs_and_start_time(planned_folder: Path) -> None:

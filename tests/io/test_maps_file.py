@@ -57,7 +57,7 @@ def test_layout_and_cf_attributes(tmp_path: Path, maps_with_projection: TerrainM
         np.testing.assert_allclose(ds["north"].values, maps.bathymetry.geometry.north)
         np.testing.assert_allclose(ds["east_block"].values, maps.cost_geometry.east)
         attrs = ds.attrs
-        assert attrs["Conventions"] == "CF-1.8"
+        assert attrs["Conventions"] == "CF-1.8, ACDD-1.3"
         assert attrs["source"] == "test grid"
         assert (attrs["information_exponent"], attrs["omega"], attrs["weight"]) == (2.0, 3.0, 7.0)
         assert (attrs["block_north"], attrs["block_east"]) == (2, 3)
@@ -73,7 +73,8 @@ def test_layout_and_cf_attributes(tmp_path: Path, maps_with_projection: TerrainM
         # no axis: the IOOS checker would take them for latitude/longitude); the block maps'
         # grid mapping is the same frame with the block grid's GDAL GeoTransform
         for name in ("north_block", "east_block"):
-            assert ds[name].attrs == {"units": "m", "long_name": ds[name].attrs["long_name"]}
+            assert not {"axis", "standard_name"} & set(ds[name].attrs), name
+            assert ds[name].attrs["units"] == "m"
         for name in ("excitation", "cost", "shifted_cost"):
             assert ds[name].attrs["grid_mapping"] == "crs_block"
         assert CRS.from_cf(ds["crs_block"].attrs) == CRS.from_cf(ds["crs"].attrs)

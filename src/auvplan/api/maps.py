@@ -10,6 +10,7 @@ figure of :func:`auvplan.viz.maps.plot_terrain_maps` all-or-nothing
 from __future__ import annotations
 
 from dataclasses import dataclass
+from datetime import UTC, datetime
 from pathlib import Path
 
 from auvplan._figures import DEFAULT_DPI
@@ -88,7 +89,7 @@ def write_terrain_maps(
     figure = render_figure(plot_terrain_maps(maps), figure_format=figure_format, dpi=dpi)
     figure_name = f"maps.{figure_format}"
     with staged_output_dir(target) as staging:
-        write_maps_netcdf(maps, staging / MAPS_FILE)
+        write_maps_netcdf(maps, staging / MAPS_FILE, created=datetime.now(UTC))
         with writing(staging / figure_name):
             (staging / figure_name).write_bytes(figure.data)
     return MapsFolder(maps, (target / MAPS_FILE, target / figure_name))

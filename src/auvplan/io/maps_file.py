@@ -18,7 +18,10 @@ Layout:
   (rioxarray's ``write_transform``), rioxarray once told their dimensions
   (``.rio.set_spatial_dims("east_block", "north_block")``);
 * global attributes: the map parameters (``information_exponent``, ``block_north``,
-  ``block_east``, ``omega``, ``weight``), the fine spacing, ``source``, ``Conventions``.
+  ``block_east``, ``omega``, ``weight``), the fine spacing, ``source``, ``Conventions``, and
+  the ACDD-1.3 discovery attributes (extent, ``id``, dates; who made the maps only as the
+  mission's ``[metadata]`` gives it), shared with ``trajectories.nc`` by
+  :mod:`auvplan.io._discovery`; each variable has its ``coverage_content_type``.
 
 The file is also a valid bathymetry input: :func:`auvplan.io.bathymetry.read_bathymetry`
 reads its ``depth`` and local frame back.
@@ -26,13 +29,16 @@ reads its ``depth`` and local frame back.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from datetime import datetime
 from pathlib import Path
-from typing import TYPE_CHECKING, Final
+from typing import TYPE_CHECKING, Any, Final
 
 import numpy as np
 
 from auvplan._version import __version__
 from auvplan.errors import DataFormatError
+from auvplan.io._discovery import content_id, geospatial_attributes, run_attributes
 from auvplan.io._gridded import VERTICAL_DATUM, grid_mapping_crs
 from auvplan.io.writing import writing
 from auvplan.terrain.grid import BathymetryGrid, GridGeometry
@@ -49,10 +55,22 @@ GRID_MAPPING: Final = "crs"
 BLOCK_GRID_MAPPING: Final = "crs_block"
 #: The maps on the coarse (block) grid.
 _BLOCK_MAPS: Final = ("excitation", "cost", "shifted_cost")
+#: ACDD ``coverage_content_type`` of the data variables (the others are coordinates).
+_CONTENT_TYPES: Final = {
+    "depth": "physicalMeasurement",
+    "information": "modelResult",
+    **dict.fromkeys(_BLOCK_MAPS, "modelResult"),
+}
 
 
-def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
-    """Write the terrain maps to a CF-1.8 NetCDF-4 file.
+def write_maps_netcdf(
+    maps: TerrainMaps,
+    path: str | Path,
+    *,
+    metadata: Mapping[str, str] | None = None,
+    created: datetime | None = None,
+) -> Path:
+    """Write the terrain maps to a CF-1.8 NetCDF-4 file with ACDD-1.3 discovery attributes.
 
     Parameters
     ----------
@@ -60,6 +78,12 @@ def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
         The maps to write.
     path : str or Path
         Output file (usually ``DIR/maps.nc``); overwritten if it exists.
+    metadata : mapping of str to str, optional
+        Who made the maps: ACDD attributes by name (the mission's ``[metadata]``); an
+        attribute computed here takes precedence.
+    created : datetime, optional
+        Time the maps were made (time-zone aware): ``date_created`` and the other ACDD dates
+        (none when not given).
 
     Returns
     -------
@@ -116,14 +140,27 @@ def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
             {"units": "1", "long_name": "shifted cost map omega + w M_C (eq. 15)"},
         ),
     }
-    attributes: dict[str, str | float | int] = {
-        "Conventions": "CF-1.8",
+    source = maps.bathymetry.name or "auvplan"
+    attributes: dict[str, Any] = {
+        **run_attributes(metadata, created),
+        "Conventions": "CF-1.8, ACDD-1.3",
         "title": "auvplan terrain-information maps",
-        "institution": "auvplan",
-        "source": maps.bathymetry.name or "auvplan",
+        "summary": f"Terrain-information maps of the bathymetry {source} for terrain-aided "
+        f"path planning, computed by auvplan: the seabed depth and the information map on a "
+        f"{fine.n_rows} x {fine.n_cols} grid of {fine.spacing_north:g} m x "
+        f"{fine.spacing_east:g} m cells, the excitation and cost maps on blocks of "
+        f"{parameters.block[0]} x {parameters.block[1]} cells.",
+        "keywords": "bathymetry, terrain information, terrain-aided navigation, cost map, "
+        "path planning, autonomous underwater vehicle, AUV",
+        "id": content_id(maps.bathymetry.depth, maps.information, maps.shifted_cost),
+        "source": source,
+        "processing_level": "maps computed from the bathymetry (model output); the depth as "
+        "read from the source",
         "history": f"created by auvplan {__version__}",
         "references": "Häusler et al., Cooperative AUV Motion Planning using Terrain "
         "Information, OCEANS 2013, Sec. III-A",
+        "acknowledgment": "Method: Häusler, Saccon, Pascoal, Hauser and Aguiar, Cooperative AUV "
+        f"Motion Planning using Terrain Information, OCEANS 2013; bathymetry: {source}",
         "comment": "north/east: metres from the map origin (the south-west node) in the local "
         "frame, a transverse Mercator centred on the map (grid_mapping variable crs)",
         "information_exponent": float(parameters.exponent),
@@ -137,6 +174,16 @@ def write_maps_netcdf(maps: TerrainMaps, path: str | Path) -> Path:
     dataset = xr.Dataset(data_vars, coords, attributes)
     if projection is not None:
         dataset = _georeference(dataset, projection, fine, coarse)
+    is_georeferenced = projection is not None
+    dataset.attrs |= geospatial_attributes(
+        dataset["lat"].values if is_georeferenced else None,
+        dataset["lon"].values if is_georeferenced else None,
+        maps.bathymetry.depth,
+        vertical_crs=None,  # the depth's datum is the source's, not always an EPSG datum
+    )
+    for name, variable in dataset.variables.items():
+        if name not in (GRID_MAPPING, BLOCK_GRID_MAPPING):
+            variable.attrs["coverage_content_type"] = _CONTENT_TYPES.get(str(name), "coordinate")
     # Encodings replace those set by rioxarray (the grid_mapping reference): merge them.
     compressed = {"zlib": True, "complevel": 4}
     encoding: dict[str, dict[str, object]] = {
@@ -195,17 +242,29 @@ def _georeference(
     import xarray as xr
     from affine import Affine
 
-    for geometry, suffix in ((fine, ""), (coarse, "_block")):
+    for geometry, suffix, where in ((fine, "", ""), (coarse, "_block", " of the block centre")):
         north, east = np.meshgrid(geometry.north, geometry.east, indexing="ij")
         lat, lon = projection.to_geographic(north, east)
         dims = (f"north{suffix}", f"east{suffix}")
         dataset = dataset.assign_coords(
             {
                 f"lat{suffix}": xr.Variable(
-                    dims, lat, {"units": "degrees_north", "standard_name": "latitude"}
+                    dims,
+                    lat,
+                    {
+                        "units": "degrees_north",
+                        "standard_name": "latitude",
+                        "long_name": f"latitude (WGS 84){where}",
+                    },
                 ),
                 f"lon{suffix}": xr.Variable(
-                    dims, lon, {"units": "degrees_east", "standard_name": "longitude"}
+                    dims,
+                    lon,
+                    {
+                        "units": "degrees_east",
+                        "standard_name": "longitude",
+                        "long_name": f"longitude (WGS 84){where}",
+                    },
                 ),
             }
         )

@@ -1,8 +1,9 @@
 """``trajectories.nc``: the optimised trajectories as a CF ``featureType = "trajectory"`` file.
 
 It follows the NCEI NetCDF trajectory template v2.0 and carries ACDD-1.3 discovery attributes
-(:func:`_discovery_attributes`: computed from the plan, and who made it from the mission's
-``[metadata]``), and every variable its ``coverage_content_type`` and valid range.
+(:func:`_discovery_attributes`: computed from the plan; who made it, from the mission's
+``[metadata]``, and when, as ``maps.nc`` does, by :mod:`auvplan.io._discovery`), and every
+variable its ``coverage_content_type`` and valid range.
 
 The layout follows the NCEI NetCDF trajectory template (v2.0, multidimensional array
 representation, CF §H.4.1): one ``trajectory`` per vehicle (the ``trajectory`` variable holds
@@ -39,17 +40,21 @@ is a true heading. On terrain without georeference (the synthetic bank) there is
 
 from __future__ import annotations
 
-import hashlib
 from collections.abc import Mapping, Sequence
-from datetime import UTC, datetime, timedelta
+from datetime import datetime, timedelta
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Final
 
 import numpy as np
 
 from auvplan._typing import FloatArray
-from auvplan._version import __version__
 from auvplan.errors import DataFormatError
+from auvplan.io._discovery import (
+    DEPTH_BELOW_SEA_SURFACE_CRS,
+    content_id,
+    geospatial_attributes,
+    run_attributes,
+)
 from auvplan.terrain.projection import LocalProjection
 
 if TYPE_CHECKING:
@@ -278,9 +283,8 @@ def trajectories_dataset(
             variable.attrs["valid_min"] = float(np.nanmin(variable.values))
             variable.attrs["valid_max"] = float(np.nanmax(variable.values))
     dataset.attrs = {
-        **(metadata or {}),
+        **run_attributes(metadata, created),
         **_discovery_attributes(dataset, names, time, start_time),
-        **(_dates(created) if created is not None else {}),
         **attributes,
     }
     for variable in dataset.variables.values():
@@ -314,10 +318,10 @@ def _discovery_attributes(
     """CF, ACDD-1.3 and NCEI trajectory-template global attributes from the data itself.
 
     Everything is derived from the plan (extent, times, vehicles): the same plan gives the
-    same attributes (the dates of :func:`_dates` aside). ``id`` is ``auvplan-`` and the first
-    16 hexadecimal digits of the SHA-256 of the positions, unique under any
-    ``naming_authority``; ``time_coverage_duration`` and ``_resolution`` are ISO 8601
-    durations (``PT<seconds>S``) of the horizon and the solver step.
+    same attributes. ``id`` is the :func:`~auvplan.io._discovery.content_id` of the
+    positions; ``time_coverage_duration`` and ``_resolution`` are ISO 8601 durations
+    (``PT<seconds>S``) of the horizon and the solver step. The attributes of the run (who,
+    when, version) are :func:`~auvplan.io._discovery.run_attributes`.
     """
     end_time = start_time + timedelta(seconds=float(time[-1]))
     depth = dataset["depth"].values
@@ -327,8 +331,6 @@ def _discovery_attributes(
         if shallowest == deepest
         else f"at depths of {shallowest:.1f} to {deepest:.1f} m"
     )
-    digest = hashlib.sha256(np.ascontiguousarray(dataset["north"].values).tobytes())
-    digest.update(np.ascontiguousarray(dataset["east"].values).tobytes())
     attributes: dict[str, Any] = {
         "Conventions": CONVENTIONS,
         "ncei_template_version": NCEI_TEMPLATE,
@@ -341,9 +343,7 @@ def _discovery_attributes(
         "velocities, actuator states and electrical power at the solver's time steps.",
         "keywords": "autonomous underwater vehicle, AUV, trajectory planning, multi-vehicle, "
         "terrain-aided navigation, bathymetry, energy",
-        "id": f"auvplan-{digest.hexdigest()[:16]}",
-        "product_version": __version__,
-        "standard_name_vocabulary": "CF Standard Name Table v93",
+        "id": content_id(dataset["north"].values, dataset["east"].values),
         "source": "numerical trajectory optimisation (auvplan)",
         "processing_level": "planned trajectories (model output), not measurements",
         "time_coverage_start": start_time.isoformat(),
@@ -355,42 +355,15 @@ def _discovery_attributes(
         "acknowledgment": "Method: Häusler, Saccon, Pascoal, Hauser and Aguiar, Cooperative AUV "
         "Motion Planning using Terrain Information, OCEANS 2013; bathymetry: the source named "
         "in the run's summary.json",
-        "geospatial_vertical_min": shallowest,
-        "geospatial_vertical_max": deepest,
-        "geospatial_vertical_units": "m",
-        "geospatial_vertical_positive": "down",
     }
-    if "lat" in dataset.coords:
-        lat, lon = dataset["lat"].values, dataset["lon"].values
-        attributes.update(
-            geospatial_lat_min=float(np.min(lat)),
-            geospatial_lat_max=float(np.max(lat)),
-            geospatial_lat_units="degrees_north",
-            geospatial_lon_min=float(np.min(lon)),
-            geospatial_lon_max=float(np.max(lon)),
-            geospatial_lon_units="degrees_east",
-            geospatial_bounds=_bounds_wkt(lat, lon),
-            geospatial_bounds_crs="EPSG:4326",
-            geospatial_bounds_vertical_crs="EPSG:5831",  # depth below the sea surface
-        )
+    is_georeferenced = "lat" in dataset.coords
+    attributes |= geospatial_attributes(
+        dataset["lat"].values if is_georeferenced else None,
+        dataset["lon"].values if is_georeferenced else None,
+        depth,
+        vertical_crs=DEPTH_BELOW_SEA_SURFACE_CRS,
+    )
     return attributes
-
-
-def _dates(created: datetime) -> dict[str, str]:
-    """ACDD ``date_created``, ``date_modified`` and ``date_issued``: ``created`` in ISO 8601.
-
-    The plan is made, last changed and issued at once (UTC, whole seconds, ``Z``).
-    """
-    text = created.astimezone(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
-    return {"date_created": text, "date_modified": text, "date_issued": text}
-
-
-def _bounds_wkt(lat: FloatArray, lon: FloatArray) -> str:
-    """ACDD ``geospatial_bounds``: the WKT polygon (lat lon order) around every position."""
-    south, north = float(np.min(lat)), float(np.max(lat))
-    west, east = float(np.min(lon)), float(np.max(lon))
-    corners = [(south, west), (north, west), (north, east), (south, east), (south, west)]
-    return "POLYGON ((" + ", ".join(f"{a:.7f} {b:.7f}" for a, b in corners) + "))"
 
 
 def read_trajectories_netcdf(path: Path) -> xr.Dataset:

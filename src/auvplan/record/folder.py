@@ -36,7 +36,7 @@ from auvplan.io.results import (
 )
 from auvplan.io.text import read_json, read_toml, write_toml
 from auvplan.io.writing import writing
-from auvplan.record.dataset import trajectories_dataset_of
+from auvplan.record.dataset import operator_metadata, trajectories_dataset_of
 from auvplan.record.files import (
     DESIRED_FILE,
     MAIN_PLAN,
@@ -205,7 +205,12 @@ def write_record(record: PlanRecord, directory: Path) -> list[Path]:
     written = [directory / name for name in (SUMMARY_FILE, MISSION_FILE, MAPS_FILE, PATHS_FILE)]
     write_json(record.summary.document(), written[0])
     write_toml(record.mission, written[1], header=layers.mission_header)
-    write_maps_netcdf(record.maps, written[2])
+    write_maps_netcdf(
+        record.maps,
+        written[2],
+        metadata=operator_metadata(record.mission),
+        created=record.summary.created_at,
+    )
     write_paths_geojson(
         written[3], names, layers.paths, record.maps.bathymetry.projection, layers.path_properties
     )
