@@ -692,7 +692,7 @@ PartyType = Literal["person", "group", "institution", "position"]
 
 
 class MetadataConfig(TableModel):
-    """Who made the plan, for the discovery attributes of ``trajectories.nc`` (ACDD-1.3).
+    """Who made the plan: discovery attributes of ``trajectories.nc`` and ``maps.nc`` (ACDD).
 
     Each key given becomes the global attribute of the same name (ACDD-1.3 and the NCEI
     trajectory template v2.0 recommend them); the attributes computed from the plan (extent,
