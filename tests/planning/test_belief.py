@@ -252,7 +252,8 @@ def test_of_exactly_tied_routes_the_search_keeps_the_one_of_lower_sigma(
 def test_the_search_pops_labels_in_the_order_of_a_plain_label_setting(
     seed: int, options: dict[str, float], bottleneck: bool
 ) -> None:
-    # unit costs: many labels of exactly equal cost, ordered by σ, peak and label number
+    # unit costs: many labels of exactly equal cost, ordered by σ, peak and label number; the
+    # kernel's push-time dominance must not change which labels pop, only how many are made
     rng = np.random.default_rng(seed)
     cost = np.ones((12, 16))
     cost[rng.uniform(size=cost.shape) < 0.12] = np.nan
@@ -266,4 +267,4 @@ def test_the_search_pops_labels_in_the_order_of_a_plain_label_setting(
     assert found.path.success
     assert found.path.cells.tolist() == [list(cell) for cell in path]
     assert found.path.cost == expected_cost
-    assert found.n_labels <= n_reference
+    assert found.n_labels < n_reference  # the push-time dominance created fewer labels
