@@ -116,9 +116,10 @@ def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, An
     on the same discretised problem from PRONTO's projected initial trajectory, hard
     constraints, the NLP expanded to SX (fastest evaluation, memory grows with the horizon) or
     kept as MX; ``fatrop``/``fatrop-c``: CasADi + FATROP alike on the MX NLP (expanded, the
-    crossing's took > 10 GB to build and compile), on CasADi's virtual machine or with the
-    NLP's functions compiled to C (``solve_s``: the solve alone).
-    ``max_iter`` caps PRONTO's iterations (for per-iteration timing).
+    crossing's took > 10 GB to build and compile), its stage Function on CasADi's virtual
+    machine or compiled to C with its derivatives (cached in ``AUVPLAN_CACHE_DIR``: the first
+    run's ``wall_s − solve_s`` includes the compilation; ``solve_s``: the solve alone).
+    ``max_iter`` caps the solver's iterations (for per-iteration timing).
     """
     with tempfile.TemporaryDirectory() as scratch:
         assembled, options = build_case(case, Path(scratch))
@@ -133,10 +134,12 @@ def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, An
     if solver.startswith(("ipopt", "fatrop")):
         initial, _ = project_guess(ModelCache().get(problem), guess, options)
         started = time.perf_counter()
+        cap = {} if max_iter is None else {"max_iter": max_iter}
         if solver.startswith("ipopt"):
-            result = solve_ipopt(problem, initial, expand=solver == "ipopt")
+            result = solve_ipopt(problem, initial, expand=solver == "ipopt", **cap)
         else:
-            result = solve_fatrop(problem, initial, expand=False, compiled=solver == "fatrop-c")
+            compiled = solver == "fatrop-c"
+            result = solve_fatrop(problem, initial, expand=False, compiled=compiled, **cap)
         record.update(
             status=str(result.status), iterations=result.n_iter, cost=result.cost,
             solve_s=result.solve_time,

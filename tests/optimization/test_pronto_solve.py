@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import dataclasses
+import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -160,3 +162,29 @@ def test_fatrop_reaches_the_optimum_of_pronto_and_ipopt(make_problem) -> None:
     if problem.constraints:
         slacks = _constraint_slacks(problem, fatrop.trajectory.states, fatrop.trajectory.inputs)
         assert np.min(slacks) > -1e-7
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None and shutil.which("cc") is None, reason="no C")
+@pytest.mark.parametrize("make_problem", [crossing_problem, obstacle_problem])
+def test_compiled_fatrop_reaches_the_optimum_of_ipopt(
+    make_problem, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """FATROP with the stage Function and its derivatives compiled to C (one library, cached
+    by content) finds IPOPT's hard-constrained optimum from the same start; a second solve
+    loads the cached library and returns the same trajectory."""
+    monkeypatch.setenv("AUVPLAN_CACHE_DIR", str(tmp_path))
+    problem = make_problem()
+    start = solve_pronto(problem, zero_guess(problem)).trajectory
+    compiled = solve_fatrop(problem, start, compiled=True)
+    libraries = list((tmp_path / "casadi").glob("auvplan_*.so"))
+    assert len(libraries) == 1  # compiled to C, not left on the virtual machine
+    ipopt = solve_ipopt(problem, start)
+    assert compiled.success, compiled.message
+    assert compiled.max_defect < 1e-7
+    assert compiled.cost == pytest.approx(ipopt.cost, rel=1e-6)
+    np.testing.assert_allclose(compiled.trajectory.inputs, ipopt.trajectory.inputs, atol=1e-4)
+    slacks = _constraint_slacks(problem, compiled.trajectory.states, compiled.trajectory.inputs)
+    assert np.min(slacks) > -1e-7
+    again = solve_fatrop(problem, start, compiled=True)
+    assert list((tmp_path / "casadi").glob("auvplan_*.so")) == libraries
+    np.testing.assert_array_equal(again.trajectory.states, compiled.trajectory.states)

@@ -16,8 +16,21 @@ depends on ``x_k, u_k`` and ``x_{k+1}`` only).
   independent reference of the tests and benchmarks.
 - :func:`solve_fatrop`: FATROP (Vanroye et al., IROS 2023), the structure-exploiting interior
   point method shipped in CasADi's wheel: a Riccati recursion over the stages, the same
-  exact Hessian; optionally with the NLP's functions compiled to C (``jit``), as a user
-  would run it for speed.
+  exact Hessian; optionally with the stage function compiled to C, as a user would run it
+  for speed.
+
+Every stage ``k < N`` is one call of a single stage Function
+``(x_k, u_k, p_k) -> (F(x_k, u_k, p_k), L(x_k, u_k, p_k), c(x_k, u_k, p_k) / scale)``
+(the step, the stage cost and all path constraints stacked; ``p`` is not differentiated),
+mapped over the ``N`` stages, so the NLP's expression graph holds one mapped call and its
+derivatives whatever ``N``. Compiled (``compiled=True``), the stage Function and the two
+derivatives CasADi's AD of the mapped graph asks of it are generated into one C file and
+loaded with ``casadi.external`` (:func:`~auvplan.optimization._compile.compile_functions`,
+cached by content hash): the Jacobian ``jac_<stage>`` (the constraint Jacobian's blocks
+``∂(F, L, c)/∂(x, u)``) and, of its adjoint ``adj1_<stage>`` (``λᵀ∂(F, L, c)/∂(x, u)``),
+the Jacobian ``jac_adj1_<stage>``, which holds the stage block of the Hessian of the
+Lagrangian ``∇²_{(x,u)} (σ L + λ_Fᵀ F + λ_cᵀ c)``. The ``N`` stages then cost ``N``
+compiled calls per evaluation; nothing of size ``N`` is compiled.
 """
 
 from __future__ import annotations
@@ -31,8 +44,9 @@ import casadi as ca
 import numpy as np
 
 from auvplan.errors import InputError
+from auvplan.optimization._compile import compile_functions
 from auvplan.optimization.barrier import BarrierKind, barrier_expression
-from auvplan.optimization.discretization import discretize_rk4
+from auvplan.optimization.discretization import DiscreteModel, discretize_rk4
 from auvplan.optimization.problem import Trajectory, TrajectoryProblem
 
 __all__ = ["IpoptResult", "IpoptStatus", "solve_fatrop", "solve_ipopt"]
@@ -141,7 +155,7 @@ def solve_ipopt(
         "ipopt.tol": tol,
         "ipopt.max_iter": max_iter,
     }
-    return _solve(problem, guess, "ipopt", options, barrier, hard_constraints)
+    return _solve(problem, guess, "ipopt", options, barrier, hard_constraints, compiled=False)
 
 
 def solve_fatrop(
@@ -158,27 +172,23 @@ def solve_fatrop(
     """Solve the discretised problem with FATROP (module notes), as :func:`solve_ipopt`.
 
     FATROP detects the NLP's stage structure (``structure_detection = "auto"``, the rows'
-    ``equality`` flags); ``compiled=True`` has CasADi generate C for the NLP's functions and
-    compile them with the system compiler (``jit``, ``gcc -O1``) before solving. ``tol`` is
-    FATROP's ``tol``; ``expand`` as for :func:`solve_ipopt` (an expanded NLP of thousands of
-    stacked-fleet stages takes more than 10 GB to build and compile: keep it mapped there).
-    Parameters, returns and errors otherwise as for :func:`solve_ipopt`.
+    ``equality`` flags). ``compiled=True`` compiles the stage Function and its derivatives to
+    C with the system compiler (``gcc -O1``, module notes; a one-off per model, cached on
+    disk) and keeps the NLP mapped (``expand`` is then ignored: a compiled Function cannot be
+    expanded); without a working compiler the stage Function stays on CasADi's virtual
+    machine. ``tol`` is FATROP's ``tol``; ``expand`` as for :func:`solve_ipopt` (an expanded
+    NLP of thousands of stacked-fleet stages takes more than 10 GB to build: keep it mapped
+    there). Parameters, returns and errors otherwise as for :func:`solve_ipopt`.
     """
     options: dict[str, Any] = {
-        "expand": expand,
+        "expand": expand and not compiled,
         "structure_detection": "auto",
         "debug": False,
         "fatrop.print_level": 0,
         "fatrop.tol": tol,
         "fatrop.max_iter": max_iter,
     }
-    if compiled:
-        options |= {
-            "jit": True,
-            "compiler": "shell",
-            "jit_options": {"flags": ["-O1"], "verbose": False},
-        }
-    return _solve(problem, guess, "fatrop", options, barrier, hard_constraints)
+    return _solve(problem, guess, "fatrop", options, barrier, hard_constraints, compiled=compiled)
 
 
 #: IPOPT's return statuses by name (FATROP reports a number and ``success``).
@@ -196,6 +206,8 @@ def _solve(
     options: dict[str, Any],
     barrier: tuple[float, float] | None,
     hard_constraints: bool,
+    *,
+    compiled: bool,
 ) -> IpoptResult:
     """Build the stage-ordered NLP (module notes) and solve it with CasADi's ``plugin``."""
     start = time.perf_counter()
@@ -211,20 +223,26 @@ def _solve(
     model = discretize_rk4(
         problem.dynamics, problem.running_cost, problem.dt, n_substeps=problem.n_substeps
     )
+    stage = _stage_function(problem, model)
+    if compiled:
+        stage = compile_functions(_with_derivatives(stage))["stage"]
     params = problem.parameters.T
     state_symbols = [ca.MX.sym(f"x{k}", n_x) for k in range(n_steps + 1)]
     input_symbols = [ca.MX.sym(f"u{k}", n_u) for k in range(n_steps)]
     states, inputs = ca.horzcat(*state_symbols), ca.horzcat(*input_symbols)
     current, following = states[:, :n_steps], states[:, 1:]
-    defects = following - model.step_function.map(n_steps, "serial")(current, inputs, params)
-    running = ca.sum2(model.cost_function.map(n_steps, "serial")(current, inputs, params))
+    next_states, stage_costs, all_slacks = stage.map(n_steps, "serial")(current, inputs, params)
+    defects = following - next_states
+    running = ca.sum2(stage_costs)
     terminal = problem.terminal_cost(states[:, n_steps])
     barrier_term: ca.MX = ca.MX(0)
     stage_rows: list[ca.MX] = [defects]  # (rows, N): column k holds stage k's rows
     final_rows: list[ca.MX] = []
+    first_row = 0
     for constraint in problem.constraints:
-        slack = constraint.function.map(n_steps, "serial")(current, inputs, params)
-        slacks = [slack / constraint.scale]
+        n_rows_i = int(constraint.function.size1_out(0))
+        slacks = [all_slacks[first_row : first_row + n_rows_i, :]]
+        first_row += n_rows_i
         final = np.flatnonzero(constraint.at_final_node).tolist()
         if final:  # the components free of u also hold at x_N (last input and parameters)
             at_end = constraint.function(
@@ -289,3 +307,39 @@ def _solve(
         solve_time=solve_time,
         max_defect=float(np.max(np.abs(np.asarray(defect.full())))),
     )
+
+
+def _stage_function(problem: TrajectoryProblem, model: DiscreteModel) -> ca.Function:
+    """``(x, u, p) -> (x_next, l, slacks)`` of one stage: ``F``, ``L`` and every ``c / scale``.
+
+    ``slacks`` stacks the path constraints' rows in the order of ``problem.constraints``.
+    The stage parameter ``p`` is declared not differentiable (``is_diff_in``): the NLP
+    holds it fixed, so no derivative with respect to it is built or compiled.
+    """
+    functions = model.functions
+    x, u, p = functions.x, functions.u, functions.p
+    slacks = [c.function(x, u, p) / c.scale for c in problem.constraints]
+    return ca.Function(
+        "auvplan_nlp_stage",
+        [x, u, p],
+        [functions.x_next, functions.stage_cost, ca.vertcat(x[:0], *slacks)],  # x[:0]: 0 × 1
+        ["x", "u", "p"],
+        ["x_next", "l", "slacks"],
+        {"is_diff_in": [True, True, False]},
+    )
+
+
+def _with_derivatives(stage: ca.Function) -> dict[str, ca.Function]:
+    """``stage`` and the derivatives CasADi's AD of a mapped call asks of it (module notes).
+
+    ``casadi.external`` finds them in the library by name: ``jac_<stage>`` (constraint
+    Jacobian, objective gradient) and ``adj1_<stage>`` with its own ``jac_adj1_<stage>``
+    (Hessian of the Lagrangian).
+    """
+    adjoint = stage.reverse(1)
+    return {
+        "stage": stage,
+        "jacobian": stage.jacobian(),
+        "adjoint": adjoint,
+        "adjoint_jacobian": adjoint.jacobian(),
+    }
