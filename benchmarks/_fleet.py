@@ -115,10 +115,11 @@ def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, An
     building the model: loading or compiling kernels). ``ipopt``/``ipopt-mx``: CasADi + IPOPT
     on the same discretised problem from PRONTO's projected initial trajectory, hard
     constraints, the NLP expanded to SX (fastest evaluation, memory grows with the horizon) or
-    kept as MX; ``fatrop``/``fatrop-c``: CasADi + FATROP alike on the MX NLP (expanded, the
-    crossing's took > 10 GB to build and compile), its stage Function on CasADi's virtual
-    machine or compiled to C with its derivatives (cached in ``AUVPLAN_CACHE_DIR``: the first
-    run's ``wall_s − solve_s`` includes the compilation; ``solve_s``: the solve alone).
+    kept as MX (``ipopt-c``: MX with the stage Function compiled to C with its derivatives,
+    cached in ``AUVPLAN_CACHE_DIR``: the first run's ``wall_s − solve_s`` includes the
+    compilation); ``fatrop``/``fatrop-c``: CasADi + FATROP alike on the MX NLP (expanded, the
+    crossing's took > 10 GB to build and compile), the stage Function on CasADi's virtual
+    machine or compiled (``solve_s``: the solve alone).
     ``max_iter`` caps the solver's iterations (for per-iteration timing).
     """
     with tempfile.TemporaryDirectory() as scratch:
@@ -135,10 +136,11 @@ def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, An
         initial, _ = project_guess(ModelCache().get(problem), guess, options)
         started = time.perf_counter()
         cap = {} if max_iter is None else {"max_iter": max_iter}
+        compiled = solver.endswith("-c")
         if solver.startswith("ipopt"):
-            result = solve_ipopt(problem, initial, expand=solver == "ipopt", **cap)
+            expand = solver == "ipopt"
+            result = solve_ipopt(problem, initial, expand=expand, compiled=compiled, **cap)
         else:
-            compiled = solver == "fatrop-c"
             result = solve_fatrop(problem, initial, expand=False, compiled=compiled, **cap)
         record.update(
             status=str(result.status), iterations=result.n_iter, cost=result.cost,

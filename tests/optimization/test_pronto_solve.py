@@ -166,16 +166,18 @@ def test_fatrop_reaches_the_optimum_of_pronto_and_ipopt(make_problem) -> None:
 
 @pytest.mark.skipif(shutil.which("gcc") is None and shutil.which("cc") is None, reason="no C")
 @pytest.mark.parametrize("make_problem", [crossing_problem, obstacle_problem])
-def test_compiled_fatrop_reaches_the_optimum_of_ipopt(
-    make_problem, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+@pytest.mark.parametrize("solve", [solve_fatrop, solve_ipopt])
+def test_compiled_solvers_reach_the_optimum_of_ipopt(
+    make_problem, solve, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """FATROP with the stage Function and its derivatives compiled to C (one library, cached
-    by content) finds IPOPT's hard-constrained optimum from the same start; a second solve
-    loads the cached library and returns the same trajectory."""
+    """FATROP and IPOPT with the stage Function and its derivatives compiled to C (one
+    library, cached by content) find the hard-constrained optimum of IPOPT on CasADi's
+    virtual machine from the same start; a second solve loads the cached library and
+    returns the same trajectory."""
     monkeypatch.setenv("AUVPLAN_CACHE_DIR", str(tmp_path))
     problem = make_problem()
     start = solve_pronto(problem, zero_guess(problem)).trajectory
-    compiled = solve_fatrop(problem, start, compiled=True)
+    compiled = solve(problem, start, compiled=True)
     libraries = list((tmp_path / "casadi").glob("auvplan_*.so"))
     assert len(libraries) == 1  # compiled to C, not left on the virtual machine
     ipopt = solve_ipopt(problem, start)
@@ -185,6 +187,6 @@ def test_compiled_fatrop_reaches_the_optimum_of_ipopt(
     np.testing.assert_allclose(compiled.trajectory.inputs, ipopt.trajectory.inputs, atol=1e-4)
     slacks = _constraint_slacks(problem, compiled.trajectory.states, compiled.trajectory.inputs)
     assert np.min(slacks) > -1e-7
-    again = solve_fatrop(problem, start, compiled=True)
+    again = solve(problem, start, compiled=True)
     assert list((tmp_path / "casadi").glob("auvplan_*.so")) == libraries
     np.testing.assert_array_equal(again.trajectory.states, compiled.trajectory.states)

@@ -16,17 +16,19 @@ depends on ``x_k, u_k`` and ``x_{k+1}`` only).
   independent reference of the tests and benchmarks.
 - :func:`solve_fatrop`: FATROP (Vanroye et al., IROS 2023), the structure-exploiting interior
   point method shipped in CasADi's wheel: a Riccati recursion over the stages, the same
-  exact Hessian; optionally with the stage function compiled to C, as a user would run it
-  for speed.
+  exact Hessian.
 
 Every stage ``k < N`` is one call of a single stage Function
 ``(x_k, u_k, p_k) -> (F(x_k, u_k, p_k), L(x_k, u_k, p_k), c(x_k, u_k, p_k) / scale)``
 (the step, the stage cost and all path constraints stacked; ``p`` is not differentiated),
 mapped over the ``N`` stages, so the NLP's expression graph holds one mapped call and its
-derivatives whatever ``N``. Compiled (``compiled=True``), the stage Function and the two
-derivatives CasADi's AD of the mapped graph asks of it are generated into one C file and
-loaded with ``casadi.external`` (:func:`~auvplan.optimization._compile.compile_functions`,
-cached by content hash): the Jacobian ``jac_<stage>`` (the constraint Jacobian's blocks
+derivatives whatever ``N``. Either solver optionally compiles it, as a user would run it for
+speed (``compiled=True``): the stage Function and the two derivatives CasADi's AD of the
+mapped graph asks of it are generated into one C file, compiled with the system compiler
+(``gcc -O1``, cached by content hash:
+:func:`~auvplan.optimization._compile.compile_functions`; without a working compiler the
+stage Function stays on CasADi's virtual machine) and loaded with ``casadi.external``, which
+finds them by name: the Jacobian ``jac_<stage>`` (the constraint Jacobian's blocks
 ``∂(F, L, c)/∂(x, u)``) and, of its adjoint ``adj1_<stage>`` (``λᵀ∂(F, L, c)/∂(x, u)``),
 the Jacobian ``jac_adj1_<stage>``, which holds the stage block of the Hessian of the
 Lagrangian ``∇²_{(x,u)} (σ L + λ_Fᵀ F + λ_cᵀ c)``. The ``N`` stages then cost ``N``
@@ -114,6 +116,7 @@ def solve_ipopt(
     tol: float = 1e-10,
     max_iter: int = 3000,
     expand: bool = True,
+    compiled: bool = False,
 ) -> IpoptResult:
     """Solve the discretised problem with IPOPT (multiple shooting, MUMPS, exact Hessian).
 
@@ -134,6 +137,9 @@ def solve_ipopt(
     expand : bool
         Expand the NLP to SX before solving (slow to build for long horizons, fast to
         evaluate); ``False`` keeps CasADi's mapped MX graph (fast to build).
+    compiled : bool
+        Compile the stage Function and its derivatives to C (module notes; cached on disk)
+        and keep the NLP mapped (``expand`` is then ignored).
 
     Returns
     -------
@@ -147,7 +153,7 @@ def solve_ipopt(
         problem has node costs (not CasADi expressions, so not in the NLP).
     """
     options: dict[str, Any] = {
-        "expand": expand,
+        "expand": expand and not compiled,
         "ipopt.print_level": 0,
         "ipopt.sb": "yes",
         "ipopt.linear_solver": "mumps",
@@ -155,7 +161,7 @@ def solve_ipopt(
         "ipopt.tol": tol,
         "ipopt.max_iter": max_iter,
     }
-    return _solve(problem, guess, "ipopt", options, barrier, hard_constraints, compiled=False)
+    return _solve(problem, guess, "ipopt", options, barrier, hard_constraints, compiled=compiled)
 
 
 def solve_fatrop(
@@ -172,13 +178,10 @@ def solve_fatrop(
     """Solve the discretised problem with FATROP (module notes), as :func:`solve_ipopt`.
 
     FATROP detects the NLP's stage structure (``structure_detection = "auto"``, the rows'
-    ``equality`` flags). ``compiled=True`` compiles the stage Function and its derivatives to
-    C with the system compiler (``gcc -O1``, module notes; a one-off per model, cached on
-    disk) and keeps the NLP mapped (``expand`` is then ignored: a compiled Function cannot be
-    expanded); without a working compiler the stage Function stays on CasADi's virtual
-    machine. ``tol`` is FATROP's ``tol``; ``expand`` as for :func:`solve_ipopt` (an expanded
-    NLP of thousands of stacked-fleet stages takes more than 10 GB to build: keep it mapped
-    there). Parameters, returns and errors otherwise as for :func:`solve_ipopt`.
+    ``equality`` flags). ``tol`` is FATROP's ``tol``; ``expand`` and ``compiled`` as for
+    :func:`solve_ipopt` (an expanded NLP of thousands of stacked-fleet stages takes more than
+    10 GB to build: keep it mapped there). Parameters, returns and errors otherwise as for
+    :func:`solve_ipopt`.
     """
     options: dict[str, Any] = {
         "expand": expand and not compiled,
