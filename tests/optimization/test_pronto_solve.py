@@ -6,6 +6,7 @@ import dataclasses
 import shutil
 from pathlib import Path
 
+import casadi as ca
 import numpy as np
 import pytest
 
@@ -19,6 +20,7 @@ from auvplan.optimization import (
     solve_ipopt,
     solve_pronto,
 )
+from auvplan.optimization.reference import _objective_scale
 
 from ._problems import (
     crossing_problem,
@@ -190,3 +192,12 @@ def test_compiled_solvers_reach_the_optimum_of_ipopt(
     again = solve(problem, start, compiled=True)
     assert list((tmp_path / "casadi").glob("auvplan_*.so")) == libraries
     np.testing.assert_array_equal(again.trajectory.states, compiled.trajectory.states)
+
+
+def test_fatrop_objective_scale_is_ipopts_gradient_rule() -> None:
+    """``σ_f = min(1, 100 / ‖∇f(w_0)‖_∞)``: a gradient of 2000 is scaled by 0.05, one
+    within 100 is left alone."""
+    w = ca.MX.sym("w", 2)
+    steep = 1000.0 * w[0] ** 2 + w[1]  # ∇f(1, 0) = (2000, 1)
+    assert _objective_scale(steep, w, np.array([1.0, 0.0])) == pytest.approx(0.05)
+    assert _objective_scale(w[0] ** 2, w, np.array([3.0, 0.0])) == 1.0
