@@ -260,8 +260,8 @@ CASES: dict[str, tuple[Callable[[Path], list[str]], str]] = {
         _plan_demo(lambda mission: mission + "\n[mission]\ndepth_m = 5000.0\n"),
         (
             "auvplan: error: mission.depth_m = 5000 m is not above the seabed along blue's path "
-            "(seabed 22.9 m deep at north 308 m, east 415 m; the deepest seabed is 43.5 m along "
-            "the paths and 60.0 m over the map): give depth_m < 22.8 m"
+            "(seabed 22.5 m deep at north 325 m, east 402 m; the deepest seabed is 43.5 m along "
+            "the paths and 60.0 m over the map): give depth_m < 22.5 m"
         ),
     ),
     "safety_radius_m = 1e-15": (

@@ -16,24 +16,6 @@ there before (``closed[cell]`` keeps the lowest closed bin). A label is thus exp
 it is better in error than every cheaper label at its cell: at most ``n_bins`` per cell.
 After the settling distance a move whose predicted σ exceeds ``max_error`` is not made.
 
-Ties. Unit-cost grids have many labels of exactly equal key (routes of the same moves in
-another order), and which of them pops first decides, through the bin dominance that ignores
-everything but σ, which route is kept. The heap therefore orders labels by the compound key
-
-.. math:: (\text{key},\ \sigma^2,\ \text{peak},\ \text{label number})
-
-lexicographically: among equal keys the lower σ first (the lower bin, then the lower σ within
-it), then the lower peak error, then the label created first. The order is total and does not
-depend on the heap's layout; the label number only ranks labels identical in cost and error.
-
-Push-time dominance. A new label is not even created when a label already queued at its cell
-pops before it in that order and is in no higher bin: that label closes the cell at its bin
-when it pops, so the new one would be skipped. Two queued labels per cell are kept for the
-comparison, the first in the pop order and the one of the lowest bin (a reference already
-popped has closed the cell at its bin or lower, so it still dominates). The labels created
-keep their relative order (their numbers only lose gaps), so the labels popped and the route
-found are those of the search without this pruning; it only cuts the labels and the heap.
-
 A move ``u → v`` of length ℓ [m] with the move factor ``f`` (e.g. the time ratio in a
 current) costs ``ℓ f (c_u + c_v) / 2 + λ ℓ (σ_u² + σ_v²) / 2`` and takes
 ``n = ℓ · updates_per_metre`` TAN updates: drift over ℓ, white variance ``n q`` and
@@ -108,72 +90,14 @@ def _grow_keys(values: FloatArray, size: int) -> FloatArray:  # pragma: no cover
 
 
 @njit(cache=True)
-def _precedes(
-    table: FloatArray, key_a: float, a: int, key_b: float, b: int
-) -> bool:  # pragma: no cover - compiled
-    """Whether label ``a`` (heap key ``key_a``) pops before label ``b`` (module notes: ties)."""
-    if key_a != key_b:
-        return key_a < key_b
-    variance_a = table[a, _P00] + table[a, _P11]
-    variance_b = table[b, _P00] + table[b, _P11]
-    if variance_a != variance_b:
-        return bool(variance_a < variance_b)
-    if table[a, _PEAK] != table[b, _PEAK]:
-        return bool(table[a, _PEAK] < table[b, _PEAK])
-    return a < b
-
-
-@njit(cache=True)
-def _heap_key(
-    table: FloatArray, label: int, heuristic: float, bottleneck: bool
-) -> float:  # pragma: no cover - compiled
-    """Heap key of ``label``: ``g + h``, or ``peak · 10⁹ + g`` in bottleneck mode."""
-    if bottleneck:
-        return float(table[label, _PEAK] * 1e9 + table[label, _G])
-    return float(table[label, _G] + heuristic)
-
-
-@njit(cache=True)
-def _bin(sigma: float, bin_width: float, n_bins: int) -> int:  # pragma: no cover - compiled
-    """Bin of σ [m]: ``min(⌊σ / Δσ⌋, n_bins − 1)``."""
-    return min(int(sigma / bin_width), n_bins - 1)
-
-
-@njit(cache=True)
-def _dominates(
-    table: FloatArray,
-    reference: int,
-    label: int,
-    key: float,
-    bin_label: int,
-    heuristic: float,
-    bottleneck: bool,
-    bin_width: float,
-    n_bins: int,
-) -> bool:  # pragma: no cover - compiled
-    """Whether ``reference`` pops before ``label`` at their cell in no higher bin.
-
-    ``reference`` ``-1`` is none; ``key`` and ``bin_label`` are ``label``'s, ``heuristic``
-    the cell's (module notes: push-time dominance).
-    """
-    if reference < 0:
-        return False
-    sigma = math.sqrt(table[reference, _P00] + table[reference, _P11])
-    if _bin(sigma, bin_width, n_bins) > bin_label:
-        return False
-    key_reference = _heap_key(table, reference, heuristic, bottleneck)
-    return _precedes(table, key_reference, reference, key, label)
-
-
-@njit(cache=True)
 def _push(
-    table: FloatArray, keys: FloatArray, items: IntArray, size: int, key: float, item: int
+    keys: FloatArray, items: IntArray, size: int, key: float, item: int
 ) -> None:  # pragma: no cover - compiled
     """Sift ``(key, item)`` up from position ``size`` (the caller has room for it)."""
     i = size
     while i > 0:
         parent = (i - 1) >> 1
-        if _precedes(table, keys[parent], items[parent], key, item):
+        if keys[parent] <= key:
             break
         keys[i] = keys[parent]
         items[i] = items[parent]
@@ -183,10 +107,8 @@ def _push(
 
 
 @njit(cache=True)
-def _pop(
-    table: FloatArray, keys: FloatArray, items: IntArray, size: int
-) -> int:  # pragma: no cover - compiled
-    """Remove the first entry (:func:`_precedes`) of a heap of ``size`` and return its item."""
+def _pop(keys: FloatArray, items: IntArray, size: int) -> int:  # pragma: no cover - compiled
+    """Remove the smallest entry of a heap of ``size`` and return its item."""
     top = items[0]
     last_key = keys[size - 1]
     last_item = items[size - 1]
@@ -196,11 +118,9 @@ def _pop(
         child = 2 * i + 1
         if child >= n:
             break
-        if child + 1 < n and _precedes(
-            table, keys[child + 1], items[child + 1], keys[child], items[child]
-        ):
+        if child + 1 < n and keys[child + 1] < keys[child]:
             child += 1
-        if _precedes(table, last_key, last_item, keys[child], items[child]):
+        if keys[child] >= last_key:
             break
         keys[i] = keys[child]
         items[i] = items[child]
@@ -246,9 +166,6 @@ def belief_search(
     """
     offsets, crossed, length = moves(width, spacing_north, spacing_east, n_moves)
     closed = np.full(cost.shape[0], n_bins, np.int32)
-    # queued labels per cell for the push-time dominance: the first to pop, the lowest bin
-    first = np.full(cost.shape[0], -1, np.int64)
-    lowest = np.full(cost.shape[0], -1, np.int64)
     capacity = 1024
     table = np.empty((capacity, 7))
     cells = np.empty(capacity, np.int64)
@@ -265,16 +182,16 @@ def belief_search(
     table[0, _P00], table[0, _P01], table[0, _P11] = j11 / det, -j01 / det, j00 / det
     cells[0], parents[0] = start, -1
     n_labels = 1
-    _push(table, keys, items, heap, _heap_key(table, 0, heuristic[start], bottleneck), 0)
+    _push(keys, items, heap, 0.0 if bottleneck else heuristic[start], 0)
     heap += 1
     found = -1
     while heap > 0:
-        label = _pop(table, keys, items, heap)
+        label = _pop(keys, items, heap)
         heap -= 1
         u = cells[label]
         row = table[label]
         sigma_u = math.sqrt(row[_P00] + row[_P11])
-        bin_u = _bin(sigma_u, bin_width, n_bins)
+        bin_u = min(int(sigma_u / bin_width), n_bins - 1)
         if bin_u >= closed[u]:
             continue
         closed[u] = bin_u
@@ -302,7 +219,7 @@ def belief_search(
                 0.5 * n_updates * (f_u[2] + f_v[2]),
             )  # fmt: skip
             sigma_v = math.sqrt(p00 + p11)
-            bin_v = _bin(sigma_v, bin_width, n_bins)
+            bin_v = min(int(sigma_v / bin_width), n_bins - 1)
             if bin_v >= closed[v]:
                 continue
             distance = row[_DIST] + ell
@@ -313,43 +230,22 @@ def belief_search(
                 peak = max(peak, sigma_v)
             g = row[_G] + ell * move * 0.5 * (cost[u] + c_v)
             g += error_weight * ell * 0.5 * (sigma_u * sigma_u + sigma_v * sigma_v)
+            if n_labels == max_labels:
+                return TOO_MANY_LABELS, np.empty(0, np.int64), np.empty(0), 0.0, 0.0, n_labels
             if n_labels == table.shape[0]:
                 table = _grow_rows(table, n_labels)
                 cells = _grow(cells, n_labels)
                 parents = _grow(parents, n_labels)
-            table[n_labels, _G], table[n_labels, _DIST], table[n_labels, _PEAK] = g, distance, peak
-            table[n_labels, _P00], table[n_labels, _P01], table[n_labels, _P11] = p00, p01, p11
-            table[n_labels, _GROWN] = grown
-            key = _heap_key(table, n_labels, heuristic[v], bottleneck)
-            if _dominates(
-                table, first[v], n_labels, key, bin_v, heuristic[v], bottleneck, bin_width, n_bins
-            ) or _dominates(
-                table, lowest[v], n_labels, key, bin_v, heuristic[v], bottleneck, bin_width, n_bins
-            ):
-                continue
-            if n_labels == max_labels:
-                return TOO_MANY_LABELS, np.empty(0, np.int64), np.empty(0), 0.0, 0.0, n_labels
             if heap == keys.shape[0]:
                 keys = _grow_keys(keys, heap)
                 items = _grow(items, heap)
+            table[n_labels, _G], table[n_labels, _DIST], table[n_labels, _PEAK] = g, distance, peak
+            table[n_labels, _P00], table[n_labels, _P01], table[n_labels, _P11] = p00, p01, p11
+            table[n_labels, _GROWN] = grown
             cells[n_labels], parents[n_labels] = v, label
-            _push(table, keys, items, heap, key, n_labels)
+            key = peak * 1e9 + g if bottleneck else g + heuristic[v]
+            _push(keys, items, heap, key, n_labels)
             heap += 1
-            # not dominated: it is in a lower bin than the references, or pops before them
-            reference = first[v]
-            if reference < 0 or _precedes(
-                table,
-                key,
-                n_labels,
-                _heap_key(table, reference, heuristic[v], bottleneck),
-                reference,
-            ):
-                first[v] = n_labels
-            reference = lowest[v]
-            if reference < 0 or bin_v <= _bin(
-                math.sqrt(table[reference, _P00] + table[reference, _P11]), bin_width, n_bins
-            ):
-                lowest[v] = n_labels
             n_labels += 1
     if found < 0:
         return UNREACHABLE, np.empty(0, np.int64), np.empty(0), 0.0, 0.0, n_labels
