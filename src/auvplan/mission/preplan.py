@@ -16,6 +16,7 @@ from auvplan._typing import BoolArray, FloatArray
 from auvplan.deconfliction import check_endpoint_clearance
 from auvplan.errors import InfeasibleError, InputError
 from auvplan.io.bathymetry import read_bathymetry
+from auvplan.mission.comm_routes import comm_corridor, comm_margin
 from auvplan.mission.config import (
     CommConfig,
     MapsConfig,
@@ -379,6 +380,7 @@ def plan_routes(
     current: CurrentField | None = None,
     water_speeds: FloatArray | None = None,
     navigation: tuple[VehicleNavigation, ...] | None = None,
+    comms: tuple[CommConfig, ...] = (),
     progress: ProgressReporter = no_progress,
 ) -> tuple[tuple[Route, ...], tuple[FloatArray, ...], tuple[NavigationChoice, ...] | None]:
     """One A* route per vehicle on the shifted cost map, and its smoothed curve.
@@ -404,7 +406,8 @@ def plan_routes(
     if navigation is not None:  # length is the energy proxy
         cost = np.where(np.isfinite(cost), 1.0, np.nan)
     edge_model = EdgeModel.CROSSED if navigation is not None else EdgeModel(planner.edge_model)
-    routes, paths, choices = [], [], []
+    routes, choices = [], []
+    paths: list[FloatArray] = []
     with progress("A*", total=len(names)) as advance:
         for index, name in enumerate(names):
             factor = (
@@ -439,11 +442,30 @@ def plan_routes(
                     return one(None), None
                 return navigation[index].route(one)
 
-            keep_out = goal_keep_outs(starts, goals, index, clearance, cell)
-            try:
-                route, choice = search(keep_out)
-            except InfeasibleError:  # the keep-outs close every way: timing must do it
-                (route, choice), keep_out = search(()), ()
+            radius = 0.0 if turning_radii is None else float(turning_radii[index])
+            deviation = max(0.5 * cell, CORNER_CUT * radius)
+            corridor = comm_corridor(
+                index, names, comms, paths, starts, goals,
+                geometry=geometry, clearance=clearance, deviation=deviation,
+            )  # fmt: skip
+            # the keep-outs may close every way (then timing must do it), and so may a corridor
+            keep_outs = goal_keep_outs(starts, goals, index, clearance, cell)
+            attempts = list(dict.fromkeys(
+                [(keep_outs, corridor), ((), corridor), (keep_outs, ()), ((), ())]
+            ))  # fmt: skip
+            for number, (keep_out, within) in enumerate(attempts, start=1):
+                try:
+                    route, choice = search(keep_out + within)
+                    break
+                except InfeasibleError:
+                    if number == len(attempts):
+                        raise
+            if corridor and not within:
+                logger.warning(
+                    "%s: no route stays %.0f m inside the communication range of its "
+                    "partner's path; routed regardless, the optimiser may not keep them in range",
+                    name, comm_margin(clearance, deviation),
+                )  # fmt: skip
             routes.append(route)
             if choice is not None:
                 clear = _straight_clear(
@@ -459,11 +481,10 @@ def plan_routes(
                 )  # fmt: skip
             choices.append(choice)
             # near the route, never through a no-go cell nor within 2 r_c of a kept-out goal
-            radius = 0.0 if turning_radii is None else float(turning_radii[index])
             path = smooth_path(
                 _lead_in(route.points, float(courses[index]), radius, 0.25 * cell, is_blocked),
                 spacing=0.25 * cell,
-                max_deviation=max(0.5 * cell, CORNER_CUT * radius),
+                max_deviation=deviation,
                 is_blocked=_with_discs(is_blocked, keep_out, 2.0 * clearance + 0.25 * cell),
             )
             paths.append(_skirt_goals(path, goals, index, clearance, cell, is_blocked))
@@ -522,6 +543,7 @@ def run_preplan(config: MissionConfig, *, progress: ProgressReporter = no_progre
         start_courses=courses_over_ground(starts, start_speeds, current),
         current=current,
         navigation=navigation,
+        comms=config.comms,
         water_speeds=None if current is None else np.array(
             [cruise if cruise is not None else optimal_cruise_speed(model).speed
              for model in models]
