@@ -71,6 +71,22 @@ def _clip_in_place(matrix: FloatArray, floor: float) -> None:
 
 
 @numba.njit(cache=True)
+def _root(parent: IntArray, block: int) -> int:
+    """Root of ``block`` in the union-find forest ``parent``."""
+    while parent[block] != block:
+        block = parent[block]
+    return block
+
+
+@numba.njit(cache=True)
+def _merge(parent: IntArray, a: int, b: int) -> None:
+    """Join the trees of ``a`` and ``b`` (the smaller root becomes the root)."""
+    a, b = _root(parent, a), _root(parent, b)
+    if a != b:
+        parent[max(a, b)] = min(a, b)
+
+
+@numba.njit(cache=True)
 def _coupled_components(stage: FloatArray, owner: IntArray, n_groups: int) -> IntArray:
     """Root group of every group, merging groups joined by a nonzero entry of ``stage``.
 
@@ -86,18 +102,9 @@ def _coupled_components(stage: FloatArray, owner: IntArray, n_groups: int) -> In
             if owner[i] < 0 or owner[j] < 0:
                 parent[:] = 0
                 return parent
-            a, b = owner[i], owner[j]
-            while parent[a] != a:
-                a = parent[a]
-            while parent[b] != b:
-                b = parent[b]
-            if a != b:
-                parent[max(a, b)] = min(a, b)
+            _merge(parent, owner[i], owner[j])
     for g in range(n_groups):
-        root = g
-        while parent[root] != root:
-            root = parent[root]
-        parent[g] = root
+        parent[g] = _root(parent, g)
     return parent
 
 
@@ -246,13 +253,6 @@ def _times_block_diagonal(
 
 
 @numba.njit(cache=True)
-def _root(parent: IntArray, block: int) -> int:
-    while parent[block] != block:
-        block = parent[block]
-    return block
-
-
-@numba.njit(cache=True)
 def _join_coupled(
     matrix: FloatArray, row_block: IntArray, column_block: IntArray, parent: IntArray
 ) -> None:
@@ -260,9 +260,7 @@ def _join_coupled(
     for i in range(matrix.shape[0]):
         for j in range(matrix.shape[1]):
             if matrix[i, j] != 0.0 and row_block[i] != column_block[j]:
-                a, b = _root(parent, row_block[i]), _root(parent, column_block[j])
-                if a != b:
-                    parent[max(a, b)] = min(a, b)
+                _merge(parent, row_block[i], column_block[j])
 
 
 @numba.njit(cache=True)
