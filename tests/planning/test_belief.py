@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import heapq
 import itertools
 import math
 
@@ -133,3 +134,138 @@ def test_mismatched_fisher_map_and_label_limit_are_input_errors() -> None:
     limited = BeliefModel(np.zeros((10, 10, 3)), 0.2, 0.01, 0.0, 3.0, max_labels=5)
     with pytest.raises(InputError, match="more than 5 labels"):
         search_belief(problem, limited)
+
+
+#: Moves in the kernel's order (:func:`auvplan.planning._belief_kernel.moves`): the label
+#: numbers, the last tie-break, follow it.
+KERNEL_MOVES = [
+    (-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1),
+    (-2, -1), (-2, 1), (-1, -2), (-1, 2), (1, -2), (1, 2), (2, -1), (2, 1),
+]  # fmt: skip
+
+
+def _label_setting(
+    problem: PlanningProblem, model: BeliefModel, *, bottleneck: bool = False
+) -> tuple[list[tuple[int, int]], float, int]:
+    """Label setting with the σ-bin dominance and no other pruning, popped with ``heapq`` in
+    the order ``(key, σ², peak, label number)``: the path, its cost and the labels created."""
+    cost, fisher, spacing = problem.cost, model.fisher, problem.spacing_north
+    n_rows, n_cols = cost.shape
+    width = model.bin_width if bottleneck else model.width
+    n_bins = 160 if bottleneck else model.n_bins
+    max_error = math.inf if bottleneck else model.max_error
+    goal = np.array(problem.goal)
+    rate = float(np.min(cost[np.isfinite(cost)]))
+    heuristic = rate * np.hypot(*((np.indices(cost.shape) - goal[:, None, None]) * spacing))
+
+    def bin_of(variance: float) -> int:
+        return min(int(math.sqrt(variance) / width), n_bins - 1)
+
+    f = fisher[problem.start]
+    info = np.diag([1.0, 1.0]) / model.initial_sigma**2 + [[f[0], f[1]], [f[1], f[2]]]
+    det = info[0, 0] * info[1, 1] - info[0, 1] ** 2
+    # label: cell, parent, g, p00, p01, p11, grown, distance, peak
+    labels = [(problem.start, -1, 0.0, info[1, 1] / det, -info[0, 1] / det, info[0, 0] / det)]
+    labels[0] += (0.0, 0.0, 0.0)
+    heap = [
+        (
+            0.0 if bottleneck else float(heuristic[problem.start]),
+            labels[0][3] + labels[0][5],
+            0.0,
+            0,
+        )
+    ]
+    closed = np.full(cost.shape, n_bins)
+    while heap:
+        *_, label = heapq.heappop(heap)
+        (r, c), _, g, p00, p01, p11, grown, distance, peak = labels[label]
+        if bin_of(p00 + p11) >= closed[r, c]:
+            continue
+        closed[r, c] = bin_of(p00 + p11)
+        if (r, c) == problem.goal:
+            path = []
+            while label >= 0:
+                path.append(labels[label][0])
+                label = labels[label][1]
+            return path[::-1], g, len(labels)
+        for dr, dc in KERNEL_MOVES:
+            v = (r + dr, c + dc)
+            cells = [v, *_crossed(r, c, dr, dc)]
+            if not all(
+                0 <= a < n_rows and 0 <= b < n_cols and np.isfinite(cost[a, b]) for a, b in cells
+            ):
+                continue
+            ell = math.hypot(dr * spacing, dc * spacing)
+            n = ell * model.updates_per_metre
+            q00, q01, q11, q_grown = propagate(
+                p00, p01, p11, grown, model.drift_rate**2, ell, n * model.process_variance,
+                *(0.5 * n * (fisher[r, c] + fisher[v])),
+            )  # fmt: skip
+            sigma_v = math.sqrt(q00 + q11)
+            if bin_of(q00 + q11) >= closed[v]:
+                continue
+            q_peak = peak
+            if distance + ell > model.settle_distance:
+                if sigma_v > max_error:
+                    continue
+                q_peak = max(peak, sigma_v)
+            sigma_u = math.sqrt(p00 + p11)
+            q_g = g + ell * 1.0 * 0.5 * (cost[r, c] + cost[v])
+            q_g += model.error_weight * ell * 0.5 * (sigma_u * sigma_u + sigma_v * sigma_v)
+            key = q_peak * 1e9 + q_g if bottleneck else q_g + heuristic[v]
+            heapq.heappush(heap, (key, q00 + q11, q_peak, len(labels)))
+            labels.append((v, label, q_g, q00, q01, q11, q_grown, distance + ell, q_peak))
+    return [], math.inf, len(labels)
+
+
+@pytest.mark.parametrize("informative_side", ["north", "south"])
+def test_of_exactly_tied_routes_the_search_keeps_the_one_of_lower_sigma(
+    informative_side: str,
+) -> None:
+    # a wall across the middle: the routes north and south of it are mirror images (equal
+    # costs to the last bit); only the south one crosses informative seabed. A budget that
+    # never binds gives the search its σ bins (plain A*, one bin, breaks ties by key only)
+    cost = np.ones((11, 21))
+    cost[2:9, 10] = np.nan
+    fisher = np.zeros((11, 21, 3))
+    fisher[9:, :, 0] = fisher[9:, :, 2] = 0.05
+    if informative_side == "north":
+        fisher = fisher[::-1].copy()
+    problem = PlanningProblem(cost, None, (5, 0), (5, 20), 10.0, 10.0)
+    found = search_belief(problem, _model(fisher, max_error=100.0))
+    rows = found.path.cells[:, 0]
+    assert (rows.max() >= 9) if informative_side == "south" else (rows.min() <= 1)
+    mirrored = search_belief(problem, _model(fisher[::-1].copy(), max_error=100.0))
+    assert found.path.cost == mirrored.path.cost
+    np.testing.assert_array_equal(mirrored.path.cells[:, 0], 10 - rows)
+    assert found.sigma[-1] < _replay_sigma(mirrored.path.cells, _model(fisher), 10.0)[-1]
+
+
+@pytest.mark.parametrize(
+    ("seed", "options", "bottleneck"),
+    [
+        (0, {"max_error": 6.0, "settle_distance": 40.0}, False),
+        (1, {"max_error": 9.0, "settle_distance": 40.0, "error_weight": 0.02}, False),
+        (2, {"error_weight": 0.05}, False),
+        (3, {"settle_distance": 40.0}, True),
+    ],
+)
+def test_the_search_pops_labels_in_the_order_of_a_plain_label_setting(
+    seed: int, options: dict[str, float], bottleneck: bool
+) -> None:
+    # unit costs: many labels of exactly equal cost, ordered by σ, peak and label number; the
+    # kernel's push-time dominance must not change which labels pop, only how many are made
+    rng = np.random.default_rng(seed)
+    cost = np.ones((12, 16))
+    cost[rng.uniform(size=cost.shape) < 0.12] = np.nan
+    cost[6, 0] = cost[5, 15] = 1.0
+    fisher = np.zeros((12, 16, 3))
+    fisher[..., 0] = fisher[..., 2] = rng.uniform(0.0, 0.3, cost.shape) ** 3
+    model = _model(fisher, **options)
+    problem = PlanningProblem(cost, None, (6, 0), (5, 15), 10.0, 10.0)
+    found = search_belief(problem, model, bottleneck=bottleneck)
+    path, expected_cost, n_reference = _label_setting(problem, model, bottleneck=bottleneck)
+    assert found.path.success
+    assert found.path.cells.tolist() == [list(cell) for cell in path]
+    assert found.path.cost == expected_cost
+    assert found.n_labels < n_reference  # the push-time dominance created fewer labels

@@ -64,12 +64,12 @@ def propagate(
     p11 += increment
     grown += drift
     before = p00 + p11
-    det = p00 * p11 - p01 * p01
-    j00 = p11 / det + f00
-    j01 = -p01 / det + f01
-    j11 = p00 / det + f11
-    det_j = j00 * j11 - j01 * j01
-    q00, q01, q11 = j11 / det_j, 0.0 - j01 / det_j, j00 / det_j
+    inverse = 1.0 / (p00 * p11 - p01 * p01)
+    j00 = p11 * inverse + f00
+    j01 = f01 - p01 * inverse
+    j11 = p00 * inverse + f11
+    inverse = 1.0 / (j00 * j11 - j01 * j01)
+    q00, q01, q11 = j11 * inverse, 0.0 - j01 * inverse, j00 * inverse
     return q00, q01, q11, grown * (q00 + q11) / before
 
 

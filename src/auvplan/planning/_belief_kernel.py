@@ -7,7 +7,7 @@ move by move), the distance travelled
 [m] and the peak radial error after the settling distance. Its bin is
 ``min(⌊σ / Δσ⌋, n_bins − 1)`` with :math:`\sigma = \sqrt{\operatorname{tr} P}`.
 
-Labels are popped from a binary heap in order of ``key``: ``g + h`` (cost mode, A* with the
+Labels are popped from a heap in order of ``key``: ``g + h`` (cost mode, A* with the
 consistent heuristic ``h`` of :mod:`auvplan.planning._kernel`), or the peak error (bottleneck
 mode, ties broken by ``g``). Either key is non-decreasing along a path and equal heuristics
 at one cell make the pop order at a cell the order of ``g`` (or of the peak), so a label
@@ -15,6 +15,33 @@ popped at a cell is dominated — and skipped — when a label of a lower or equ
 there before (``closed[cell]`` keeps the lowest closed bin). A label is thus expanded only if
 it is better in error than every cheaper label at its cell: at most ``n_bins`` per cell.
 After the settling distance a move whose predicted σ exceeds ``max_error`` is not made.
+
+Ties. Unit-cost grids have many labels of exactly equal key (routes of the same moves in
+another order), and which of them pops first decides, through the bin dominance that ignores
+everything but σ, which route is kept. With more than one bin the heap therefore orders labels
+by the compound key
+
+.. math:: (\text{key},\ \sigma^2,\ \text{peak},\ \text{label number})
+
+lexicographically: among equal keys the lower σ first (the lower bin, then the lower σ within
+it), then the lower peak error, then the label created first. The order is total and does not
+depend on the heap's layout; the label number only ranks labels identical in cost and error.
+With one bin (plain A*: no budget, no soft term) σ decides nothing and the heap compares keys
+only, as a binary heap does: the shortest route is then not chosen for its σ among the equally
+short ones (it is the reference the navigation budgets are measured against,
+:mod:`auvplan.mission.navigation`, so it must not look more informative than an energy-only
+route is).
+
+Push-time dominance (more than one bin). A new label is not even created when a label
+already queued at its cell pops before it in that order and is in no higher bin: that label
+closes the cell at its bin when it pops, so the new one would be skipped. Two queued labels
+per cell are kept for the comparison, the first in the pop order and the one of the lowest bin
+(a reference already popped has closed the cell at its bin or lower, so it still dominates),
+as records beside the cell (key, σ², peak, label number: no look-up in the label table). The
+labels created keep their relative order (their numbers only lose gaps), so the labels popped
+and the route found are those of the search without this pruning; it only cuts the labels and
+the heap. Being total, the order also lets the heap be 4-ary (half the levels of a binary
+heap, the four children of an entry side by side) without changing what pops.
 
 A move ``u → v`` of length ℓ [m] with the move factor ``f`` (e.g. the time ratio in a
 current) costs ``ℓ f (c_u + c_v) / 2 + λ ℓ (σ_u² + σ_v²) / 2`` and takes
@@ -90,37 +117,113 @@ def _grow_keys(values: FloatArray, size: int) -> FloatArray:  # pragma: no cover
 
 
 @njit(cache=True)
+def _before(
+    key_a: float,
+    variance_a: float,
+    peak_a: float,
+    a: float,
+    key_b: float,
+    variance_b: float,
+    peak_b: float,
+    b: float,
+) -> bool:  # pragma: no cover - compiled
+    """Whether label ``a`` pops before label ``b`` in the compound order (module notes)."""
+    if key_a != key_b:
+        return key_a < key_b
+    if variance_a != variance_b:
+        return variance_a < variance_b
+    if peak_a != peak_b:
+        return peak_a < peak_b
+    return a < b  # fmt: skip
+
+
+@njit(cache=True)
+def _precedes(
+    table: FloatArray, key_a: float, a: int, key_b: float, b: int, ties: bool
+) -> bool:  # pragma: no cover - compiled
+    """Whether label ``a`` (heap key ``key_a``) pops before label ``b`` (module notes: ties).
+
+    ``ties``: break ties of the key by the compound order; else compare keys only.
+    """
+    if key_a != key_b or not ties:
+        return key_a < key_b
+    return _before(
+        key_a, table[a, _P00] + table[a, _P11], table[a, _PEAK], a,
+        key_b, table[b, _P00] + table[b, _P11], table[b, _PEAK], b,
+    )  # fmt: skip
+
+
+@njit(cache=True)
+def _bin(sigma: float, bin_width: float, n_bins: int) -> int:  # pragma: no cover - compiled
+    """Bin of σ [m]: ``min(⌊σ / Δσ⌋, n_bins − 1)``."""
+    return min(int(sigma / bin_width), n_bins - 1)
+
+
+@njit(cache=True)
+def _dominated(
+    reference: FloatArray,
+    key: float,
+    variance: float,
+    peak: float,
+    label: int,
+    bin_label: int,
+    bin_width: float,
+    n_bins: int,
+) -> bool:  # pragma: no cover - compiled
+    """Whether the queued ``reference`` pops before ``label`` in no higher bin.
+
+    ``reference`` is a cell's record ``key, σ², peak, label`` (label ``-1``: none; module
+    notes: push-time dominance); the other arguments are ``label``'s.
+    """
+    if reference[3] < 0.0 or _bin(math.sqrt(reference[1]), bin_width, n_bins) > bin_label:
+        return False
+    return _before(
+        reference[0], reference[1], reference[2], reference[3], key, variance, peak, label
+    )  # fmt: skip
+
+
+@njit(cache=True)
 def _push(
-    keys: FloatArray, items: IntArray, size: int, key: float, item: int
+    table: FloatArray,
+    keys: FloatArray,
+    items: IntArray,
+    size: int,
+    key: float,
+    item: int,
+    ties: bool,
+    arity: int,
 ) -> None:  # pragma: no cover - compiled
-    """Sift ``(key, item)`` up from position ``size`` (the caller has room for it)."""
+    """Sift ``(key, item)`` up from position ``size`` of an ``arity``-ary heap (room for it)."""
     i = size
     while i > 0:
-        parent = (i - 1) >> 1
-        if keys[parent] <= key:
+        parent = (i - 1) // arity
+        if not _precedes(table, key, item, keys[parent], items[parent], ties):
             break
         keys[i] = keys[parent]
         items[i] = items[parent]
         i = parent
     keys[i] = key
-    items[i] = item
+    items[i] = item  # fmt: skip
 
 
 @njit(cache=True)
-def _pop(keys: FloatArray, items: IntArray, size: int) -> int:  # pragma: no cover - compiled
-    """Remove the smallest entry of a heap of ``size`` and return its item."""
+def _pop(
+    table: FloatArray, keys: FloatArray, items: IntArray, size: int, ties: bool, arity: int
+) -> int:  # pragma: no cover - compiled
+    """Remove the first entry (:func:`_precedes`) of a heap of ``size``; return its item."""
     top = items[0]
     last_key = keys[size - 1]
     last_item = items[size - 1]
     n = size - 1
     i = 0
     while True:
-        child = 2 * i + 1
+        child = arity * i + 1
         if child >= n:
             break
-        if child + 1 < n and keys[child + 1] < keys[child]:
-            child += 1
-        if keys[child] >= last_key:
+        for other in range(child + 1, min(child + arity, n)):
+            if _precedes(table, keys[other], items[other], keys[child], items[child], ties):
+                child = other
+        if not _precedes(table, keys[child], items[child], last_key, last_item, ties):
             break
         keys[i] = keys[child]
         items[i] = items[child]
@@ -165,7 +268,15 @@ def belief_search(
     created.
     """
     offsets, crossed, length = moves(width, spacing_north, spacing_east, n_moves)
+    n_updates = length * updates_per_metre  # TAN updates of each move
+    white = n_updates * process_variance
+    half_updates = 0.5 * n_updates
     closed = np.full(cost.shape[0], n_bins, np.int32)
+    ties = n_bins > 1
+    arity = 4 if ties else 2  # the compound order is total: any heap pops in its order
+    # queued labels per cell for the push-time dominance, the first to pop (slot 0) and the
+    # lowest bin (slot 1), as records key, σ², peak, label: kept beside the cell for locality
+    references = np.full((cost.shape[0] if ties else 0, 2, 4), -1.0)
     capacity = 1024
     table = np.empty((capacity, 7))
     cells = np.empty(capacity, np.int64)
@@ -182,22 +293,23 @@ def belief_search(
     table[0, _P00], table[0, _P01], table[0, _P11] = j11 / det, -j01 / det, j00 / det
     cells[0], parents[0] = start, -1
     n_labels = 1
-    _push(keys, items, heap, 0.0 if bottleneck else heuristic[start], 0)
+    _push(table, keys, items, heap, 0.0 if bottleneck else heuristic[start], 0, ties, arity)
     heap += 1
     found = -1
     while heap > 0:
-        label = _pop(keys, items, heap)
+        label = _pop(table, keys, items, heap, ties, arity)
         heap -= 1
         u = cells[label]
         row = table[label]
         sigma_u = math.sqrt(row[_P00] + row[_P11])
-        bin_u = min(int(sigma_u / bin_width), n_bins - 1)
+        bin_u = _bin(sigma_u, bin_width, n_bins)
         if bin_u >= closed[u]:
             continue
         closed[u] = bin_u
         if u == goal:
             found = label
             break
+        f_u = fisher[u]
         for k in range(n_moves):
             v = u + offsets[k]
             c_v = cost[v]
@@ -209,17 +321,14 @@ def belief_search(
             ):
                 continue
             ell = length[k]
-            n_updates = ell * updates_per_metre
             f_v = fisher[v]
-            f_u = fisher[u]
             p00, p01, p11, grown = propagate(
-                row[_P00], row[_P01], row[_P11], row[_GROWN], drift_variance, ell,
-                n_updates * process_variance,
-                0.5 * n_updates * (f_u[0] + f_v[0]), 0.5 * n_updates * (f_u[1] + f_v[1]),
-                0.5 * n_updates * (f_u[2] + f_v[2]),
+                row[_P00], row[_P01], row[_P11], row[_GROWN], drift_variance, ell, white[k],
+                half_updates[k] * (f_u[0] + f_v[0]), half_updates[k] * (f_u[1] + f_v[1]),
+                half_updates[k] * (f_u[2] + f_v[2]),
             )  # fmt: skip
             sigma_v = math.sqrt(p00 + p11)
-            bin_v = min(int(sigma_v / bin_width), n_bins - 1)
+            bin_v = _bin(sigma_v, bin_width, n_bins)
             if bin_v >= closed[v]:
                 continue
             distance = row[_DIST] + ell
@@ -230,6 +339,17 @@ def belief_search(
                 peak = max(peak, sigma_v)
             g = row[_G] + ell * move * 0.5 * (cost[u] + c_v)
             g += error_weight * ell * 0.5 * (sigma_u * sigma_u + sigma_v * sigma_v)
+            key = peak * 1e9 + g if bottleneck else g + heuristic[v]  # non-decreasing
+            variance = p00 + p11
+            if ties and (
+                _dominated(
+                    references[v, 0], key, variance, peak, n_labels, bin_v, bin_width, n_bins
+                )
+                or _dominated(
+                    references[v, 1], key, variance, peak, n_labels, bin_v, bin_width, n_bins
+                )
+            ):
+                continue
             if n_labels == max_labels:
                 return TOO_MANY_LABELS, np.empty(0, np.int64), np.empty(0), 0.0, 0.0, n_labels
             if n_labels == table.shape[0]:
@@ -243,9 +363,19 @@ def belief_search(
             table[n_labels, _P00], table[n_labels, _P01], table[n_labels, _P11] = p00, p01, p11
             table[n_labels, _GROWN] = grown
             cells[n_labels], parents[n_labels] = v, label
-            key = peak * 1e9 + g if bottleneck else g + heuristic[v]
-            _push(keys, items, heap, key, n_labels)
+            _push(table, keys, items, heap, key, n_labels, ties, arity)
             heap += 1
+            if ties:  # not dominated: in a lower bin than the references, or pops before them
+                for slot in range(2):
+                    reference = references[v, slot]
+                    if reference[3] < 0.0 or (
+                        _before(key, variance, peak, n_labels, reference[0], reference[1],
+                                reference[2], reference[3])
+                        if slot == 0
+                        else bin_v <= _bin(math.sqrt(reference[1]), bin_width, n_bins)
+                    ):  # fmt: skip
+                        reference[0], reference[1], reference[2] = key, variance, peak
+                        reference[3] = n_labels
             n_labels += 1
     if found < 0:
         return UNREACHABLE, np.empty(0, np.int64), np.empty(0), 0.0, 0.0, n_labels
