@@ -62,15 +62,17 @@ def advance_node(
                 rate_d[r, c] = jb[r, c]
             for k in range(n_x):
                 a = jb[r, k]
-                for c in range(n_z):
-                    rate_d[r, c] += a * db[k, c]
+                if a != 0.0:  # the model's Jacobians are sparse (e.g. positions enter no rate)
+                    for c in range(n_z):
+                        rate_d[r, c] += a * db[k, c]
         cg = cost_grad[b]
         for c in range(n_x, n_z):
             cg[c] += factor * gb[c]
         for r in range(n_x):
             a = factor * gb[r]
-            for c in range(n_z):
-                cg[c] += a * db[r, c]
+            if a != 0.0:
+                for c in range(n_z):
+                    cg[c] += a * db[r, c]
         sj, st, nc = step_jac[b], start[b], next_carried[b]
         for r in range(n_x):
             for c in range(n_z):
@@ -80,28 +82,43 @@ def advance_node(
 
 @numba.njit(cache=True, fastmath=True)
 def add_hessian(total: FloatArray, local: FloatArray, carried: FloatArray) -> None:
-    """``total += D̃ᵀ local D̃`` at every point (in place; ``total``, ``local`` ``(B, n_z, n_z)``)."""
+    """``total += D̃ᵀ local D̃`` at every point (in place; ``total``, ``local`` ``(B, n_z, n_z)``).
+
+    Node Hessians are mostly zero (about 3/4 of the entries for a MEDUSA: positions enter no
+    rate, and each rate few states), and so are many entries of ``D``: products with an exact
+    zero are skipped (the same sums), and so are the rows of ``local D̃`` that are zero.
+    """
     n_points, n_x, n_z = carried.shape
     right = np.empty((n_z, n_z))
+    live = np.empty(n_x, dtype=np.bool_)  # rows of `right` not all zero
     for b in range(n_points):
         e, h, t = carried[b], local[b], total[b]
         for r in range(n_z):  # right = local D̃ (i-k-j order)
+            nonzero = False
             for c in range(n_x):
                 right[r, c] = 0.0
             for c in range(n_x, n_z):
                 right[r, c] = h[r, c]
+                nonzero = nonzero or h[r, c] != 0.0
             for k in range(n_x):
                 a = h[r, k]
-                for c in range(n_z):
-                    right[r, c] += a * e[k, c]
+                if a != 0.0:
+                    nonzero = True
+                    for c in range(n_z):
+                        right[r, c] += a * e[k, c]
+            if r < n_x:
+                live[r] = nonzero
         for r in range(n_x, n_z):  # total += D̃ᵀ right: the identity rows of D̃ …
             for c in range(n_z):
                 t[r, c] += right[r, c]
         for k in range(n_x):  # … and the rows of D
+            if not live[k]:
+                continue
             for r in range(n_z):
                 a = e[k, r]
-                for c in range(n_z):
-                    t[r, c] += a * right[k, c]
+                if a != 0.0:
+                    for c in range(n_z):
+                        t[r, c] += a * right[k, c]
 
 
 @numba.njit(cache=True, fastmath=True)
