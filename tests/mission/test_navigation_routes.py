@@ -178,3 +178,44 @@ def test_a_budget_route_is_flown_within_its_corridor(
     assert list(slack) == [f"{summary['vehicles'][0]['name']} / corridor"]
     assert min(slack.values()) >= -1e-9
     assert plan["plan_status"] == "CONVERGED"
+
+
+def test_the_ladder_searches_a_budget_again_with_finer_bins_before_it_stops() -> None:
+    # the dominance keeps one label per σ bin and cell, so coarse bins can miss a route that
+    # meets a budget: the ladder must search a failed budget again at twice the bins, take
+    # what that finds, and stop only when both fail
+    import numpy as np
+
+    from auvplan.mission.navigation import LADDER_RATIO, VehicleNavigation
+    from auvplan.planning import EdgeModel, Route, SearchStatus
+    from auvplan.planning.belief import MAX_BUDGET_BINS, BeliefModel
+    from auvplan.planning.route import BudgetInfeasible
+
+    def route(length: float, sigma: float) -> Route:
+        points = np.array([[0.0, 0.0], [0.0, length]])
+        return Route(
+            np.zeros((2, 2), np.int64), points, length, SearchStatus.EXACT, "", 0, "v",
+            EdgeModel.CROSSED, np.full(2, sigma), sigma,
+        )  # fmt: skip
+
+    calls: list[tuple[float, int]] = []
+
+    def search(model: BeliefModel, bottleneck: bool) -> Route:
+        assert not bottleneck
+        if not np.isfinite(model.max_error):
+            return route(100.0, 10.0)  # the shortest route: σ 10 m all along
+        calls.append((model.max_error, model.budget_bins))
+        if model.max_error > 8.0 and model.budget_bins == 2 * MAX_BUDGET_BINS:
+            return route(105.0, 5.0)  # only the finer bins find it: +5 % energy, σ 5 m
+        raise BudgetInfeasible("no route")
+
+    model = BeliefModel(np.zeros((1, 1, 3)), 0.1, 0.01, 0.0, 1.0)
+    vehicle = VehicleNavigation("v", model, lambda length: length, None, 0.08, 0.2)
+    chosen, choice = vehicle.route(search)
+    first, second = 10.0 * LADDER_RATIO, 10.0 * LADDER_RATIO**2
+    assert [bins for _, bins in calls] == [MAX_BUDGET_BINS, 2 * MAX_BUDGET_BINS] * 2
+    assert [budget for budget, _ in calls] == pytest.approx([first, first, second, second])
+    assert chosen.points[-1, 1] == 105.0
+    assert choice.budget_m == pytest.approx(first)
+    assert choice.energy_increase == pytest.approx(0.05)
+    assert choice.searches == 5

@@ -14,7 +14,8 @@ recursion of :mod:`auvplan.navigation.prediction` at the vehicle's nominal speed
 * **Automatic** (no ``max_error_m``): budgets are tried on a geometric ladder down from the
   shortest route's peak error (:data:`LADDER_RATIO`), loosest first, until one is infeasible
   or its route costs more than ``max_energy_increase`` over the shortest route's energy (a
-  tighter budget costs at least as much); of those, the route with the lowest predicted RMS
+  tighter budget costs at least as much; before concluding so, the budget is searched again
+  with finer σ bins, :data:`LADDER_BINS`); of those, the route with the lowest predicted RMS
   error is taken if it cuts the shortest route's by at least ``min_error_reduction``, else
   the shortest route. Energy of a route of length
   ``L``: ``P(L / T) T`` with a fixed horizon ``T`` (faster on a longer route), ``e(U) L``
@@ -45,7 +46,7 @@ from auvplan.mission.tables import NavigationConfig
 from auvplan.navigation import Track, process_noise_sigma
 from auvplan.navigation.prediction import ErrorPrediction, fisher_map, predict_error
 from auvplan.planning import Route, path_length
-from auvplan.planning.belief import BeliefModel
+from auvplan.planning.belief import MAX_BUDGET_BINS, BeliefModel
 from auvplan.planning.route import BudgetInfeasible
 from auvplan.terrain import BathymetryGrid, TerrainMaps
 from auvplan.vehicle import VehicleModel, optimal_cruise_speed
@@ -57,6 +58,10 @@ logger = logging.getLogger(__name__)
 #: ``LADDER_RATIO ** k``, ``k = 1 … LADDER_STEPS`` (down to 27 % of it), loosest first.
 LADDER_STEPS: Final = 8
 LADDER_RATIO: Final = 0.85
+#: Bins of σ a ladder budget is searched with: the default, then, where it finds no route
+#: within the energy cap, twice as many (the dominance keeps one label per bin and cell, so
+#: coarse bins can drop the one label that would have met the budget cheaply).
+LADDER_BINS: Final = (MAX_BUDGET_BINS, 2 * MAX_BUDGET_BINS)
 
 #: One search: a belief model and whether to minimise the peak error instead of the cost.
 RouteSearch = Callable[[BeliefModel, bool], Route]
@@ -170,18 +175,21 @@ class VehicleNavigation:
                 return route, unmet
             return route, choice(route, "budget", self.max_error)
         best, best_budget = cheapest, None
+        cap = (1.0 + self.max_energy_increase) * base_energy
         steps = LADDER_STEPS if base_peak > 0.0 else 0  # 0: the route ends within settle_s
         for step in range(1, steps + 1):  # tighter budgets cost at least as much
             budget = base_peak * LADDER_RATIO**step
-            try:
+            route = None
+            for bins in LADDER_BINS:  # a budget the coarse bins miss, searched again finer
                 searches += 1
-                route = search(self.with_budget(budget), False)
-            except BudgetInfeasible:
-                break
-            if (
-                self.energy(path_length(route.points))
-                > (1.0 + self.max_energy_increase) * base_energy
-            ):
+                try:
+                    found = search(self.with_budget(budget, bins), False)
+                except BudgetInfeasible:
+                    continue
+                if self.energy(path_length(found.points)) <= cap:
+                    route = found
+                    break
+            if route is None:
                 break
             if route_rms(route) < route_rms(best):
                 best, best_budget = route, budget
@@ -189,9 +197,9 @@ class VehicleNavigation:
             best, best_budget = cheapest, None
         return best, choice(best, "automatic", best_budget)
 
-    def with_budget(self, budget: float) -> BeliefModel:
-        """The model with a budget [m]."""
-        return dataclasses.replace(self.model, max_error=budget)
+    def with_budget(self, budget: float, bins: int = MAX_BUDGET_BINS) -> BeliefModel:
+        """The model with a budget [m] resolved in ``bins`` bins of σ at most."""
+        return dataclasses.replace(self.model, max_error=budget, budget_bins=bins)
 
     def _budget_message(self, cheapest: Route, floor: float) -> str:
         """One line: where the cheapest route breaks the budget, and the smallest budget."""

@@ -73,6 +73,8 @@ class BeliefModel:
         Quantisation of σ [m] for dominance (at least; see :attr:`width`).
     max_labels : int
         Labels created before the search gives up (bounds the memory, 64 B per label).
+    budget_bins : int
+        Bins of σ under a budget at most (:attr:`width`).
     """
 
     fisher: FloatArray
@@ -85,6 +87,7 @@ class BeliefModel:
     error_weight: float = 0.0
     bin_width: float = 0.5
     max_labels: int = 40_000_000
+    budget_bins: int = MAX_BUDGET_BINS
 
     def __post_init__(self) -> None:
         for name in ("updates_per_metre", "drift_rate", "process_variance", "error_weight"):
@@ -97,9 +100,9 @@ class BeliefModel:
 
     @property
     def width(self) -> float:
-        """Width [m] of the σ bins: ``bin_width``, or a budget's :data:`MAX_BUDGET_BINS`-th."""
+        """Width [m] of the σ bins: ``bin_width``, or a budget's ``budget_bins``-th."""
         if math.isfinite(self.max_error):
-            return max(self.bin_width, self.max_error / MAX_BUDGET_BINS)
+            return max(self.bin_width, self.max_error / self.budget_bins)
         return self.bin_width
 
     @property
