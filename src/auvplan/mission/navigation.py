@@ -179,7 +179,7 @@ class VehicleNavigation:
         steps = LADDER_STEPS if base_peak > 0.0 else 0  # 0: the route ends within settle_s
         for step in range(1, steps + 1):  # tighter budgets cost at least as much
             budget = base_peak * LADDER_RATIO**step
-            route = None
+            within: Route | None = None
             for bins in LADDER_BINS:  # a budget the coarse bins miss, searched again finer
                 searches += 1
                 try:
@@ -187,12 +187,12 @@ class VehicleNavigation:
                 except BudgetInfeasible:
                     continue
                 if self.energy(path_length(found.points)) <= cap:
-                    route = found
+                    within = found
                     break
-            if route is None:
+            if within is None:
                 break
-            if route_rms(route) < route_rms(best):
-                best, best_budget = route, budget
+            if route_rms(within) < route_rms(best):
+                best, best_budget = within, budget
         if route_rms(best) > (1.0 - self.min_error_reduction) * base_rms:
             best, best_budget = cheapest, None
         return best, choice(best, "automatic", best_budget)
