@@ -138,19 +138,11 @@ def _before(
 
 
 @njit(cache=True)
-def _precedes(
-    table: FloatArray, key_a: float, a: int, key_b: float, b: int, ties: bool
-) -> bool:  # pragma: no cover - compiled
-    """Whether label ``a`` (heap key ``key_a``) pops before label ``b`` (module notes: ties).
-
-    ``ties``: break ties of the key by the compound order; else compare keys only.
-    """
-    if key_a != key_b or not ties:
-        return key_a < key_b
-    return _before(
-        key_a, table[a, _P00] + table[a, _P11], table[a, _PEAK], a,
-        key_b, table[b, _P00] + table[b, _P11], table[b, _PEAK], b,
-    )  # fmt: skip
+def _tie_first(table: FloatArray, a: int, b: int) -> bool:  # pragma: no cover - compiled
+    """Whether label ``a`` pops before label ``b`` of the same key (module notes: ties)."""
+    variance_a = table[a, _P00] + table[a, _P11]
+    variance_b = table[b, _P00] + table[b, _P11]
+    return _before(0.0, variance_a, table[a, _PEAK], a, 0.0, variance_b, table[b, _PEAK], b)
 
 
 @njit(cache=True)
@@ -191,13 +183,14 @@ def _push(
     key: float,
     item: int,
     ties: bool,
-    arity: int,
+    shift: int,
 ) -> None:  # pragma: no cover - compiled
-    """Sift ``(key, item)`` up from position ``size`` of an ``arity``-ary heap (room for it)."""
+    """Sift ``(key, item)`` up from position ``size`` of a ``2^shift``-ary heap (room for it)."""
     i = size
     while i > 0:
-        parent = (i - 1) // arity
-        if not _precedes(table, key, item, keys[parent], items[parent], ties):
+        parent = (i - 1) >> shift
+        above = keys[parent]  # the parent pops first unless the new key is lower or tied first
+        if key > above or (key == above and not (ties and _tie_first(table, item, items[parent]))):
             break
         keys[i] = keys[parent]
         items[i] = items[parent]
@@ -208,22 +201,31 @@ def _push(
 
 @njit(cache=True)
 def _pop(
-    table: FloatArray, keys: FloatArray, items: IntArray, size: int, ties: bool, arity: int
+    table: FloatArray, keys: FloatArray, items: IntArray, size: int, ties: bool, shift: int
 ) -> int:  # pragma: no cover - compiled
-    """Remove the first entry (:func:`_precedes`) of a heap of ``size``; return its item."""
+    """Remove the first entry of a heap of ``size`` and return its item.
+
+    Entries pop in the order of their keys, ties by :func:`_tie_first` if ``ties``.
+    """
     top = items[0]
     last_key = keys[size - 1]
     last_item = items[size - 1]
     n = size - 1
     i = 0
     while True:
-        child = arity * i + 1
+        child = (i << shift) + 1
         if child >= n:
             break
-        for other in range(child + 1, min(child + arity, n)):
-            if _precedes(table, keys[other], items[other], keys[child], items[child], ties):
+        for other in range(child + 1, min(child + (1 << shift), n)):
+            key = keys[other]
+            if key < keys[child] or (
+                key == keys[child] and ties and _tie_first(table, items[other], items[child])
+            ):
                 child = other
-        if not _precedes(table, keys[child], items[child], last_key, last_item, ties):
+        key = keys[child]  # the last entry settles here unless the child pops first
+        if key > last_key or (
+            key == last_key and not (ties and _tie_first(table, items[child], last_item))
+        ):
             break
         keys[i] = keys[child]
         items[i] = items[child]
@@ -273,7 +275,7 @@ def belief_search(
     half_updates = 0.5 * n_updates
     closed = np.full(cost.shape[0], n_bins, np.int32)
     ties = n_bins > 1
-    arity = 4 if ties else 2  # the compound order is total: any heap pops in its order
+    shift = 2 if ties else 1  # 4-ary under the total order (any heap pops in it), else binary
     # queued labels per cell for the push-time dominance, the first to pop (slot 0) and the
     # lowest bin (slot 1), as records key, σ², peak, label: kept beside the cell for locality
     references = np.full((cost.shape[0] if ties else 0, 2, 4), -1.0)
@@ -293,11 +295,11 @@ def belief_search(
     table[0, _P00], table[0, _P01], table[0, _P11] = j11 / det, -j01 / det, j00 / det
     cells[0], parents[0] = start, -1
     n_labels = 1
-    _push(table, keys, items, heap, 0.0 if bottleneck else heuristic[start], 0, ties, arity)
+    _push(table, keys, items, heap, 0.0 if bottleneck else heuristic[start], 0, ties, shift)
     heap += 1
     found = -1
     while heap > 0:
-        label = _pop(table, keys, items, heap, ties, arity)
+        label = _pop(table, keys, items, heap, ties, shift)
         heap -= 1
         u = cells[label]
         row = table[label]
@@ -363,7 +365,7 @@ def belief_search(
             table[n_labels, _P00], table[n_labels, _P01], table[n_labels, _P11] = p00, p01, p11
             table[n_labels, _GROWN] = grown
             cells[n_labels], parents[n_labels] = v, label
-            _push(table, keys, items, heap, key, n_labels, ties, arity)
+            _push(table, keys, items, heap, key, n_labels, ties, shift)
             heap += 1
             if ties:  # not dominated: in a lower bin than the references, or pops before them
                 for slot in range(2):
