@@ -134,7 +134,7 @@ def _before(
         return variance_a < variance_b
     if peak_a != peak_b:
         return peak_a < peak_b
-    return a < b  # fmt: skip
+    return a < b
 
 
 @njit(cache=True)
@@ -196,7 +196,7 @@ def _push(
         items[i] = items[parent]
         i = parent
     keys[i] = key
-    items[i] = item  # fmt: skip
+    items[i] = item
 
 
 @njit(cache=True)
