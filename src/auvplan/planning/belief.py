@@ -97,6 +97,8 @@ class BeliefModel:
         for name in ("initial_sigma", "bin_width", "max_error"):
             if not getattr(self, name) > 0.0:
                 raise InputError(f"belief model {name} must be > 0, got {getattr(self, name)}")
+        if self.budget_bins < 1:
+            raise InputError(f"belief model budget_bins must be >= 1, got {self.budget_bins}")
 
     @property
     def width(self) -> float:
