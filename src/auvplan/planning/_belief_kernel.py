@@ -52,8 +52,10 @@ information ``n (F_u + F_v) / 2``.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 from numba import njit
 
 from auvplan._typing import FloatArray, IntArray
@@ -103,15 +105,9 @@ def _grow_rows(table: FloatArray, size: int) -> FloatArray:  # pragma: no cover 
 
 
 @njit(cache=True)
-def _grow(values: IntArray, size: int) -> IntArray:  # pragma: no cover - compiled
+def _grow(values: npt.NDArray[Any], size: int) -> npt.NDArray[Any]:  # pragma: no cover
+    """``values`` in an array twice as long, its first ``size`` entries copied."""
     bigger = np.empty(2 * values.shape[0], values.dtype)
-    bigger[:size] = values[:size]
-    return bigger
-
-
-@njit(cache=True)
-def _grow_keys(values: FloatArray, size: int) -> FloatArray:  # pragma: no cover - compiled
-    bigger = np.empty(2 * values.shape[0])
     bigger[:size] = values[:size]
     return bigger
 
@@ -130,6 +126,14 @@ def _before(
     """Whether label ``a`` pops before label ``b`` in the compound order (module notes)."""
     if key_a != key_b:
         return key_a < key_b
+    return _tie_before(variance_a, peak_a, a, variance_b, peak_b, b)
+
+
+@njit(cache=True)
+def _tie_before(
+    variance_a: float, peak_a: float, a: float, variance_b: float, peak_b: float, b: float
+) -> bool:  # pragma: no cover - compiled
+    """Whether label ``a`` pops before label ``b`` of the same key: lower σ², peak, number."""
     if variance_a != variance_b:
         return variance_a < variance_b
     if peak_a != peak_b:
@@ -139,10 +143,11 @@ def _before(
 
 @njit(cache=True)
 def _tie_first(table: FloatArray, a: int, b: int) -> bool:  # pragma: no cover - compiled
-    """Whether label ``a`` pops before label ``b`` of the same key (module notes: ties)."""
-    variance_a = table[a, _P00] + table[a, _P11]
-    variance_b = table[b, _P00] + table[b, _P11]
-    return _before(0.0, variance_a, table[a, _PEAK], a, 0.0, variance_b, table[b, _PEAK], b)
+    """:func:`_tie_before` of labels ``a`` and ``b`` read from the label ``table``."""
+    return _tie_before(
+        table[a, _P00] + table[a, _P11], table[a, _PEAK], a,
+        table[b, _P00] + table[b, _P11], table[b, _PEAK], b,
+    )  # fmt: skip
 
 
 @njit(cache=True)
@@ -359,7 +364,7 @@ def belief_search(
                 cells = _grow(cells, n_labels)
                 parents = _grow(parents, n_labels)
             if heap == keys.shape[0]:
-                keys = _grow_keys(keys, heap)
+                keys = _grow(keys, heap)
                 items = _grow(items, heap)
             table[n_labels, _G], table[n_labels, _DIST], table[n_labels, _PEAK] = g, distance, peak
             table[n_labels, _P00], table[n_labels, _P01], table[n_labels, _P11] = p00, p01, p11
