@@ -180,42 +180,77 @@ def test_a_budget_route_is_flown_within_its_corridor(
     assert plan["plan_status"] == "CONVERGED"
 
 
-def test_the_ladder_searches_a_budget_again_with_finer_bins_before_it_stops() -> None:
-    # the dominance keeps one label per σ bin and cell, so coarse bins can miss a route that
-    # meets a budget: the ladder must search a failed budget again at twice the bins, take
-    # what that finds, and stop only when both fail
+def _fake_route(length: float, sigma: float) -> object:
     import numpy as np
 
-    from auvplan.mission.navigation import LADDER_RATIO, VehicleNavigation
     from auvplan.planning import EdgeModel, Route, SearchStatus
-    from auvplan.planning.belief import MAX_BUDGET_BINS, BeliefModel
-    from auvplan.planning.route import BudgetInfeasible
 
-    def route(length: float, sigma: float) -> Route:
-        points = np.array([[0.0, 0.0], [0.0, length]])
-        return Route(
-            np.zeros((2, 2), np.int64), points, length, SearchStatus.EXACT, "", 0, "v",
-            EdgeModel.CROSSED, np.full(2, sigma), sigma,
-        )  # fmt: skip
+    points = np.array([[0.0, 0.0], [0.0, length]])
+    return Route(
+        np.zeros((2, 2), np.int64), points, length, SearchStatus.EXACT, "", 0, "v",
+        EdgeModel.CROSSED, np.full(2, sigma), sigma,
+    )  # fmt: skip
 
-    calls: list[tuple[float, int]] = []
 
-    def search(model: BeliefModel, bottleneck: bool) -> Route:
-        assert not bottleneck
-        if not np.isfinite(model.max_error):
-            return route(100.0, 10.0)  # the shortest route: σ 10 m all along
-        calls.append((model.max_error, model.budget_bins))
-        if model.max_error > 8.0 and model.budget_bins == 2 * MAX_BUDGET_BINS:
-            return route(105.0, 5.0)  # only the finer bins find it: +5 % energy, σ 5 m
-        raise BudgetInfeasible("no route")
+def _priced_vehicle(max_energy_increase: float = 0.08, min_error_reduction: float = 0.2) -> object:
+    import numpy as np
+
+    from auvplan.mission.navigation import VehicleNavigation
+    from auvplan.planning.belief import BeliefModel
 
     model = BeliefModel(np.zeros((1, 1, 3)), 0.1, 0.01, 0.0, 1.0)
-    vehicle = VehicleNavigation("v", model, lambda length: length, None, 0.08, 0.2)
-    chosen, choice = vehicle.route(search)
-    first, second = 10.0 * LADDER_RATIO, 10.0 * LADDER_RATIO**2
-    assert [bins for _, bins in calls] == [MAX_BUDGET_BINS, 2 * MAX_BUDGET_BINS] * 2
-    assert [budget for budget, _ in calls] == pytest.approx([first, first, second, second])
-    assert chosen.points[-1, 1] == 105.0
-    assert choice.budget_m == pytest.approx(first)
-    assert choice.energy_increase == pytest.approx(0.05)
-    assert choice.searches == 5
+    return VehicleNavigation(
+        "v", model, lambda length: length, 2.0, None, max_energy_increase, min_error_reduction
+    )
+
+
+def _priced_search(prices: list[float]) -> Callable[..., object]:
+    """Routes that lengthen as the price on σ² grows: 100 m at σ 10 m (the shortest),
+    104 m at σ 6 m from λ = 1e-4, 107 m at σ 5 m from 0.03, 120 m at σ 3 m from 0.3."""
+    import numpy as np
+
+    def search(model: object, bottleneck: bool) -> object:
+        assert not bottleneck
+        if not np.isfinite(model.max_error):  # type: ignore[attr-defined]
+            return _fake_route(100.0, 10.0)
+        assert model.max_error == 10.0  # type: ignore[attr-defined]  # the shortest's peak
+        price = model.error_weight  # type: ignore[attr-defined]
+        prices.append(price)
+        for least, length, sigma in ((0.3, 120.0, 3.0), (0.03, 107.0, 5.0), (1e-4, 104.0, 6.0)):
+            if price >= least:
+                return _fake_route(length, sigma)
+        return _fake_route(100.0, 10.0)
+
+    return search
+
+
+def test_the_automatic_route_is_the_least_error_one_within_the_energy_cap() -> None:
+    # the bisection on the price must pass the 104 m route, take the 107 m one and refuse the
+    # 120 m one (+20 % > 8 %); prices around 1 / σ_rms² = 0.01 of the shortest route
+    prices: list[float] = []
+    chosen, choice = _priced_vehicle().route(_priced_search(prices))  # type: ignore[attr-defined]
+    assert chosen.points[-1, 1] == 107.0
+    assert choice.rms_m == 5.0
+    assert choice.budget_m == 10.0  # within the shortest route's peak
+    assert choice.energy_increase == pytest.approx(0.07)
+    assert 0.03 <= choice.price_w_m2 / 2.0 < 0.3  # W/m²: the model's price times the power
+    assert prices[0] == pytest.approx(10.0)  # 1e3 × 0.01 first: the 120 m route is over the cap
+    assert choice.searches == 1 + 1 + 8
+
+
+def test_the_least_error_route_within_the_cap_is_taken_in_one_search() -> None:
+    prices: list[float] = []
+    vehicle = _priced_vehicle(max_energy_increase=0.25)
+    chosen, choice = vehicle.route(_priced_search(prices))  # type: ignore[attr-defined]
+    assert chosen.points[-1, 1] == 120.0
+    assert choice.searches == 2
+
+
+def test_a_cut_below_min_error_reduction_buys_nothing() -> None:
+    # within 5 %, the best route (104 m) cuts σ from 10 to 6 m: 40 %; asking 50 % buys nothing
+    vehicle = _priced_vehicle(max_energy_increase=0.05, min_error_reduction=0.5)
+    chosen, choice = vehicle.route(_priced_search([]))  # type: ignore[attr-defined]
+    assert chosen.points[-1, 1] == 100.0
+    assert choice.budget_m is None
+    assert choice.price_w_m2 is None
+    assert choice.energy_increase == 0.0

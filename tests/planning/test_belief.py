@@ -269,11 +269,3 @@ def test_the_search_pops_labels_in_the_order_of_a_plain_label_setting(
     assert found.path.cells.tolist() == [list(cell) for cell in path]
     assert found.path.cost == expected_cost
     assert found.n_labels < n_reference  # the push-time dominance created fewer labels
-
-
-def test_a_budget_needs_at_least_one_bin() -> None:
-    with pytest.raises(InputError, match="budget_bins must be >= 1"):
-        BeliefModel(np.zeros((1, 1, 3)), 0.1, 0.01, 0.0, 1.0, max_error=5.0, budget_bins=0)
-    finer = BeliefModel(np.zeros((1, 1, 3)), 0.1, 0.01, 0.0, 1.0, max_error=32.0, budget_bins=32)
-    assert finer.width == 1.0  # 32 m in 32 bins (the default 16 would give 2 m)
-    assert finer.n_bins == 33

@@ -11,13 +11,14 @@ recursion of :mod:`auvplan.navigation.prediction` at the vehicle's nominal speed
   stays within it. If no route does, the cheapest route within the smallest budget any
   route meets (its ``smallest_budget_m``), and a warning naming where the shortest route
   breaks the budget: the plan then fails its check (exit 3) with that smallest budget.
-* **Automatic** (no ``max_error_m``): budgets are tried on a geometric ladder down from the
-  shortest route's peak error (:data:`LADDER_RATIO`), loosest first, until one is infeasible
-  or its route costs more than ``max_energy_increase`` over the shortest route's energy (a
-  tighter budget costs at least as much; before concluding so, the budget is searched again
-  with finer σ bins, :data:`LADDER_BINS`); of those, the route with the lowest predicted RMS
-  error is taken if it cuts the shortest route's by at least ``min_error_reduction``, else
-  the shortest route. Energy of a route of length
+* **Automatic** (no ``max_error_m``): the route of least predicted RMS error within
+  ``max_energy_increase`` over the shortest route's energy, found as the Lagrangian of that
+  problem: searches with a soft price ``λ ∫ σ² ds`` on the error variance, ``λ`` bisected on
+  a log scale (:data:`PRICE_DECADES`, :data:`PRICE_STEPS`) for the largest price whose route
+  is within the energy cap (the route's length grows with ``λ``), each search kept within
+  the shortest route's peak error (which bounds its σ bins). The route of least RMS error
+  among those within the cap is taken if it cuts the shortest route's RMS by at least
+  ``min_error_reduction``, else the shortest route. Energy of a route of length
   ``L``: ``P(L / T) T`` with a fixed horizon ``T`` (faster on a longer route), ``e(U) L``
   at a cruise speed (``P`` the vehicle's steady power, ``e`` its energy per metre).
 
@@ -46,7 +47,7 @@ from auvplan.mission.tables import NavigationConfig
 from auvplan.navigation import Track, process_noise_sigma
 from auvplan.navigation.prediction import ErrorPrediction, fisher_map, predict_error
 from auvplan.planning import Route, path_length
-from auvplan.planning.belief import MAX_BUDGET_BINS, BeliefModel
+from auvplan.planning.belief import BeliefModel
 from auvplan.planning.route import BudgetInfeasible
 from auvplan.terrain import BathymetryGrid, TerrainMaps
 from auvplan.vehicle import VehicleModel, optimal_cruise_speed
@@ -54,14 +55,11 @@ from auvplan.vehicle.trim import energy_per_metre, top_speed, trim_surge
 
 logger = logging.getLogger(__name__)
 
-#: Budgets tried by the automatic mode: the shortest route's peak error times
-#: ``LADDER_RATIO ** k``, ``k = 1 … LADDER_STEPS`` (down to 27 % of it), loosest first.
-LADDER_STEPS: Final = 8
-LADDER_RATIO: Final = 0.85
-#: Bins of σ a ladder budget is searched with: the default, then, where it finds no route
-#: within the energy cap, twice as many (the dominance keeps one label per bin and cell, so
-#: coarse bins can drop the one label that would have met the budget cheaply).
-LADDER_BINS: Final = (MAX_BUDGET_BINS, 2 * MAX_BUDGET_BINS)
+#: The automatic mode's prices ``λ`` span ``PRICE_DECADES`` decades either side of
+#: ``1 / σ_rms²`` of the shortest route (the price at which its error term equals its length)
+#: and are bisected ``PRICE_STEPS`` times on ``log λ`` (to 6 / 2⁸ of a decade).
+PRICE_DECADES: Final = 3.0
+PRICE_STEPS: Final = 8
 
 #: One search: a belief model and whether to minimise the peak error instead of the cost.
 RouteSearch = Callable[[BeliefModel, bool], Route]
@@ -78,7 +76,9 @@ class NavigationChoice:
     searches run; ``smallest_budget_m``: when no route meets the budget, the smallest one
     any route meets (the route is then within it), and ``message`` says where the shortest
     route breaks the budget; ``straight_clear``: whether the straight line from start to goal
-    keeps clear of land, no-data cells and polygons (which only the routes avoid).
+    keeps clear of land, no-data cells and polygons (which only the routes avoid);
+    ``price_w_m2``: the automatic route's price on the error variance, in the units of
+    ``weights.navigation`` [W/m²] (None: not priced).
     """
 
     mode: str
@@ -92,6 +92,7 @@ class NavigationChoice:
     smallest_budget_m: float | None = None
     message: str = ""
     straight_clear: bool = False
+    price_w_m2: float | None = None
 
     @property
     def pays_for_navigation(self) -> bool:
@@ -124,17 +125,23 @@ class NavigationChoice:
             "route_energy_increase": self.energy_increase,
             "searches": self.searches,
             "smallest_feasible_budget_m": self.smallest_budget_m,
+            "navigation_price_w_m2": self.price_w_m2,
             "tracked_by_the_optimiser": self.tracked,
         }
 
 
 @dataclass(frozen=True)
 class VehicleNavigation:
-    """One vehicle's belief model (no budget) and route energy, to choose its route."""
+    """One vehicle's belief model (no budget) and route energy, to choose its route.
+
+    ``energy(L)`` [J] of a route of length ``L`` [m]; ``power`` [W] converts the model's
+    ``error_weight`` [1/m²] to ``weights.navigation`` [W/m²].
+    """
 
     name: str
     model: BeliefModel
     energy: Callable[[float], float]
+    power: float
     max_error: float | None
     max_energy_increase: float
     min_error_reduction: float
@@ -174,32 +181,46 @@ class VehicleNavigation:
                 logger.info("%s", unmet.message)  # the plan's verdict tells the user
                 return route, unmet
             return route, choice(route, "budget", self.max_error)
-        best, best_budget = cheapest, None
+        if base_peak <= 0.0:  # the route ends within settle_s: nothing to buy
+            return cheapest, choice(cheapest, "automatic", None)
         cap = (1.0 + self.max_energy_increase) * base_energy
-        steps = LADDER_STEPS if base_peak > 0.0 else 0  # 0: the route ends within settle_s
-        for step in range(1, steps + 1):  # tighter budgets cost at least as much
-            budget = base_peak * LADDER_RATIO**step
-            within: Route | None = None
-            for bins in LADDER_BINS:  # a budget the coarse bins miss, searched again finer
-                searches += 1
-                try:
-                    found = search(self.with_budget(budget, bins), False)
-                except BudgetInfeasible:
-                    continue
-                if self.energy(path_length(found.points)) <= cap:
-                    within = found
-                    break
-            if within is None:
-                break
-            if route_rms(within) < route_rms(best):
-                best, best_budget = within, budget
-        if route_rms(best) > (1.0 - self.min_error_reduction) * base_rms:
-            best, best_budget = cheapest, None
-        return best, choice(best, "automatic", best_budget)
+        scale = 1.0 / base_rms**2
 
-    def with_budget(self, budget: float, bins: int = MAX_BUDGET_BINS) -> BeliefModel:
-        """The model with a budget [m] resolved in ``bins`` bins of σ at most."""
-        return dataclasses.replace(self.model, max_error=budget, budget_bins=bins)
+        def priced(exponent: float) -> Route | None:
+            """The route at the price ``scale 10^exponent`` if it is within the cap."""
+            nonlocal searches
+            searches += 1
+            price = self.model.error_weight + scale * 10.0**exponent
+            model = dataclasses.replace(self.model, max_error=base_peak, error_weight=price)
+            try:
+                found = search(model, False)
+            except BudgetInfeasible:  # coarse σ bins may lose the shortest route itself
+                return None
+            return found if self.energy(path_length(found.points)) <= cap else None
+
+        best, best_exponent = cheapest, None
+        low, high = -PRICE_DECADES, PRICE_DECADES
+        found = priced(high)
+        if found is not None:  # the least error any route buys is within the cap
+            best, best_exponent = found, high
+        for _ in range(PRICE_STEPS if found is None else 0):
+            middle = 0.5 * (low + high)
+            found = priced(middle)
+            if found is None:
+                high = middle
+                continue
+            low = middle
+            if route_rms(found) < route_rms(best):
+                best, best_exponent = found, middle
+        if best_exponent is None or route_rms(best) > (1.0 - self.min_error_reduction) * base_rms:
+            return cheapest, choice(cheapest, "automatic", None)
+        price = self.model.error_weight + scale * 10.0**best_exponent
+        chosen = choice(best, "automatic", base_peak)
+        return best, dataclasses.replace(chosen, price_w_m2=price * self.power)
+
+    def with_budget(self, budget: float) -> BeliefModel:
+        """The model with a budget [m]."""
+        return dataclasses.replace(self.model, max_error=budget)
 
     def _budget_message(self, cheapest: Route, floor: float) -> str:
         """One line: where the cheapest route breaks the budget, and the smallest budget."""
@@ -306,8 +327,8 @@ def vehicle_navigation(
         )
         vehicles.append(
             VehicleNavigation(
-                name, model_nav, energy, navigation.max_error, navigation.max_energy_increase,
-                navigation.min_error_reduction,
+                name, model_nav, energy, speed * per_metre, navigation.max_error,
+                navigation.max_energy_increase, navigation.min_error_reduction,
             )
         )  # fmt: skip
     return tuple(vehicles)

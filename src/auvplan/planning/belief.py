@@ -73,8 +73,6 @@ class BeliefModel:
         Quantisation of σ [m] for dominance (at least; see :attr:`width`).
     max_labels : int
         Labels created before the search gives up (bounds the memory, 64 B per label).
-    budget_bins : int
-        Bins of σ under a budget at most (:attr:`width`).
     """
 
     fisher: FloatArray
@@ -87,7 +85,6 @@ class BeliefModel:
     error_weight: float = 0.0
     bin_width: float = 0.5
     max_labels: int = 40_000_000
-    budget_bins: int = MAX_BUDGET_BINS
 
     def __post_init__(self) -> None:
         for name in ("updates_per_metre", "drift_rate", "process_variance", "error_weight"):
@@ -97,14 +94,12 @@ class BeliefModel:
         for name in ("initial_sigma", "bin_width", "max_error"):
             if not getattr(self, name) > 0.0:
                 raise InputError(f"belief model {name} must be > 0, got {getattr(self, name)}")
-        if self.budget_bins < 1:
-            raise InputError(f"belief model budget_bins must be >= 1, got {self.budget_bins}")
 
     @property
     def width(self) -> float:
-        """Width [m] of the σ bins: ``bin_width``, or a budget's ``budget_bins``-th."""
+        """Width [m] of the σ bins: ``bin_width``, or a budget's :data:`MAX_BUDGET_BINS`-th."""
         if math.isfinite(self.max_error):
-            return max(self.bin_width, self.max_error / self.budget_bins)
+            return max(self.bin_width, self.max_error / MAX_BUDGET_BINS)
         return self.bin_width
 
     @property
