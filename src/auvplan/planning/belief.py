@@ -165,8 +165,8 @@ def search_belief(
     code, flat, sigma, cost, peak, n_labels = belief_search(
         _padded(cells, np.inf).ravel(), width, start, goal,
         float(problem.spacing_north), float(problem.spacing_east), factor, stride,
-        len(MOVES) if stride else 2 * len(MOVES), _padded(_heuristic(problem), 0.0).ravel(),
-        _padded(np.moveaxis(model.fisher, -1, 0), 0.0).reshape(3, -1).T.copy(),
+        len(MOVES) if stride else 2 * len(MOVES), _heuristic(problem).ravel(),
+        _padded_fisher(model.fisher),
         model.updates_per_metre, model.drift_rate**2, model.process_variance,
         model.initial_sigma**2, math.inf if bottleneck else model.max_error,
         model.settle_distance, model.error_weight,
@@ -201,18 +201,29 @@ def _padded(values: FloatArray, fill: float) -> FloatArray:
     return np.pad(values, padding, constant_values=fill)
 
 
+def _padded_fisher(fisher: FloatArray) -> FloatArray:
+    """``fisher`` ``(n_rows, n_cols, 3)`` in a ring of :data:`_PAD` zero cells, flat per cell."""
+    rows, cols, _ = fisher.shape
+    padded = np.zeros((rows + 2 * _PAD, cols + 2 * _PAD, 3))
+    padded[_PAD:-_PAD, _PAD:-_PAD] = fisher
+    return padded.reshape(-1, 3)
+
+
 def _heuristic(problem: PlanningProblem) -> FloatArray:
     """Euclidean distance to the goal [m] times the least cost per metre of any move.
 
     A lower bound of every path's cost whatever the move set (king or knight moves), and
     consistent: a move of length ℓ costs at least ``c_min f_min ℓ`` and changes the distance
-    by at most ℓ.
+    by at most ℓ. Of the padded grid (the ring's cells are impassable: never read).
     """
     passable = np.isfinite(problem.cost) & problem.passable
     rate = float(np.min(problem.cost[passable])) if np.any(passable) else 0.0
     if problem.move_factor is not None:
         factors = problem.move_factor[np.isfinite(problem.move_factor)]
         rate *= float(np.min(factors)) if factors.size else 0.0
-    north = (np.arange(problem.shape[0]) - problem.goal[0]) * problem.spacing_north
-    east = (np.arange(problem.shape[1]) - problem.goal[1]) * problem.spacing_east
-    return np.asarray(rate * np.hypot(north[:, None], east[None, :]), np.float64)
+    rows, cols = problem.shape
+    north = (np.arange(-_PAD, rows + _PAD) - problem.goal[0]) * problem.spacing_north
+    east = (np.arange(-_PAD, cols + _PAD) - problem.goal[1]) * problem.spacing_east
+    distance = np.hypot(north[:, None], east[None, :])
+    distance *= rate
+    return np.asarray(distance, np.float64)
