@@ -42,7 +42,8 @@ peak. ``labels``: labels the belief search created (for the automatic mode, summ
 searches that returned a route; an infeasible budget raises inside ``plan_route`` and is not
 counted), cells A* expanded. ``budget m``: the budget searched (for the automatic mode, the
 bound of its priced searches, the shortest route's peak); ``route m``: the graph cost, i.e.
-the length over cell centres (for the automatic mode the route's polyline length); ``peak σ``: the route's peak predicted radial error after settling.
+the length over cell centres (for the automatic mode the route's polyline length);
+``peak σ``: the route's peak predicted radial error after settling.
 """
 
 from __future__ import annotations
@@ -50,6 +51,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import math
 import os
 import statistics
 import subprocess
@@ -283,11 +285,12 @@ class Case:
             return route
 
         vehicle = VehicleNavigation(
-            "auv", self.model, lambda length: length, 1.0, None,
+            "auv", self.model, lambda length: length, 1.0,
+            math.dist(*self.endpoints), None,
             float(self.config.max_energy_increase), float(self.config.min_error_reduction),
         )  # fmt: skip
         try:
-            route, choice = vehicle.route(one)
+            route, choice = vehicle.route(one, True)  # the seabed has no obstacle
         except InputError as error:
             return {"outcome": "too many labels", "labels": sum(labels), "error": str(error)}
         return {

@@ -192,7 +192,9 @@ def _fake_route(length: float, sigma: float) -> object:
     )  # fmt: skip
 
 
-def _priced_vehicle(max_energy_increase: float = 0.08, min_error_reduction: float = 0.2) -> object:
+def _priced_vehicle(
+    max_energy_increase: float = 0.08, min_error_reduction: float = 0.2, straight: float = 100.0
+) -> object:
     import numpy as np
 
     from auvplan.mission.navigation import VehicleNavigation
@@ -200,8 +202,9 @@ def _priced_vehicle(max_energy_increase: float = 0.08, min_error_reduction: floa
 
     model = BeliefModel(np.zeros((1, 1, 3)), 0.1, 0.01, 0.0, 1.0)
     return VehicleNavigation(
-        "v", model, lambda length: length, 2.0, None, max_energy_increase, min_error_reduction
-    )
+        "v", model, lambda length: length, 2.0, straight, None, max_energy_increase,
+        min_error_reduction,
+    )  # fmt: skip
 
 
 def _priced_search(prices: list[float]) -> Callable[..., object]:
@@ -228,7 +231,7 @@ def test_the_automatic_route_is_the_least_error_one_within_the_energy_cap() -> N
     # the bisection on the price must pass the 104 m route, take the 107 m one and refuse the
     # 120 m one (+20 % > 8 %); prices around 1 / σ_rms² = 0.01 of the shortest route
     prices: list[float] = []
-    chosen, choice = _priced_vehicle().route(_priced_search(prices))  # type: ignore[attr-defined]
+    chosen, choice = _priced_vehicle().route(_priced_search(prices), True)  # type: ignore[attr-defined]
     assert chosen.points[-1, 1] == 107.0
     assert choice.rms_m == 5.0
     assert choice.budget_m == 10.0  # within the shortest route's peak
@@ -241,7 +244,7 @@ def test_the_automatic_route_is_the_least_error_one_within_the_energy_cap() -> N
 def test_the_least_error_route_within_the_cap_is_taken_in_one_search() -> None:
     prices: list[float] = []
     vehicle = _priced_vehicle(max_energy_increase=0.25)
-    chosen, choice = vehicle.route(_priced_search(prices))  # type: ignore[attr-defined]
+    chosen, choice = vehicle.route(_priced_search(prices), True)  # type: ignore[attr-defined]
     assert chosen.points[-1, 1] == 120.0
     assert choice.searches == 2
 
@@ -249,8 +252,22 @@ def test_the_least_error_route_within_the_cap_is_taken_in_one_search() -> None:
 def test_a_cut_below_min_error_reduction_buys_nothing() -> None:
     # within 5 %, the best route (104 m) cuts σ from 10 to 6 m: 40 %; asking 50 % buys nothing
     vehicle = _priced_vehicle(max_energy_increase=0.05, min_error_reduction=0.5)
-    chosen, choice = vehicle.route(_priced_search([]))  # type: ignore[attr-defined]
+    chosen, choice = vehicle.route(_priced_search([]), True)  # type: ignore[attr-defined]
     assert chosen.points[-1, 1] == 100.0
     assert choice.budget_m is None
     assert choice.price_w_m2 is None
     assert choice.energy_increase == 0.0
+
+
+def test_the_energy_cap_is_measured_from_the_plan_that_flies_the_straight_line() -> None:
+    # the energy-only plan flies the straight line (98 m) where it is clear, not the 100 m
+    # grid route: 8 % over it is 105.8 m, which the 104 m route meets and the 107 m one not
+    vehicle = _priced_vehicle(straight=98.0)
+    chosen, choice = vehicle.route(_priced_search([]), True)  # type: ignore[attr-defined]
+    assert chosen.points[-1, 1] == 104.0
+    assert choice.energy_increase == pytest.approx(104.0 / 98.0 - 1.0)
+    assert choice.straight_clear
+    # where the straight line is blocked, the energy-only plan flies the shortest route
+    chosen, choice = vehicle.route(_priced_search([]), False)  # type: ignore[attr-defined]
+    assert chosen.points[-1, 1] == 107.0
+    assert not choice.straight_clear

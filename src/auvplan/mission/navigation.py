@@ -12,11 +12,13 @@ recursion of :mod:`auvplan.navigation.prediction` at the vehicle's nominal speed
   route meets (its ``smallest_budget_m``), and a warning naming where the shortest route
   breaks the budget: the plan then fails its check (exit 3) with that smallest budget.
 * **Automatic** (no ``max_error_m``): the route of least predicted RMS error within
-  ``max_energy_increase`` over the shortest route's energy, found as the Lagrangian of that
-  problem: searches with a soft price ``λ ∫ σ² ds`` on the error variance, ``λ`` bisected on
-  a log scale (:data:`PRICE_DECADES`, :data:`PRICE_STEPS`) for the largest price whose route
-  is within the energy cap (the route's length grows with ``λ``), each search kept within
-  the shortest route's peak error (which bounds its σ bins). The route of least RMS error
+  ``max_energy_increase`` over the energy-only plan's energy (that of the straight line from
+  start to goal where it is clear, which that plan flies; else of the shortest route), found
+  as the Lagrangian of that problem: searches with a soft price ``λ ∫ σ² ds`` on the error
+  variance, ``λ`` bisected on a log scale (:data:`PRICE_DECADES`, :data:`PRICE_STEPS`) for
+  the largest price whose route is within the energy cap (the route's length grows with
+  ``λ``), each search kept within the shortest route's peak error (which bounds its σ
+  bins). The route of least RMS error
   among those within the cap is taken if it cuts the shortest route's RMS by at least
   ``min_error_reduction``, else the shortest route. Energy of a route of length
   ``L``: ``P(L / T) T`` with a fixed horizon ``T`` (faster on a longer route), ``e(U) L``
@@ -72,7 +74,8 @@ class NavigationChoice:
     ``mode``: ``"budget"`` or ``"automatic"``; ``budget_m``: the budget the route meets
     (None: the energy-only route); ``peak_m`` / ``rms_m``: predicted peak error after settling
     and RMS error along the route; ``energy_only_*``: the same for the shortest route;
-    ``energy_increase``: predicted extra energy of the route (fraction); ``searches``: the
+    ``energy_increase``: predicted extra energy of the route over the energy-only plan's, the
+    straight line where it is clear, else the shortest route (fraction); ``searches``: the
     searches run; ``smallest_budget_m``: when no route meets the budget, the smallest one
     any route meets (the route is then within it), and ``message`` says where the shortest
     route breaks the budget; ``straight_clear``: whether the straight line from start to goal
@@ -135,32 +138,44 @@ class VehicleNavigation:
     """One vehicle's belief model (no budget) and route energy, to choose its route.
 
     ``energy(L)`` [J] of a route of length ``L`` [m]; ``power`` [W] converts the model's
-    ``error_weight`` [1/m²] to ``weights.navigation`` [W/m²].
+    ``error_weight`` [1/m²] to ``weights.navigation`` [W/m²]; ``straight`` [m] is the
+    distance from start to goal.
     """
 
     name: str
     model: BeliefModel
     energy: Callable[[float], float]
     power: float
+    straight: float
     max_error: float | None
     max_energy_increase: float
     min_error_reduction: float
 
-    def route(self, search: RouteSearch) -> tuple[Route, NavigationChoice]:
-        """The vehicle's route by its budget or automatically (module notes)."""
+    def route(self, search: RouteSearch, straight_clear: bool) -> tuple[Route, NavigationChoice]:
+        """The vehicle's route by its budget or automatically (module notes).
+
+        ``straight_clear``: whether the straight line from start to goal is clear, so that
+        the energy-only plan flies it (the energy the route's increase is measured from:
+        ``straight`` metres, else the shortest route's length).
+        """
         cheapest = search(self.model, False)
-        base_energy = self.energy(path_length(cheapest.points))
+        shortest = self.straight if straight_clear else path_length(cheapest.points)
+        base_energy = self.energy(shortest)
         base_peak, base_rms = _peak(cheapest), route_rms(cheapest)
         searches = 1
 
         def choice(
             route: Route, mode: str, budget: float | None, smallest: float | None = None
         ) -> NavigationChoice:
-            increase = self.energy(path_length(route.points)) / base_energy - 1.0
+            increase = (
+                self.energy(path_length(route.points)) / base_energy - 1.0
+                if route is not cheapest
+                else 0.0  # the energy-only plan
+            )
             message = "" if smallest is None else self._budget_message(cheapest, smallest)
             return NavigationChoice(
                 mode, budget, _peak(route), route_rms(route), base_peak, base_rms, increase,
-                searches, smallest, message,
+                searches, smallest, message, straight_clear,
             )  # fmt: skip
 
         if self.max_error is not None:
@@ -327,7 +342,7 @@ def vehicle_navigation(
         )
         vehicles.append(
             VehicleNavigation(
-                name, model_nav, energy, speed * per_metre, navigation.max_error,
+                name, model_nav, energy, speed * per_metre, float(distance), navigation.max_error,
                 navigation.max_energy_increase, navigation.min_error_reduction,
             )
         )  # fmt: skip

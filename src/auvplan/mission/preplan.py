@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import math
 from collections.abc import Callable
@@ -440,7 +439,10 @@ def plan_routes(
 
                 if navigation is None:
                     return one(None), None
-                return navigation[index].route(one)
+                clear = _straight_clear(
+                    starts[index, :2], goals[index, :2], 0.25 * cell, is_blocked
+                )
+                return navigation[index].route(one, clear)
 
             radius = 0.0 if turning_radii is None else float(turning_radii[index])
             deviation = max(0.5 * cell, CORNER_CUT * radius)
@@ -468,10 +470,6 @@ def plan_routes(
                 )  # fmt: skip
             routes.append(route)
             if choice is not None:
-                clear = _straight_clear(
-                    starts[index, :2], goals[index, :2], 0.25 * cell, is_blocked
-                )
-                choice = dataclasses.replace(choice, straight_clear=clear)
                 logger.info(
                     "navigation %s: %s route, predicted error RMS %.1f m, peak %.1f m "
                     "(shortest route: %.1f m, %.1f m), energy %+.1f %%",
