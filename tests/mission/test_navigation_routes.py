@@ -32,7 +32,7 @@ def test_automatic_routes_buy_navigation_only_where_it_is_worth_it(
     assert isinstance(rms, float)
     assert isinstance(base, float)
     assert rms <= 0.8 * base
-    assert 0.0 < float(ridge["route_energy_increase"]) <= 0.08  # type: ignore[arg-type]
+    assert 0.0 < float(ridge["route_energy_increase"]) <= 0.10  # type: ignore[arg-type]
     flat = _preplan(transit_mission(tmp_path / "flat", ridge=False), tmp_path / "flat" / "out")
     assert flat["budget_m"] is None
     assert flat["route_energy_increase"] == 0.0

@@ -443,7 +443,7 @@ class NavigationConfig(TableModel):
         json_schema_extra=_unit("s"),
     )  # fmt: skip
     max_energy_increase: Number = Field(
-        0.08,
+        0.10,
         ge=0.0,
         le=10.0,
         description="automatic budget: most extra energy (fraction of the energy-only path's)",
