@@ -64,6 +64,8 @@ from auvplan.navigation._prediction_kernel import propagate
 #: Columns of the label table: cost, p00, p01, p11, variance grown since the fixes, distance,
 #: peak.
 _G, _P00, _P01, _P11, _GROWN, _DIST, _PEAK = 0, 1, 2, 3, 4, 5, 6
+#: Most labels the tables of :func:`belief_search` have room for from the start (88 B each).
+_INITIAL_LABELS = 1 << 24
 #: Exit codes of :func:`belief_search`.
 FOUND, UNREACHABLE, TOO_MANY_LABELS = 0, 1, 2
 
@@ -284,7 +286,9 @@ def belief_search(
     # queued labels per cell for the push-time dominance, the first to pop (slot 0) and the
     # lowest bin (slot 1), as records key, σ², peak, label: kept beside the cell for locality
     references = np.full((cost.shape[0] if ties else 0, 2, 4), -1.0)
-    capacity = 1024
+    # room for a label per cell (up to 2^24) from the start: growing by doubling copied the
+    # tables again and again; the pages are only touched as labels fill them
+    capacity = max(1024, min(max_labels, cost.shape[0], _INITIAL_LABELS))
     table = np.empty((capacity, 7))
     cells = np.empty(capacity, np.int64)
     parents = np.empty(capacity, np.int64)
