@@ -72,7 +72,7 @@ class BeliefModel:
     bin_width : float
         Quantisation of σ [m] for dominance (at least; see :attr:`width`).
     max_labels : int
-        Labels created before the search gives up (bounds the memory, 64 B per label).
+        Labels created before the search gives up (bounds the memory, 88 B per label).
     """
 
     fisher: FloatArray
@@ -214,7 +214,7 @@ def _heuristic(problem: PlanningProblem) -> FloatArray:
 
     A lower bound of every path's cost whatever the move set (king or knight moves), and
     consistent: a move of length ℓ costs at least ``c_min f_min ℓ`` and changes the distance
-    by at most ℓ. Of the padded grid (the ring's cells are impassable: never read).
+    by at most ℓ. Evaluated on the padded grid (the ring's cells are impassable: never read).
     """
     passable = np.isfinite(problem.cost) & problem.passable
     rate = float(np.min(problem.cost[passable])) if np.any(passable) else 0.0
