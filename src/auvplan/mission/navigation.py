@@ -201,12 +201,17 @@ class VehicleNavigation:
         cap = (1.0 + self.max_energy_increase) * base_energy
         scale = 1.0 / base_rms**2
 
+        def price(exponent: float) -> float:
+            """The model's price [1/m²]: its own ``error_weight`` plus ``scale 10^exponent``."""
+            return float(self.model.error_weight + scale * 10.0**exponent)
+
         def priced(exponent: float) -> Route | None:
-            """The route at the price ``scale 10^exponent`` if it is within the cap."""
+            """The route at :func:`price` ``(exponent)`` if it is within the cap."""
             nonlocal searches
             searches += 1
-            price = self.model.error_weight + scale * 10.0**exponent
-            model = dataclasses.replace(self.model, max_error=base_peak, error_weight=price)
+            model = dataclasses.replace(
+                self.model, max_error=base_peak, error_weight=price(exponent)
+            )
             try:
                 found = search(model, False)
             except BudgetInfeasible:  # coarse σ bins may lose the shortest route itself
@@ -229,9 +234,8 @@ class VehicleNavigation:
                 best, best_exponent = found, middle
         if best_exponent is None or route_rms(best) > (1.0 - self.min_error_reduction) * base_rms:
             return cheapest, choice(cheapest, "automatic", None)
-        price = self.model.error_weight + scale * 10.0**best_exponent
         chosen = choice(best, "automatic", base_peak)
-        return best, dataclasses.replace(chosen, price_w_m2=price * self.power)
+        return best, dataclasses.replace(chosen, price_w_m2=price(best_exponent) * self.power)
 
     def with_budget(self, budget: float) -> BeliefModel:
         """The model with a budget [m]."""

@@ -415,11 +415,17 @@ def plan_routes(
                 else current_move_factor(geometry, velocity, float(water_speeds[index]))
             )
 
+            # whether the energy-only plan can fly the straight line (the navigation's energy base)
+            clear = navigation is not None and _straight_clear(
+                starts[index, :2], goals[index, :2], 0.25 * cell, is_blocked
+            )
+
             def search(
                 extra: tuple[Obstacle, ...],
                 index: int = index,
                 name: str = name,
                 factor: FloatArray | None = factor,
+                clear: bool = clear,
             ) -> tuple[Route, NavigationChoice | None]:
                 def one(belief: BeliefModel | None, bottleneck: bool = False) -> Route:
                     return plan_route(
@@ -439,9 +445,6 @@ def plan_routes(
 
                 if navigation is None:
                     return one(None), None
-                clear = _straight_clear(
-                    starts[index, :2], goals[index, :2], 0.25 * cell, is_blocked
-                )
                 return navigation[index].route(one, clear)
 
             radius = 0.0 if turning_radii is None else float(turning_radii[index])
