@@ -90,6 +90,9 @@ def test_a_vehicle_30_m_off_gets_a_plan_that_meets_every_constraint(
     assert result.problem is None  # CONVERGED, every constraint met between samples
     assert result.plan is not None
     assert result.plan.verdict.status.name == "CONVERGED"
+    levels = result.config.solver.pronto_options().epsilon_levels()
+    first = levels[-2] if schedule == "kept" else levels[0]  # the old plan re-centred one level up
+    assert result.plan.result.history[0].epsilon == pytest.approx(first)
     wanted = parent.states[0][_step(parent), :2] + [north, east]
     np.testing.assert_allclose(result.plan.states[0][0, :2], wanted, atol=1e-9)
     separation = 2.0 * result.config.fleet.safety_radius

@@ -47,8 +47,8 @@ def test_lq_sweep_with_blocks_equals_the_dense_sweep(rng: np.random.Generator) -
     l_x, l_u = rng.normal(size=(N, N_X)), rng.normal(size=(N, N_U))
     p_final, m_x = np.eye(N_X) + 0.1 * np.ones((N_X, N_X)), rng.normal(size=N_X)
     args = (a, b, q, s, r, l_x, l_u, p_final, m_x)
-    dense = _kernels.lq_backward(*args, np.array([[0, N_X]]), np.array([[0, N_U]]))
-    blocked = _kernels.lq_backward(*args, *block_ranges(_groups(), N_X, N_U))
+    dense = _kernels.lq_backward(*args, np.array([[0, N_X]]), np.array([[0, N_U]]), 0.0)
+    blocked = _kernels.lq_backward(*args, *block_ranges(_groups(), N_X, N_U), 0.0)
     assert dense[2] == blocked[2] == -1
     np.testing.assert_allclose(blocked[0], dense[0], rtol=1e-11, atol=1e-12)
     np.testing.assert_allclose(blocked[1], dense[1], rtol=1e-11, atol=1e-12)
@@ -81,8 +81,8 @@ def test_lq_sweep_by_components_equals_the_dense_sweep(rng: np.random.Generator)
     l_x, l_u = rng.normal(size=(N, N_X)), rng.normal(size=(N, N_U))
     p_final, m_x = np.diag(rng.uniform(1.0, 2.0, N_X)), rng.normal(size=N_X)
     args = (a, b, q, s, r, l_x, l_u, p_final, m_x)
-    dense = _kernels.lq_backward(*args, np.array([[0, N_X]]), np.array([[0, N_U]]))
-    parts = _kernels.lq_backward(*args, *block_ranges(_groups(), N_X, N_U))
+    dense = _kernels.lq_backward(*args, np.array([[0, N_X]]), np.array([[0, N_U]]), 0.0)
+    parts = _kernels.lq_backward(*args, *block_ranges(_groups(), N_X, N_U), 0.0)
     assert dense[2] == parts[2] == -1
     np.testing.assert_allclose(parts[0], dense[0], rtol=1e-10, atol=1e-12)
     np.testing.assert_allclose(parts[1], dense[1], rtol=1e-10, atol=1e-12)
@@ -108,3 +108,39 @@ def test_regulator_on_replaced_stages_equals_the_regulator_on_the_edited_lineari
     given = design_regulator(a, b, q_r, r_r, blocks=blocks, replaced=replaced)
     np.testing.assert_allclose(given, expected, rtol=1e-12, atol=1e-14)
     assert not np.allclose(given, design_regulator(a, b, q_r, r_r, blocks=blocks))
+
+
+def _projected(w: np.ndarray, floor: float) -> np.ndarray:
+    """``V max(Λ, floor) Vᵀ`` of every stage, by numpy on the whole matrix."""
+    values, vectors = np.linalg.eigh(w)
+    return np.einsum("kij,kj,klj->kil", vectors, np.maximum(values, floor), vectors)
+
+
+def test_clipped_lq_sweep_is_the_sweep_of_the_projected_weights(rng: np.random.Generator) -> None:
+    """Indefinite stage weights (subsystems 0 and 1 coupled at some stages, a state on its
+    own): the sweep with ``floor`` equals the plain sweep on the weights projected by numpy."""
+    a, b = _block_diagonal_dynamics(rng)
+    w = np.zeros((N, N_X + N_U, N_X + N_U))
+    for group in _groups():
+        z = rng.normal(size=(N, group.size, group.size))
+        w[:, group[:, None], group] = z @ np.swapaxes(z, 1, 2) - 2.0 * np.eye(group.size)
+    coupled = np.r_[_groups()[0], _groups()[1]]
+    w[::4, coupled[0], coupled[-1]] = w[::4, coupled[-1], coupled[0]] = 0.7
+    w[:, 9, :] = w[:, :, 9] = 0.0  # a state that nothing couples: a 1 x 1 block
+    w[:, 9, 9] = rng.normal(size=N)
+    l_x, l_u = rng.normal(size=(N, N_X)), rng.normal(size=(N, N_U))
+    p_final, m_x = np.diag(rng.uniform(1.0, 2.0, N_X)), rng.normal(size=N_X)
+    blocks = block_ranges(_groups(), N_X, N_U)
+
+    def sweep(weights: np.ndarray, floor: float) -> tuple:
+        q, s, r = (weights[:, :N_X, :N_X], weights[:, :N_X, N_X:], weights[:, N_X:, N_X:])
+        args = (a, b, q.copy(), s.copy(), r.copy(), l_x, l_u, p_final, m_x)
+        return _kernels.lq_backward(*args, *blocks, floor)
+
+    values, vectors = np.linalg.eigh(w)
+    projected = np.einsum("kij,kj,klj->kil", vectors, np.maximum(values, 0.5), vectors)
+    clipped, plain = sweep(w, 0.5), sweep(projected, 0.0)
+    assert clipped[2] == plain[2] == -1
+    np.testing.assert_allclose(clipped[0], plain[0], rtol=1e-9, atol=1e-11)
+    np.testing.assert_allclose(clipped[1], plain[1], rtol=1e-9, atol=1e-11)
+    assert sweep(w, 0.0)[2] >= 0  # unclipped, the sweep fails

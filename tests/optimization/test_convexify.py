@@ -1,4 +1,4 @@
-"""The convexified model: eigenvalues clipped at the floor, per block when stages decouple."""
+"""The convexified model: eigenvalues clipped at the floor, per block where stages decouple."""
 
 from __future__ import annotations
 
@@ -32,23 +32,23 @@ def _stacked(weights: StageWeights) -> np.ndarray:
     return np.concatenate([top, np.concatenate([np.swapaxes(weights.S, 1, 2), weights.R], 2)], 1)
 
 
+def _projection(stacked: np.ndarray, floor: float) -> np.ndarray:
+    """``V max(Λ, floor) Vᵀ`` of every stage, by numpy on the whole matrix."""
+    values, vectors = np.linalg.eigh(stacked)
+    return np.einsum("kij,kj,klj->kil", vectors, np.maximum(values, floor), vectors)
+
+
 def test_clipped_model_is_the_eigenvalue_projection() -> None:
+    """Two vehicles' blocks, joined at some stages: the same as projecting every stage whole."""
     weights = _weights(np.random.default_rng(0))
     clipped = _stacked(convexify(weights, 1e-2))
-    values, vectors = np.linalg.eigh(_stacked(weights))
-    expected = np.einsum("kij,kj,klj->kil", vectors, np.maximum(values, 1e-2), vectors)
-    np.testing.assert_allclose(clipped, expected, atol=1e-12)
+    np.testing.assert_allclose(clipped, _projection(_stacked(weights), 1e-2), atol=1e-12)
     assert np.min(np.linalg.eigvalsh(clipped)) >= 1e-2 - 1e-12
 
 
-def test_block_wise_clipping_gives_the_same_model() -> None:
-    weights = _weights(np.random.default_rng(1))
-    whole, by_block = convexify(weights, 1e-2), convexify(weights, 1e-2, GROUPS)
-    np.testing.assert_allclose(_stacked(by_block), _stacked(whole), atol=1e-12)
-
-
-def test_clipping_by_coupled_components_gives_the_same_model() -> None:
-    """Four vehicles, pairs of them coupled at some stages: clipped per component, exactly."""
+def test_clipping_by_coupled_components_gives_the_projection() -> None:
+    """Four vehicles, chains and pairs of them coupled at some stages, and coordinates of a
+    vehicle that nothing couples (1 × 1 blocks, below and above the floor)."""
     rng = np.random.default_rng(2)
     n_x, stages = 16, 80
     groups = tuple(np.r_[4 * g : 4 * g + 4, n_x + g] for g in range(4))  # 4 states, 1 input
@@ -59,12 +59,26 @@ def test_clipping_by_coupled_components_gives_the_same_model() -> None:
     for a, b, every in ((0, 2, 3), (2, 3, 4), (1, 3, 7)):  # chains and pairs of components
         stacked[::every, 4 * a, 4 * b + 1] = stacked[::every, 4 * b + 1, 4 * a] = 0.4
         stacked[::every, n_x + a, 4 * b] = stacked[::every, 4 * b, n_x + a] = -0.2
+    alone = 4 * 1 + 2  # vehicle 1's third state: on its own at every stage
+    stacked[:, alone, :] = stacked[:, :, alone] = 0.0
+    stacked[:, alone, alone] = rng.normal(size=stages)
     weights = StageWeights(
         stacked[:, :n_x, :n_x].copy(),
         stacked[:, :n_x, n_x:].copy(),
         stacked[:, n_x:, n_x:].copy(),
         np.eye(n_x),
     )
-    whole, by_component = convexify(weights, 1e-2), convexify(weights, 1e-2, groups)
-    np.testing.assert_allclose(_stacked(by_component), _stacked(whole), atol=1e-12)
-    assert np.min(np.linalg.eigvalsh(_stacked(by_component))) >= 1e-2 - 1e-12
+    clipped = _stacked(convexify(weights, 1e-2))
+    np.testing.assert_allclose(clipped, _projection(stacked, 1e-2), atol=1e-12)
+    assert np.min(np.linalg.eigvalsh(clipped)) >= 1e-2 - 1e-12
+    assert np.all(clipped[:, alone, alone] == np.maximum(stacked[:, alone, alone], 1e-2))
+
+
+def test_stages_above_the_floor_are_kept_bit_for_bit() -> None:
+    weights = _weights(np.random.default_rng(3))
+    stacked = _stacked(weights)
+    kept = np.all(np.linalg.eigvalsh(stacked) > 1e-2, axis=1)
+    assert kept.any()
+    assert not kept.all()
+    clipped = _stacked(convexify(weights, 1e-2))
+    assert np.array_equal(clipped[kept], stacked[kept])

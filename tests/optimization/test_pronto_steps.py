@@ -31,6 +31,7 @@ from auvplan.optimization import (
     solve_lq_direction,
     solve_pronto,
 )
+from auvplan.optimization.lq import quadratic_form
 
 from ._problems import (
     crossing_problem,
@@ -174,7 +175,10 @@ def test_newton_direction_is_the_model_minimiser(rng: np.random.Generator) -> No
     weights = second_order_weights(model, xi, lin, costate)
     direction = solve_lq_direction(lin, weights)
     assert direction.direction is DirectionType.NEWTON
-    assert direction.slope == pytest.approx(-direction.model_curvature, rel=1e-10)
+    # the LQ minimiser of a convex model: Dh·ζ = −ζᵀ W ζ
+    assert direction.slope == pytest.approx(
+        -quadratic_form(weights, direction.z, direction.v), rel=1e-10
+    )
     # the closed-loop costate: λ_N = m_x and λ_k = a_k − K_kᵀ b_k + (A_k − B_k K_k)ᵀ λ_{k+1}
     np.testing.assert_allclose(costate[-1], lin.m_x)
     k = 7
@@ -257,7 +261,7 @@ def test_armijo_rejects_diverging_candidates() -> None:
     weights = second_order_weights(model, xi, lin, compute_costate(lin, gains))
     direction = solve_lq_direction(lin, weights)
     huge = type(direction)(
-        direction.z * 1e4, direction.v * 1e4, direction.slope * 1e4, 0.0, direction.direction
+        direction.z * 1e4, direction.v * 1e4, direction.slope * 1e4, direction.direction
     )
     with np.errstate(all="ignore"):
         blown = project(model, Trajectory(xi.states + huge.z, xi.inputs + huge.v), gains)
@@ -286,7 +290,7 @@ def test_armijo_rejects_infeasible_candidates_once_feasible() -> None:
     z = np.zeros_like(xi.states)
     z[:, 0] = 2.0 - xi.states[:, 0]
     z[:, 1] = 0.15 - xi.states[:, 1]
-    push = LqDirection(z, np.zeros_like(xi.inputs), 0.0, 0.0, DirectionType.STEEPEST)
+    push = LqDirection(z, np.zeros_like(xi.inputs), 0.0, DirectionType.STEEPEST)
     lin = linearize(model, xi, result.epsilon, result.delta)
     gains = design_regulator(lin.A, lin.B, 100.0 * problem.state_weight, problem.input_weight)
     common = {"epsilon": result.epsilon, "delta": result.delta, "max_backtracks": 40}

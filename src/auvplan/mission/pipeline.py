@@ -258,8 +258,11 @@ def run_optimization(
     """Stage 3: PRONTO with barrier continuation from the projected desired trajectories.
 
     A ``warm_start`` with a guess (a replan: the old plan from the replanning time) starts at
-    the last barrier level ``eps_final`` and at the guess's ``δ``: the guess solves that
-    level already.
+    the guess's ``δ`` and at the barrier level before the last: the guess solved the last
+    level for other starts, and a vehicle moved off its plan can leave it infeasible (4 × 1 h
+    MEDUSAs, one moved 30 m: scaled slack −0.05). One level up the barrier re-centres it; at
+    the last level its iterates hug the constraint it crossed (``δ`` shrank to 7e-10, 17
+    iterations against 9, ``benchmarks/bench_replan.py``).
     """
     assembled = assemble_problem(
         layout, preplan, deconfliction,
@@ -270,7 +273,10 @@ def run_optimization(
     options = config.solver.pronto_options()
     if warm_start is not None and warm_start.guess is not None:
         delta = options.delta_initial if warm_start.delta is None else warm_start.delta
-        options = dataclasses.replace(options, eps_initial=options.eps_final, delta_initial=delta)
+        levels = options.epsilon_levels()
+        options = dataclasses.replace(
+            options, eps_initial=levels[-min(2, len(levels))], delta_initial=delta
+        )
     result = solve_pronto(assembled.problem, assembled.guess, options=options, callback=callback)
     logger.info(
         "PRONTO (terrain weight %g): %s after %d iterations, cost %.1f",

@@ -29,8 +29,6 @@ from auvplan.mission.pipeline import fleet_layout, run_optimization
 from auvplan.mission.preplan import PreplanStage, compute_maps, load_terrain
 from auvplan.mission.tables import CurrentConfig
 from auvplan.mission.timing import run_deconfliction
-from auvplan.optimization.lq import convexify
-from auvplan.optimization.stages import StageWeights
 
 __all__ = ["warm_up", "warm_up_missions"]
 
@@ -86,10 +84,6 @@ def warm_up(config: MissionConfig) -> None:
     """
     for small in warm_up_missions(config):
         _stages_2_and_3(small)
-    # the eigenvalue clip runs only where Newton's model is not convex, which a small
-    # mission need not reach: one stage of a 2-state, 1-input model calls its kernel
-    convexify(StageWeights(np.eye(2)[None], np.zeros((1, 2, 1)), -np.ones((1, 1, 1)), np.eye(2)),
-              1e-6, (np.arange(3),))  # fmt: skip
 
 
 def _stages_2_and_3(small: MissionConfig) -> None:

@@ -87,95 +87,105 @@ def _merge(parent: IntArray, a: int, b: int) -> None:
 
 
 @numba.njit(cache=True)
-def _coupled_components(stage: FloatArray, owner: IntArray, n_groups: int) -> IntArray:
-    """Root group of every group, merging groups joined by a nonzero entry of ``stage``.
+def _components(matrix: FloatArray, parent: IntArray, order: IntArray, starts: IntArray) -> int:
+    """Connected components of the graph of ``matrix``'s nonzero off-diagonal entries.
 
-    ``owner[i]`` is the group of index ``i`` of ``z = (x, u)``, or ``-1`` (then every group
-    is merged: an index outside all groups couples everything).
+    Writes the indices of component ``c`` to ``order[starts[c]:starts[c + 1]]`` (ascending)
+    and returns the number of components; ``parent`` is scratch space of the matrix's size.
+    A symmetric matrix is block-diagonal in its components (up to a permutation).
     """
-    parent = np.arange(n_groups)
-    n = stage.shape[0]
+    n = matrix.shape[0]
+    for i in range(n):
+        parent[i] = i
     for i in range(n):
         for j in range(i + 1, n):
-            if stage[i, j] == 0.0 or owner[i] == owner[j]:
-                continue
-            if owner[i] < 0 or owner[j] < 0:
-                parent[:] = 0
-                return parent
-            _merge(parent, owner[i], owner[j])
-    for g in range(n_groups):
-        parent[g] = _root(parent, g)
-    return parent
+            if matrix[i, j] != 0.0:
+                _merge(parent, i, j)
+    n_components = 0
+    for i in range(n):  # a root is its component's smallest index: roots come in order
+        root = _root(parent, i)
+        parent[i] = root
+        if root == i:
+            starts[n_components] = i  # the root's index, for now
+            n_components += 1
+    size = np.zeros(n, dtype=np.int64)
+    for i in range(n):
+        size[parent[i]] += 1
+    offset = 0
+    for c in range(n_components):
+        root = starts[c]
+        starts[c] = offset
+        offset += size[root]
+        size[root] = starts[c]  # now the next free slot of the component
+    starts[n_components] = n
+    for i in range(n):
+        order[size[parent[i]]] = i
+        size[parent[i]] += 1
+    return n_components
+
+
+@numba.njit(cache=True)
+def _clip_components(
+    stage: FloatArray, floor: float, parent: IntArray, order: IntArray, starts: IntArray
+) -> None:
+    """``V max(Λ, floor) Vᵀ`` of a symmetric matrix, written over it, block by block.
+
+    The matrix is block-diagonal in the components of its nonzero entries (:func:`_components`;
+    ``parent``, ``order``, ``starts`` are its scratch arrays): each block is tested and clipped on
+    its own (:func:`_clip_in_place`), a ``1 × 1`` block as ``max(w, floor)``.
+    """
+    for c in range(_components(stage, parent, order, starts)):
+        index = order[starts[c] : starts[c + 1]]
+        size = index.size
+        if size == 1:
+            if stage[index[0], index[0]] <= floor:  # noqa: PLR1730 (max() would drop a NaN)
+                stage[index[0], index[0]] = floor
+            continue
+        block = np.empty((size, size))
+        for i in range(size):
+            for j in range(size):
+                block[i, j] = stage[index[i], index[j]]
+        _clip_in_place(block, floor)
+        for i in range(size):
+            for j in range(size):
+                stage[index[i], index[j]] = block[i, j]
+
+
+@numba.njit(cache=True)
+def _clipped_stage(
+    q: FloatArray, s: FloatArray, r: FloatArray, floor: float
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """``Q, S, R`` of ``½(W + Wᵀ)``, ``W = [[Q, S], [Sᵀ, R]]``, eigenvalues clipped at ``floor``.
+
+    Only the blocks of coupled coordinates that fail the Cholesky test of ``W − floor·I``
+    change (:func:`_clip_components`): within a vehicle e.g. its position, which its dynamics
+    do not curve, is a block of its own; at ``O(Σ n_c³)`` instead of ``O(n³)``.
+    """
+    n_x, n_u = s.shape
+    n = n_x + n_u
+    stage = np.empty((n, n))
+    stage[:n_x, :n_x] = 0.5 * (q + q.T)
+    stage[:n_x, n_x:] = s
+    stage[n_x:, :n_x] = s.T
+    stage[n_x:, n_x:] = 0.5 * (r + r.T)
+    scratch = np.empty((3, n + 1), dtype=np.int64)
+    _clip_components(stage, floor, scratch[0], scratch[1], scratch[2])
+    return stage[:n_x, :n_x].copy(), stage[:n_x, n_x:].copy(), stage[n_x:, n_x:].copy()
 
 
 @numba.njit(cache=True)
 def clip_stage_weights(
-    q_mat: FloatArray,
-    s_mat: FloatArray,
-    r_mat: FloatArray,
-    floor: float,
-    groups: IntArray,
-    group_sizes: IntArray,
+    q_mat: FloatArray, s_mat: FloatArray, r_mat: FloatArray, floor: float
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Stage weights ``W = ½(Z + Zᵀ)``, ``Z = [[Q, S], [Sᵀ, R]]``, with eigenvalues clipped.
-
-    Per stage, the eigenvalues of ``W`` are clipped at ``floor`` where ``W − floor·I`` fails
-    the Cholesky test; elsewhere ``W`` is kept. ``groups[g, :group_sizes[g]]`` are index
-    sets of ``z = (x, u)`` (e.g. one per vehicle). At every stage the groups joined by
-    nonzero entries form components (e.g. the vehicles that come near each other there);
-    ``W`` is block-diagonal in them, so testing and clipping each component's block is the
-    same as testing and clipping ``W`` whole, at ``O(Σ n_c³)`` instead of ``O(n³)`` per
-    stage. Without groups every stage is tested and clipped whole.
+    """:func:`_clipped_stage` of every stage.
 
     Returns the clipped ``Q (N, n_x, n_x)``, ``S (N, n_x, n_u)`` and ``R (N, n_u, n_u)``.
     """
-    n_stages, n_x, _ = q_mat.shape
-    n_u = r_mat.shape[1]
-    n = n_x + n_u
-    n_groups = group_sizes.size
-    owner = np.full(n, -1, dtype=np.int64)
-    for g in range(n_groups):
-        for i in range(group_sizes[g]):
-            owner[groups[g, i]] = g
     q_out = np.empty_like(q_mat)
     s_out = np.empty_like(s_mat)
     r_out = np.empty_like(r_mat)
-    stage = np.empty((n, n))
-    index = np.empty(n, dtype=np.int64)
-    for k in range(n_stages):
-        for i in range(n_x):
-            for j in range(n_x):
-                stage[i, j] = 0.5 * (q_mat[k, i, j] + q_mat[k, j, i])
-            for j in range(n_u):
-                stage[i, n_x + j] = s_mat[k, i, j]
-                stage[n_x + j, i] = s_mat[k, i, j]
-        for i in range(n_u):
-            for j in range(n_u):
-                stage[n_x + i, n_x + j] = 0.5 * (r_mat[k, i, j] + r_mat[k, j, i])
-        if n_groups == 0:
-            _clip_in_place(stage, floor)
-        else:
-            root = _coupled_components(stage, owner, n_groups)
-            for component in range(n_groups):
-                size = 0
-                for i in range(n):
-                    g = owner[i]
-                    if (g < 0 and component == 0) or (g >= 0 and root[g] == component):
-                        index[size] = i
-                        size += 1
-                if size == 0:
-                    continue
-                block = np.empty((size, size))
-                for i in range(size):
-                    for j in range(size):
-                        block[i, j] = stage[index[i], index[j]]
-                _clip_in_place(block, floor)
-                for i in range(size):
-                    for j in range(size):
-                        stage[index[i], index[j]] = block[i, j]
-        q_out[k] = stage[:n_x, :n_x]
-        s_out[k] = stage[:n_x, n_x:]
-        r_out[k] = stage[n_x:, n_x:]
+    for k in range(q_mat.shape[0]):
+        q_out[k], s_out[k], r_out[k] = _clipped_stage(q_mat[k], s_mat[k], r_mat[k], floor)
     return q_out, s_out, r_out
 
 
@@ -314,6 +324,7 @@ def lq_backward(
     r_final: FloatArray,
     x_blocks: IntArray,
     u_blocks: IntArray,
+    floor: float,
 ) -> tuple[FloatArray, FloatArray, int]:
     """Discrete Riccati with cross term for the LQ direction (§6.3), component by component.
 
@@ -326,6 +337,12 @@ def lq_backward(
     ``O(Σ_c n_c³)`` per stage instead of ``O(n_x³)`` (vehicles far apart, whose separation
     barriers vanish, stay apart). Products with ``A_k``, ``B_k`` inside a component use its
     blocks (``O(n_c² n_block)``).
+
+    With ``floor > 0`` every stage's weights ``W_k = [[Q_k, S_k], [S_kᵀ, R_k]]`` are replaced
+    by their projection onto ``{W ⪰ floor·I}`` (eigenvalues clipped at ``floor``, per
+    component and in it per block of coupled coordinates: :func:`_clipped_stage`) as the
+    sweep reaches them: the convexified model, without a clipped copy of the weights. The
+    caller clips ``P_N``.
 
     Returns the feedback ``K^o (N, n_u, n_x)``, feed-forward ``v^o (N, n_u)`` and the stage
     index at which ``M_k = R_k + B_kᵀ P B_k`` failed the Cholesky test (``-1`` if none).
@@ -350,13 +367,16 @@ def lq_backward(
             a = a_mat[k][xs][:, xs]
             b = b_mat[k][xs][:, us]
             p_c = p[xs][:, xs]
+            q_c, s_c, r_c = q_mat[k][xs][:, xs], s_mat[k][xs][:, us], r_mat[k][us][:, us]
+            if floor > 0.0:
+                q_c, s_c, r_c = _clipped_stage(q_c, s_c, r_c, floor)
             pa = _times_block_diagonal(p_c, a, xb, xb)
             pb = _times_block_diagonal(p_c, b, xb, ub)
-            m = r_mat[k][us][:, us] + _times_block_diagonal(pb.T.copy(), b, xb, ub).T
+            m = r_c + _times_block_diagonal(pb.T.copy(), b, xb, ub).T
             lower, is_pd = _cholesky(0.5 * (m + m.T))
             if not is_pd:
                 return feedback, feedforward, k
-            g_mat = s_mat[k][xs][:, us].T + _times_block_diagonal(pb.T.copy(), a, xb, xb)
+            g_mat = s_c.T + _times_block_diagonal(pb.T.copy(), a, xb, xb)
             g_vec = l_u[k][us] + b.T @ r[xs]
             rhs = np.empty((us.size, xs.size + 1))
             rhs[:, : xs.size] = g_mat
@@ -364,7 +384,7 @@ def lq_backward(
             sol = _cholesky_solve(lower, rhs)
             gain = sol[:, : xs.size].copy()
             a_pa = _times_block_diagonal(pa.T.copy(), a, xb, xb).T  # Aᵀ P A
-            p_new = q_mat[k][xs][:, xs] + a_pa - g_mat.T @ gain
+            p_new = q_c + a_pa - g_mat.T @ gain
             r_c = l_x[k][xs] + a.T @ r[xs] - gain.T @ g_vec
             for i in range(us.size):
                 feedforward[k, us[i]] = -sol[i, xs.size]

@@ -38,15 +38,12 @@ class DirectionType(enum.Enum):
     STEEPEST = "steepest"
 
 
-def convexify(
-    weights: StageWeights, floor: float, groups: tuple[IntArray, ...] = ()
-) -> StageWeights:
+def convexify(weights: StageWeights, floor: float) -> StageWeights:
     """Clip the eigenvalues of every ``[[Q, S], [Sᵀ, R]]`` and of ``P_N`` at ``floor``.
 
-    Only stages that fail a Cholesky test above the floor change. ``groups`` (index sets of
-    ``z = (x, u)`` that tile it, e.g. one per vehicle) speeds this up without changing the
-    result: at each stage the groups coupled by nonzero entries form components and each
-    component's block is clipped on its own
+    The convexified model of the ladder as arrays (:func:`solve_lq_direction` clips inside its
+    Riccati sweep instead, without these copies). Only the blocks of coupled coordinates that
+    fail a Cholesky test above the floor change
     (:func:`auvplan.optimization._kernels.clip_stage_weights`).
 
     Returns
@@ -54,21 +51,20 @@ def convexify(
     StageWeights
         Positive-definite weights (projection onto ``{W ⪰ floor·I}`` per stage).
     """
-    sizes = np.array([group.size for group in groups], dtype=np.int64)
-    padded = np.zeros((len(groups), int(sizes.max(initial=0))), dtype=np.int64)
-    for row, group in zip(padded, groups, strict=True):
-        row[: group.size] = group
     q_mat, s_mat, r_mat = _kernels.clip_stage_weights(
         np.ascontiguousarray(weights.Q),
         np.ascontiguousarray(weights.S),
         np.ascontiguousarray(weights.R),
         floor,
-        padded,
-        sizes,
     )
-    p_values, p_vectors = np.linalg.eigh(0.5 * (weights.P_N + weights.P_N.T))
-    p_clipped = (p_vectors * np.maximum(p_values, floor)) @ p_vectors.T
-    return StageWeights(q_mat, s_mat, r_mat, p_clipped)
+    return StageWeights(q_mat, s_mat, r_mat, _clipped_matrix(weights.P_N, floor))
+
+
+def _clipped_matrix(matrix: FloatArray, floor: float) -> FloatArray:
+    """``V max(Λ, floor) Vᵀ`` of ``½(M + Mᵀ)``."""
+    values, vectors = np.linalg.eigh(0.5 * (matrix + matrix.T))
+    clipped: FloatArray = (vectors * np.maximum(values, floor)) @ vectors.T
+    return clipped
 
 
 @dataclass(frozen=True)
@@ -82,9 +78,8 @@ class LqDirection:
     v : ndarray of shape (N, n_u)
         Input direction.
     slope : float
-        ``Dh·ζ`` (negative for a descent direction).
-    model_curvature : float
-        Second derivative of the model that produced ζ, along ζ.
+        ``Dh·ζ`` (negative for a descent direction; ``−ζᵀ W ζ`` for the model ``W`` that
+        produced it).
     direction : DirectionType
         Ladder level used.
     """
@@ -92,7 +87,6 @@ class LqDirection:
     z: FloatArray
     v: FloatArray
     slope: float
-    model_curvature: float
     direction: DirectionType
 
 
@@ -116,7 +110,8 @@ def directional_derivative(linearization: Linearization, z: FloatArray, v: Float
 def block_ranges(groups: tuple[IntArray, ...], n_x: int, n_u: int) -> tuple[IntArray, IntArray]:
     """``(start, stop)`` rows of each group's states and inputs, shape ``(n_blocks, 2)`` each.
 
-    ``groups`` are index sets of ``z = (x, u)`` (:func:`convexify`); without groups, or when
+    ``groups`` are index sets of ``z = (x, u)`` that tile it (e.g. one per vehicle,
+    :func:`~auvplan.optimization.separable.coordinate_groups`); without groups, or when
     a group's states or inputs are not one contiguous range, the whole ``x`` and ``u`` form
     one block.
     """
@@ -143,7 +138,9 @@ def _try_direction(
     weights: StageWeights,
     direction: DirectionType,
     blocks: tuple[IntArray, IntArray],
+    floor: float = 0.0,
 ) -> LqDirection | None:
+    """The direction of one ladder level; with ``floor > 0`` every stage weight is clipped."""
     lin = linearization
     feedback, feedforward, failed = _kernels.lq_backward(
         lin.A,
@@ -156,6 +153,7 @@ def _try_direction(
         np.ascontiguousarray(weights.P_N),
         np.ascontiguousarray(lin.m_x),
         *blocks,
+        floor,
     )
     if failed >= 0:
         logger.debug("%s LQ model not positive definite at stage %d", direction.value, failed)
@@ -164,11 +162,10 @@ def _try_direction(
     slope = directional_derivative(lin, z, v)
     if not (np.isfinite(slope) and np.all(np.isfinite(z))):
         return None
-    curvature = quadratic_form(weights, z, v)
     if slope > 0.0:
         logger.debug("%s direction is not a descent direction (Dh·ζ = %g)", direction.value, slope)
         return None
-    return LqDirection(z, v, slope, curvature, direction)
+    return LqDirection(z, v, slope, direction)
 
 
 def solve_lq_direction(
@@ -183,9 +180,10 @@ def solve_lq_direction(
     """Search direction by the discrete Riccati recursion with cross term (§6.3).
 
     Fallback ladder: Newton (``weights``) → convexified quasi-Newton (eigenvalue-clipped
-    ``quasi_weights()``, or clipped ``weights`` when none given) → steepest
-    (``steepest_weights``, e.g. the regulator weights). A level is rejected when some
-    ``M_k = R_k + B_kᵀ P_{k+1} B_k`` fails the Cholesky test or ``Dh·ζ > 0``.
+    ``quasi_weights()``, or clipped ``weights`` when none given; clipped stage by stage inside
+    the sweep) → steepest (``steepest_weights``, e.g. the regulator weights). A level is
+    rejected when some ``M_k = R_k + B_kᵀ P_{k+1} B_k`` fails the Cholesky test or
+    ``Dh·ζ > 0``.
 
     Parameters
     ----------
@@ -200,8 +198,8 @@ def solve_lq_direction(
     eigenvalue_floor : float
         Eigenvalue clip of the convexified model.
     groups : tuple of ndarray
-        Independent subsystems' indices of ``(x, u)`` (see :func:`convexify`); ``A_k`` and
-        ``B_k`` are block-diagonal in them (:func:`block_ranges`), which the Riccati sweep uses.
+        Independent subsystems' indices of ``(x, u)``; ``A_k`` and ``B_k`` are block-diagonal
+        in them (:func:`block_ranges`), which the Riccati sweep uses.
 
     Returns
     -------
@@ -220,9 +218,10 @@ def solve_lq_direction(
     base = quasi_weights() if quasi_weights is not None else weights
     direction = _try_direction(
         linearization,
-        convexify(base, eigenvalue_floor, groups),
+        StageWeights(base.Q, base.S, base.R, _clipped_matrix(base.P_N, eigenvalue_floor)),
         DirectionType.CONVEXIFIED,
         blocks,
+        eigenvalue_floor,
     )
     if direction is not None:
         return direction
