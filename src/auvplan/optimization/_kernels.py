@@ -248,8 +248,8 @@ def _times_block_diagonal(
     """``matrix @ diagonal`` for a block-diagonal ``diagonal``.
 
     Block ``b`` is ``diagonal[rows[b, 0]:rows[b, 1], columns[b, 0]:columns[b, 1]]``; entries
-    outside the blocks are taken as zero. ``diagonalᵀ @ matrix`` is the transpose of
-    ``matrixᵀ @ diagonal``.
+    outside the blocks are taken as zero (``diagonalᵀ @ matrix``:
+    :func:`_block_diagonal_transpose_times`).
     """
     out = np.zeros((matrix.shape[0], diagonal.shape[1]))
     for b in range(rows.shape[0]):
@@ -259,6 +259,35 @@ def _times_block_diagonal(
                 if d != 0.0:
                     for i in range(matrix.shape[0]):
                         out[i, j] += matrix[i, k] * d
+    return out
+
+
+@numba.njit(cache=True)
+def _block_diagonal_transpose_times(
+    diagonal: FloatArray, matrix: FloatArray, rows: IntArray, columns: IntArray
+) -> FloatArray:
+    """``diagonalᵀ @ matrix`` for a block-diagonal ``diagonal``, without transposed copies.
+
+    The blocks are as in :func:`_times_block_diagonal`.
+    """
+    out = np.zeros((diagonal.shape[1], matrix.shape[1]))
+    for b in range(rows.shape[0]):
+        for j in range(columns[b, 0], columns[b, 1]):
+            for k in range(rows[b, 0], rows[b, 1]):
+                d = diagonal[k, j]
+                if d != 0.0:
+                    for c in range(matrix.shape[1]):
+                        out[j, c] += d * matrix[k, c]
+    return out
+
+
+@numba.njit(cache=True)
+def _gather(matrix: FloatArray, rows: IntArray, columns: IntArray) -> FloatArray:
+    """``matrix[rows][:, columns]`` in one pass."""
+    out = np.empty((rows.size, columns.size))
+    for i in range(rows.size):
+        for j in range(columns.size):
+            out[i, j] = matrix[rows[i], columns[j]]
     return out
 
 
@@ -364,34 +393,36 @@ def lq_backward(
             if _root(parent, root) != root:
                 continue
             xs, us, xb, ub = _component(parent, root, x_blocks, u_blocks)
-            a = a_mat[k][xs][:, xs]
-            b = b_mat[k][xs][:, us]
-            p_c = p[xs][:, xs]
-            q_c, s_c, r_c = q_mat[k][xs][:, xs], s_mat[k][xs][:, us], r_mat[k][us][:, us]
+            a, b = _gather(a_mat[k], xs, xs), _gather(b_mat[k], xs, us)
+            p_c = _gather(p, xs, xs)
+            q_c, s_c, r_c = (
+                _gather(q_mat[k], xs, xs),
+                _gather(s_mat[k], xs, us),
+                _gather(r_mat[k], us, us),
+            )
             if floor > 0.0:
                 q_c, s_c, r_c = _clipped_stage(q_c, s_c, r_c, floor)
             pa = _times_block_diagonal(p_c, a, xb, xb)
             pb = _times_block_diagonal(p_c, b, xb, ub)
-            m = r_c + _times_block_diagonal(pb.T.copy(), b, xb, ub).T
+            m = r_c + _block_diagonal_transpose_times(b, pb, xb, ub)  # R + Bᵀ P B
             lower, is_pd = _cholesky(0.5 * (m + m.T))
             if not is_pd:
                 return feedback, feedforward, k
-            g_mat = s_c.T + _times_block_diagonal(pb.T.copy(), a, xb, xb)
+            g_mat = (s_c + _block_diagonal_transpose_times(a, pb, xb, xb)).T  # Sᵀ + (P B)ᵀ A
             g_vec = l_u[k][us] + b.T @ r[xs]
             rhs = np.empty((us.size, xs.size + 1))
             rhs[:, : xs.size] = g_mat
             rhs[:, xs.size] = g_vec
             sol = _cholesky_solve(lower, rhs)
             gain = sol[:, : xs.size].copy()
-            a_pa = _times_block_diagonal(pa.T.copy(), a, xb, xb).T  # Aᵀ P A
-            p_new = q_c + a_pa - g_mat.T @ gain
-            r_c = l_x[k][xs] + a.T @ r[xs] - gain.T @ g_vec
+            p_new = q_c + _block_diagonal_transpose_times(a, pa, xb, xb) - g_mat.T @ gain
+            r_new = l_x[k][xs] + a.T @ r[xs] - gain.T @ g_vec
             for i in range(us.size):
                 feedforward[k, us[i]] = -sol[i, xs.size]
                 for j in range(xs.size):
                     feedback[k, us[i], xs[j]] = gain[i, j]
             for i in range(xs.size):
-                r[xs[i]] = r_c[i]
+                r[xs[i]] = r_new[i]
                 for j in range(xs.size):
                     p[xs[i], xs[j]] = 0.5 * (p_new[i, j] + p_new[j, i])
     return feedback, feedforward, -1
