@@ -242,33 +242,14 @@ def closed_loop_costate(
 
 
 @numba.njit(cache=True)
-def _times_block_diagonal(
-    matrix: FloatArray, diagonal: FloatArray, rows: IntArray, columns: IntArray
-) -> FloatArray:
-    """``matrix @ diagonal`` for a block-diagonal ``diagonal``.
-
-    Block ``b`` is ``diagonal[rows[b, 0]:rows[b, 1], columns[b, 0]:columns[b, 1]]``; entries
-    outside the blocks are taken as zero (``diagonalᵀ @ matrix``:
-    :func:`_block_diagonal_transpose_times`).
-    """
-    out = np.zeros((matrix.shape[0], diagonal.shape[1]))
-    for b in range(rows.shape[0]):
-        for j in range(columns[b, 0], columns[b, 1]):
-            for k in range(rows[b, 0], rows[b, 1]):
-                d = diagonal[k, j]
-                if d != 0.0:
-                    for i in range(matrix.shape[0]):
-                        out[i, j] += matrix[i, k] * d
-    return out
-
-
-@numba.njit(cache=True)
 def _block_diagonal_transpose_times(
     diagonal: FloatArray, matrix: FloatArray, rows: IntArray, columns: IntArray
 ) -> FloatArray:
     """``diagonalᵀ @ matrix`` for a block-diagonal ``diagonal``, without transposed copies.
 
-    The blocks are as in :func:`_times_block_diagonal`.
+    Block ``b`` is ``diagonal[rows[b, 0]:rows[b, 1], columns[b, 0]:columns[b, 1]]``; entries
+    outside the blocks are taken as zero. ``matrix @ diagonal`` is the transpose of
+    ``diagonalᵀ @ matrixᵀ`` (``matrix.T``, a view).
     """
     out = np.zeros((diagonal.shape[1], matrix.shape[1]))
     for b in range(rows.shape[0]):
@@ -402,8 +383,8 @@ def lq_backward(
             )
             if floor > 0.0:
                 q_c, s_c, r_c = _clipped_stage(q_c, s_c, r_c, floor)
-            pa = _times_block_diagonal(p_c, a, xb, xb)
-            pb = _times_block_diagonal(p_c, b, xb, ub)
+            pa = _block_diagonal_transpose_times(a, p_c.T, xb, xb).T  # P A
+            pb = _block_diagonal_transpose_times(b, p_c.T, xb, ub).T  # P B
             m = r_c + _block_diagonal_transpose_times(b, pb, xb, ub)  # R + Bᵀ P B
             lower, is_pd = _cholesky(0.5 * (m + m.T))
             if not is_pd:
