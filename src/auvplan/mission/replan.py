@@ -12,9 +12,10 @@ and the weights are kept; the new plan's ``t = 0`` is the old plan's ``t = at`` 
    otherwise the run fails naming it (no plan, exit 3).
 2. The old schedule, shifted by ``at`` and led in from the new starts, is kept when its
    continuous separation certificate still holds: the desired trajectories are then the old
-   ones from ``at``, and PRONTO starts from the old optimised trajectory from ``at`` at the
-   last barrier level and the old plan's ``δ`` (its projection from the new initial states
-   is the first iterate); should that not give a plan that meets every constraint, PRONTO
+   ones from ``at``, and PRONTO starts from the old optimised trajectory from ``at`` one
+   barrier level above the last, at the old plan's ``δ`` (its projection from the new
+   initial states is the first iterate; :func:`auvplan.mission.pipeline.run_optimization`
+   says why); should that not give a plan that meets every constraint, PRONTO
    starts again from the desired trajectories with the full barrier continuation.
    Otherwise the remainder paths are deconflicted anew over ``T - at`` as stage 2 does
    (:func:`auvplan.mission.timing.run_deconfliction`) and PRONTO starts from the new desired
