@@ -137,9 +137,7 @@ def test_clipped_lq_sweep_is_the_sweep_of_the_projected_weights(rng: np.random.G
         args = (a, b, q.copy(), s.copy(), r.copy(), l_x, l_u, p_final, m_x)
         return _kernels.lq_backward(*args, *blocks, floor)
 
-    values, vectors = np.linalg.eigh(w)
-    projected = np.einsum("kij,kj,klj->kil", vectors, np.maximum(values, 0.5), vectors)
-    clipped, plain = sweep(w, 0.5), sweep(projected, 0.0)
+    clipped, plain = sweep(w, 0.5), sweep(_projected(w, 0.5), 0.0)
     assert clipped[2] == plain[2] == -1
     np.testing.assert_allclose(clipped[0], plain[0], rtol=1e-9, atol=1e-11)
     np.testing.assert_allclose(clipped[1], plain[1], rtol=1e-9, atol=1e-11)

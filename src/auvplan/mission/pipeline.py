@@ -261,8 +261,8 @@ def run_optimization(
     the guess's ``δ`` and at the barrier level before the last: the guess solved the last
     level for other starts, and a vehicle moved off its plan can leave it infeasible (4 × 1 h
     MEDUSAs, one moved 30 m: scaled slack −0.05). One level up the barrier re-centres it; at
-    the last level its iterates hug the constraint it crossed (``δ`` shrank to 7e-10, 17
-    iterations against 9, ``benchmarks/bench_replan.py``).
+    the last level its iterates hug the constraint it crossed (``δ`` shrank to 2e-9, 12
+    iterations against 8, ``benchmarks/bench_replan.py``).
     """
     assembled = assemble_problem(
         layout, preplan, deconfliction,
