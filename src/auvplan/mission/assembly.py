@@ -21,7 +21,7 @@ from auvplan.mission.fleet import (
     regulator_weights,
 )
 from auvplan.mission.preplan import PreplanStage
-from auvplan.mission.reward import information_reward
+from auvplan.mission.reward import InformationReward, information_reward
 from auvplan.mission.timing import DeconflictStage
 from auvplan.ocean import CurrentField
 from auvplan.optimization import PathConstraint, Trajectory, TrajectoryProblem
@@ -38,12 +38,29 @@ ARRAYS_PER_STEP: Final = 16
 
 
 @dataclass(frozen=True)
+class FleetParts:
+    """What the fleet problem was built from.
+
+    Goal poses ``(n_vehicles, 3)``, weights, limits, the information reward's weight [W] and
+    whether the stage parameters carry a current; a vehicle's own problem is built from them
+    alike (:mod:`auvplan.mission.decomposition`).
+    """
+
+    goals: FloatArray
+    weights: FleetWeights
+    limits: FleetLimits
+    reward_weight: float
+    has_current: bool
+
+
+@dataclass(frozen=True)
 class AssembledProblem:
     """The fleet problem: CasADi functions, the :class:`TrajectoryProblem` and the guess."""
 
     functions: FleetProblemFunctions
     problem: TrajectoryProblem
     guess: Trajectory
+    parts: FleetParts
 
 
 @dataclass(frozen=True)
@@ -61,20 +78,26 @@ class WarmStart:
     delta: float | None = None
 
 
-def check_optimizer_memory(layout: FleetLayout, n_steps: int) -> None:
+def check_optimizer_memory(layout: FleetLayout, n_steps: int, *, decomposed: bool = False) -> None:
     """Refuse a problem whose optimiser would need more than ``MEMORY_BUDGET`` bytes.
 
     Checked when stage 3 is assembled, before anything large is allocated (the earlier
-    stages need no such memory: ``--stage deconflict`` runs any fleet).
+    stages need no such memory: ``--stage deconflict`` runs any fleet). The coupled solve
+    keeps ``ARRAYS_PER_STEP`` dense ``(n_x + n_u)²`` blocks per step; the ``decomposed`` one
+    keeps them for one vehicle at a time, plus the fleet's stacked regulator gains
+    ``(n_u, n_x)`` per step.
 
     Raises
     ------
     InputError
-        When ``n_steps`` dense ``(n_x + n_u)²`` blocks would need more than ``MEMORY_BUDGET``;
-        names the keys to change.
+        When the optimiser would need more than ``MEMORY_BUDGET``; names the keys to change.
     """
-    size = layout.n_x + layout.n_u
-    needed = float(n_steps) * ARRAYS_PER_STEP * size * size * 8
+    if decomposed:
+        size = max(model.n_x + model.n_u for model in layout.models)
+        needed = float(n_steps) * 8 * (ARRAYS_PER_STEP * size * size + layout.n_u * layout.n_x)
+    else:
+        size = layout.n_x + layout.n_u
+        needed = float(n_steps) * ARRAYS_PER_STEP * size * size * 8
     if needed > MEMORY_BUDGET:
         raise InputError(
             f"{n_steps} solver steps x {layout.n_vehicles} vehicles need ~{needed / 2**30:.0f} GiB "
@@ -176,6 +199,69 @@ def navigation_corridors(preplan: PreplanStage) -> tuple[float, ...]:
     )
 
 
+def fleet_limits(
+    layout: FleetLayout,
+    preplan: PreplanStage,
+    deconfliction: DeconflictStage,
+    *,
+    safety_radius: float,
+    comms: tuple[CommConfig, ...],
+) -> FleetLimits:
+    """Separation, obstacles, communication pairs and corridors of the fleet problem."""
+    circles = [
+        (obstacle, name)
+        for obstacle, name in zip(preplan.obstacles, preplan.obstacle_names, strict=True)
+        if isinstance(obstacle, CircleObstacle)
+    ]
+    desired = deconfliction.desired_states
+    return FleetLimits(
+        safety_radius=safety_radius,
+        separation_margin=separation_margin(safety_radius, deconfliction.dt, desired, layout),
+        obstacles=np.array([(o.north, o.east, o.radius) for o, _ in circles]).reshape(-1, 3),
+        obstacle_names=tuple(name for _, name in circles),
+        comm_pairs=tuple(
+            (layout.names.index(comm.pair[0]), layout.names.index(comm.pair[1]), comm.max_range)
+            for comm in comms
+        ),
+        corridors=navigation_corridors(preplan),
+    )
+
+
+def fleet_problem(
+    layout: FleetLayout,
+    functions: FleetProblemFunctions,
+    reward: InformationReward | None,
+    *,
+    initial_state: FloatArray,
+    dt: float,
+    stage_parameters: FloatArray,
+    n_substeps: int,
+) -> TrajectoryProblem:
+    """The :class:`TrajectoryProblem` of ``functions``, one stage per row of ``stage_parameters``.
+
+    ``dt`` [s] is the control interval, ``n_substeps`` the RK4 substeps per interval.
+    """
+    return TrajectoryProblem(
+        dynamics=functions.dynamics,
+        running_cost=functions.running_cost,
+        terminal_cost=functions.terminal_cost,
+        initial_state=initial_state,
+        dt=dt,
+        n_steps=stage_parameters.shape[0],
+        stage_parameters=stage_parameters,
+        constraints=tuple(
+            PathConstraint(block.function, kind=block.kind, name=block.name)
+            for block in functions.constraints
+        ),
+        regulator_Q=np.diag(layout.per_state(regulator_weights, 1.0)),
+        regulator_R=np.eye(layout.n_u),
+        n_substeps=n_substeps,
+        regulator_floor=layout.per_state(regulator_floor, 0.0),
+        blocks=functions.blocks,
+        node_costs=() if reward is None else (reward,),
+    )
+
+
 def assemble_problem(
     layout: FleetLayout,
     preplan: PreplanStage,
@@ -187,6 +273,7 @@ def assemble_problem(
     comms: tuple[CommConfig, ...],
     current: CurrentField | None = None,
     warm_start: WarmStart | None = None,
+    decomposed: bool = False,
 ) -> AssembledProblem:
     """The stacked fleet problem for PRONTO (and the IPOPT reference), with its initial guess.
 
@@ -196,69 +283,46 @@ def assemble_problem(
     guess is the desired trajectory with zero inputs; PRONTO projects it onto the dynamics.
     ``current`` (None: still water) enters each stage linearised about the desired position.
     ``warm_start`` replaces the initial state (:func:`start_states`) and, when it has one, the
-    guess.
+    guess. ``decomposed``: the problem is solved vehicle by vehicle
+    (:mod:`auvplan.mission.decomposition`), which needs memory for one vehicle at a time.
 
     Raises
     ------
     InputError
         When the optimiser would need too much memory (:func:`check_optimizer_memory`).
     """
-    check_optimizer_memory(layout, deconfliction.time.size - 1)
+    check_optimizer_memory(layout, deconfliction.time.size - 1, decomposed=decomposed)
     desired = deconfliction.desired_states
-    circles = [
-        (obstacle, name)
-        for obstacle, name in zip(preplan.obstacles, preplan.obstacle_names, strict=True)
-        if isinstance(obstacle, CircleObstacle)
-    ]
-    limits = FleetLimits(
-        safety_radius=safety_radius,
-        separation_margin=separation_margin(safety_radius, deconfliction.dt, desired, layout),
-        obstacles=np.array([(o.north, o.east, o.radius) for o, _ in circles]).reshape(-1, 3),
-        obstacle_names=tuple(name for _, name in circles),
-        comm_pairs=tuple(
-            (layout.names.index(comm.pair[0]), layout.names.index(comm.pair[1]), comm.max_range)
-            for comm in comms
-        ),
-        corridors=navigation_corridors(preplan),
+    limits = fleet_limits(layout, preplan, deconfliction, safety_radius=safety_radius, comms=comms)
+    fleet_weights = FleetWeights(
+        terrain=terrain_weight,
+        energy=weights.energy,
+        terminal=weights.terminal,
+        tracked=tuple(choice.tracked for choice in preplan.navigation or ()),
     )
-    functions = build_fleet_functions(
+    goals = goal_poses(layout, preplan.goals, desired)
+    has_current = current is not None
+    functions = build_fleet_functions(layout, goals, fleet_weights, limits, has_current=has_current)
+    reward_weight = terrain_weight * weights.information
+    problem = fleet_problem(
         layout,
-        goal_poses(layout, preplan.goals, desired),
-        FleetWeights(
-            terrain=terrain_weight,
-            energy=weights.energy,
-            terminal=weights.terminal,
-            tracked=tuple(choice.tracked for choice in preplan.navigation or ()),
-        ),
-        limits,
-        has_current=current is not None,
-    )
-    stacked_desired = layout.stack(desired)
-    reward = information_reward(layout, preplan.maps, terrain_weight * weights.information)
-    problem = TrajectoryProblem(
-        dynamics=functions.dynamics,
-        running_cost=functions.running_cost,
-        terminal_cost=functions.terminal_cost,
+        functions,
+        information_reward(layout, preplan.maps, reward_weight),
         initial_state=start_states(layout, preplan)
         if warm_start is None
         else warm_start.initial_state,
         dt=deconfliction.dt,
-        n_steps=deconfliction.time.size - 1,
         stage_parameters=stage_parameters(layout, desired, deconfliction.time, current),
-        constraints=tuple(
-            PathConstraint(block.function, kind=block.kind, name=block.name)
-            for block in functions.constraints
-        ),
-        regulator_Q=np.diag(layout.per_state(regulator_weights, 1.0)),
-        regulator_R=np.eye(layout.n_u),
         n_substeps=integration_substeps(layout, deconfliction.dt),
-        regulator_floor=layout.per_state(regulator_floor, 0.0),
-        blocks=functions.blocks,
-        node_costs=() if reward is None else (reward,),
     )
     guess = Trajectory(
-        states=stacked_desired, inputs=np.zeros((deconfliction.time.size - 1, layout.n_u))
+        states=layout.stack(desired), inputs=np.zeros((deconfliction.time.size - 1, layout.n_u))
     )
     if warm_start is not None and warm_start.guess is not None:
         guess = warm_start.guess
-    return AssembledProblem(functions, problem, guess)
+    return AssembledProblem(
+        functions,
+        problem,
+        guess,
+        FleetParts(goals, fleet_weights, limits, reward_weight, has_current),
+    )

@@ -323,6 +323,11 @@ class FleetLimits:
     ``corridors`` (empty: none): per vehicle the half-width ``w`` [m] of the corridor around
     its desired position it keeps, ``|p_k − p_d,k| ≤ w`` (``inf``: no corridor), for routes
     certified by a navigation budget (:func:`auvplan.mission.assembly.navigation_corridors`).
+    ``neighbours`` and ``neighbour_ranges`` are vehicles outside the layout whose positions
+    ``(north, east)`` [m] are appended to the stage parameters, in this order: every vehicle of
+    the layout keeps ``2 r_c + margin`` from the first ``neighbours`` of them (hockey stick) and
+    within range ``d_max`` [m] of the next ``len(neighbour_ranges)`` (plain); a vehicle's own
+    problem in the decomposed solve (:mod:`auvplan.mission.decomposition`).
     """
 
     safety_radius: float
@@ -331,6 +336,13 @@ class FleetLimits:
     obstacle_names: tuple[str, ...]
     comm_pairs: tuple[tuple[int, int, float], ...]
     corridors: tuple[float, ...] = ()
+    neighbours: int = 0
+    neighbour_ranges: tuple[float, ...] = ()
+
+    @property
+    def n_neighbour_parameters(self) -> int:
+        """Stage parameters the neighbours' positions take (after the layout's own)."""
+        return 2 * (self.neighbours + len(self.neighbour_ranges))
 
 
 def build_fleet_functions(
@@ -356,7 +368,8 @@ def build_fleet_functions(
     has_current : bool
         Whether the stage parameters carry the current model (:func:`vehicle_stage_functions`).
     """
-    n_p = layout.n_p(has_current=has_current)
+    own_p = layout.n_p(has_current=has_current)
+    n_p = own_p + limits.n_neighbour_parameters
     x = ca.SX.sym("x", layout.n_x)
     c = ca.SX.sym("c", layout.n_u)
     p = ca.SX.sym("p", n_p)
@@ -401,6 +414,7 @@ def build_fleet_functions(
             (x, c, p),
             xs,
             [p[layout.parameter_slice(i, has_current=has_current)] for i in range(len(models))],
+            [(p[k], p[k + 1]) for k in range(own_p, n_p, 2)],
             limits,
         ),
     )
@@ -411,11 +425,13 @@ def _constraints(
     arguments: tuple[ca.SX, ca.SX, ca.SX],
     xs: list[ca.SX],
     desired: list[ca.SX],
+    neighbours: list[tuple[ca.SX, ca.SX]],
     limits: FleetLimits,
 ) -> tuple[FleetConstraint, ...]:
     """The path constraint blocks ``c ≥ 0``.
 
-    ``desired`` holds each vehicle's stage parameters (its desired state first).
+    ``desired`` holds each vehicle's stage parameters (its desired state first);
+    ``neighbours`` the positions of the vehicles outside the layout (:class:`FleetLimits`).
     """
     names, models = layout.names, layout.models
     blocks: list[FleetConstraint] = []
@@ -436,10 +452,14 @@ def _constraints(
 
     pairs = [(i, j) for i in range(layout.n_vehicles) for j in range(i + 1, layout.n_vehicles)]
     separation = 2 * limits.safety_radius + limits.separation_margin
+    vehicles = range(layout.n_vehicles)
+    close = [(i, m) for i in vehicles for m in range(limits.neighbours)]
     add(
         "collision",
-        [squared_distance(i, *position(j)) / separation**2 - 1 for i, j in pairs],
-        [Pair(names[i], names[j]) for i, j in pairs],
+        [squared_distance(i, *position(j)) / separation**2 - 1 for i, j in pairs]
+        + [squared_distance(i, *neighbours[m]) / separation**2 - 1 for i, m in close],
+        [Pair(names[i], names[j]) for i, j in pairs]
+        + [Pair(names[i], f"neighbour {m}") for i, m in close],
         "hockey",
     )
     circles = np.asarray(limits.obstacles).reshape(-1, 3)
@@ -458,10 +478,17 @@ def _constraints(
         ],
         "hockey",
     )
+    ranged = [
+        (i, limits.neighbours + m, d_max)
+        for i in vehicles
+        for m, d_max in enumerate(limits.neighbour_ranges)
+    ]
     add(
         "communication",
-        [1 - squared_distance(i, *position(j)) / d_max**2 for i, j, d_max in limits.comm_pairs],
-        [Pair(names[i], names[j]) for i, j, _ in limits.comm_pairs],
+        [1 - squared_distance(i, *position(j)) / d_max**2 for i, j, d_max in limits.comm_pairs]
+        + [1 - squared_distance(i, *neighbours[m]) / d_max**2 for i, m, d_max in ranged],
+        [Pair(names[i], names[j]) for i, j, _ in limits.comm_pairs]
+        + [Pair(names[i], f"neighbour {m}") for i, m, _ in ranged],
         "plain",
     )
     corridors = [(i, w) for i, w in enumerate(limits.corridors) if np.isfinite(w)]

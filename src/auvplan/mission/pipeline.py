@@ -28,6 +28,7 @@ from typing import Any
 from auvplan.errors import InputError, SolverError
 from auvplan.mission.assembly import WarmStart, assemble_problem
 from auvplan.mission.config import MissionConfig
+from auvplan.mission.decomposition import solve_decomposed
 from auvplan.mission.evaluation import OptimizedPlan, evaluate_plan
 from auvplan.mission.fleet import FleetLayout
 from auvplan.mission.models import vehicle_model
@@ -264,11 +265,12 @@ def run_optimization(
     the last level its iterates hug the constraint it crossed (``δ`` shrank to 2e-9, 12
     iterations against 8, ``benchmarks/bench_replan.py``).
     """
+    decomposed = config.solver.decomposes(layout.n_vehicles)
     assembled = assemble_problem(
         layout, preplan, deconfliction,
         weights=config.weights, terrain_weight=terrain_weight,
         safety_radius=config.fleet.safety_radius, comms=config.comms, current=preplan.current,
-        warm_start=warm_start,
+        warm_start=warm_start, decomposed=decomposed,
     )  # fmt: skip
     options = config.solver.pronto_options()
     if warm_start is not None and warm_start.guess is not None:
@@ -277,7 +279,12 @@ def run_optimization(
         options = dataclasses.replace(
             options, eps_initial=levels[-min(2, len(levels))], delta_initial=delta
         )
-    result = solve_pronto(assembled.problem, assembled.guess, options=options, callback=callback)
+    if decomposed:
+        result = solve_decomposed(assembled, preplan, options, callback=callback)
+    else:
+        result = solve_pronto(
+            assembled.problem, assembled.guess, options=options, callback=callback
+        )
     logger.info(
         "PRONTO (terrain weight %g): %s after %d iterations, cost %.1f",
         terrain_weight,

@@ -38,6 +38,8 @@ BlockSize = Annotated[int, Strict(), Field(ge=1, le=256)]
 FORBIDDEN_NAME_CHARACTERS: Final = ",\n\"'"
 
 _SOLVER_DEFAULTS: Final = ProntoOptions()
+#: Fleet size from which ``solver.fleet = "auto"`` solves vehicle by vehicle.
+DECOMPOSED_FROM: Final = 8
 #: Smallest safety radius r_c [m]: two vehicles kept 2 cm apart would already touch (no hull
 #: is that small), and the deconfliction's time step, which must move a vehicle less than
 #: 2 r_c, would shrink towards nothing.
@@ -550,6 +552,10 @@ class SolverConfig(TableModel):
     compile: Flag = Field(
         _SOLVER_DEFAULTS.compile_c, description="C-compile the CasADi stage functions"
     )
+    fleet: Literal["auto", "coupled", "decomposed"] = Field(
+        "auto",
+        description="fleet solve: coupled, vehicle by vehicle, or auto (by fleet size)",
+    )
 
     @model_validator(mode="after")
     def _schedule(self) -> SolverConfig:
@@ -572,6 +578,16 @@ class SolverConfig(TableModel):
             stage_kernels=self.kernels,
             compile_c=self.compile,
         )
+
+    def decomposes(self, n_vehicles: int) -> bool:
+        """Whether a fleet of ``n_vehicles`` is solved vehicle by vehicle.
+
+        ``"auto"`` decomposes from :data:`DECOMPOSED_FROM` vehicles
+        (:mod:`auvplan.mission.decomposition`).
+        """
+        if self.fleet == "auto":
+            return n_vehicles >= DECOMPOSED_FROM
+        return self.fleet == "decomposed"
 
     @property
     def harmonics(self) -> int | None:

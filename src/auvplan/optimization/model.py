@@ -8,6 +8,7 @@ models in an explicit :class:`ModelCache` and passes it to the solver.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from dataclasses import dataclass, field
 
@@ -133,7 +134,8 @@ class ModelCache:
 
     Entries are matched by the identity of the problem object (problems are immutable) and
     the build options; the cache holds a reference to each problem, so an identity is never
-    reused while its entry exists. At most ``max_entries`` models are kept (oldest evicted).
+    reused while its entry exists. At most ``max_entries`` models are kept (the least recently
+    used evicted).
 
     Examples
     --------
@@ -155,10 +157,34 @@ class ModelCache:
     def get(self, problem: TrajectoryProblem, backend: StageBackend | None = None) -> ProntoModel:
         """The model of ``problem`` for this backend, built by :func:`build_model` if new."""
         backend = StageBackend() if backend is None else backend
-        for cached, cached_backend, model in self._entries:
+        for index, (cached, cached_backend, model) in enumerate(self._entries):
             if cached is problem and cached_backend == backend:
+                self._entries.append(self._entries.pop(index))
                 return model
         model = build_model(problem, backend)
         self._entries.append((problem, backend, model))
         del self._entries[: -self.max_entries]
         return model
+
+    def rebind(
+        self,
+        problem: TrajectoryProblem,
+        *,
+        initial_state: FloatArray,
+        stage_parameters: FloatArray,
+        backend: StageBackend | None = None,
+    ) -> TrajectoryProblem:
+        """``problem`` with another initial state and stage parameters, sharing its model.
+
+        The evaluators depend on the functions, the grid and the sizes, not on these values:
+        the copy is entered with ``problem``'s model (built if new), so a problem solved
+        again and again with new parameters is built once.
+        """
+        backend = StageBackend() if backend is None else backend
+        model = self.get(problem, backend)
+        copy = dataclasses.replace(
+            problem, initial_state=initial_state, stage_parameters=stage_parameters
+        )
+        self._entries.append((copy, backend, dataclasses.replace(model, problem=copy)))
+        del self._entries[: -self.max_entries]
+        return copy

@@ -77,6 +77,9 @@ class StageBlock:
 def check_tiling(blocks: Sequence[StageBlock], sizes: tuple[int, int, int]) -> None:
     """Check that the blocks' rows tile the stacked ``(n_x, n_u, n_p)`` exactly.
 
+    The stage parameters may end with rows no block reads (parameters of the path
+    constraints only, e.g. other vehicles' positions).
+
     Raises
     ------
     InputError
@@ -84,6 +87,8 @@ def check_tiling(blocks: Sequence[StageBlock], sizes: tuple[int, int, int]) -> N
     """
     for attribute, size in zip(("states", "inputs", "parameters"), sizes, strict=True):
         rows = sorted((getattr(b, attribute).start, getattr(b, attribute).stop) for b in blocks)
+        if attribute == "parameters" and rows:
+            size = min(size, rows[-1][1])
         edges = [start for start, _ in rows] + [size]
         if edges[0] != 0 or any(stop != edges[i + 1] for i, (_, stop) in enumerate(rows)):
             raise InputError(f"the blocks' {attribute} do not tile the {size} stacked rows")

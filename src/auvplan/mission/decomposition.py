@@ -1,0 +1,368 @@
+r"""Stage 3 for large fleets: each vehicle's problem solved in turn against the others' plans.
+
+The fleet objective (:mod:`auvplan.mission.fleet`) is a sum of each vehicle's own terms and
+of pair terms,
+
+.. math::
+
+    h(x) = \sum_i h_i(x_i) + \sum_{i<j} h_{ij}(x_i, x_j),
+
+``h_i`` a vehicle's energy, tracking, terminal cost and own barriers (obstacles, state limits,
+corridor), ``h_ij`` the barrier of a pair's separation (hockey stick) or communication range.
+Block-coordinate descent (Gauss–Seidel over the vehicles) minimises ``h`` over one ``x_i``
+with the others held: vehicle ``i``'s problem is ``h_i + Σ_j h_ij(·, x_j)``, the others'
+positions entering as stage parameters (:class:`auvplan.mission.fleet.FleetLimits`). Every
+solve lowers ``h`` (the terms it leaves out do not depend on ``x_i``), so the sweeps descend.
+They stop after a sweep in which no vehicle's problem took a step: every problem was then
+converged at its first direction against the others' final plans, and the gradient of ``h``,
+whose blocks are the vehicles' own gradients, is below the tolerance block by block.
+
+The first sweep runs each vehicle through the whole barrier continuation, against the others'
+latest plans (their desired trajectories until they are solved); later sweeps run the last
+level, and only for the vehicles one of whose neighbours moved since their last solve.
+
+A separation enters vehicle ``i``'s problem at stage ``k`` only for the others within
+:func:`neighbour_reach` of it there (the nearest first; the rest of its neighbour slots are
+parked far away, where the barrier is exactly zero): beyond it the barrier composed with the
+hockey stick, ``−log tanh(s) ≈ 2 e^{−2s}``, is below ``1e-9`` of ``ε dt``. A vehicle's problem
+has one vehicle's size whatever the fleet, so memory and work per vehicle-stage are flat in
+the fleet size. The plan is then judged on the whole fleet's problem like a coupled one: its
+cost and smallest slack on every pair, and the closed-loop replay between samples
+(:mod:`auvplan.mission.evaluation`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Final
+
+import numpy as np
+
+from auvplan._typing import FloatArray, IntArray
+from auvplan.mission.assembly import AssembledProblem, fleet_problem
+from auvplan.mission.fleet import FleetLayout, FleetWeights, build_fleet_functions
+from auvplan.mission.preplan import PreplanStage
+from auvplan.mission.reward import information_reward
+from auvplan.optimization import (
+    ModelCache,
+    ProntoIteration,
+    ProntoOptions,
+    ProntoResult,
+    ProntoStatus,
+    Trajectory,
+    TrajectoryProblem,
+    solve_pronto,
+)
+from auvplan.optimization.stages import evaluate_cost
+from auvplan.vehicle import positions
+
+__all__ = ["MAX_SWEEPS", "neighbour_reach", "solve_decomposed"]
+
+logger = logging.getLogger(__name__)
+
+#: Sweeps after the first before the solve stops with ``MAX_ITER``.
+MAX_SWEEPS: Final = 30
+#: Scaled slack ``s = d²/d_s² − 1`` of a separation beyond which it is left out (see module).
+NEGLIGIBLE_SLACK: Final = 10.0
+#: How far [m] a vehicle may move in one solve beyond the reach of its neighbours' barriers.
+MOVE_ALLOWANCE: Final = 30.0
+#: Offset [m] of a parked neighbour slot from the vehicle's own desired position.
+PARKED: Final = 1.0e6
+
+
+def neighbour_reach(separation: float) -> float:
+    """Distance [m] within which another vehicle enters a vehicle's problem.
+
+    ``separation`` is ``2 r_c + margin`` [m]; the reach is where the separation's scaled
+    slack is :data:`NEGLIGIBLE_SLACK`, plus :data:`MOVE_ALLOWANCE`.
+    """
+    return separation * math.sqrt(1.0 + NEGLIGIBLE_SLACK) + MOVE_ALLOWANCE
+
+
+@dataclass
+class _Vehicle:
+    """One vehicle's problem and its latest solution (private)."""
+
+    index: int
+    template: TrajectoryProblem
+    slots: int
+    partners: tuple[int, ...]
+    cache: ModelCache
+    trajectory: Trajectory
+    delta: float
+    gains: FloatArray | None = None
+    result: ProntoResult | None = None
+    steps: int = 0
+    solved_at: int = -1
+    moved_at: int = -1
+    neighbours: frozenset[int] = frozenset()
+
+
+@dataclass
+class _Fleet:
+    """The vehicles' problems, built once per neighbour count (private)."""
+
+    assembled: AssembledProblem
+    layout: FleetLayout
+    preplan: PreplanStage
+    reach: float
+
+    def own_problem(self, index: int, slots: int) -> tuple[TrajectoryProblem, tuple[int, ...]]:
+        """Vehicle ``index``'s problem with ``slots`` neighbour slots, and its comm partners."""
+        layout, parts = self.layout, self.assembled.parts
+        limits = parts.limits
+        own = FleetLayout((layout.names[index],), (layout.models[index],))
+        partners = [(j if i == index else i, d) for i, j, d in limits.comm_pairs if index in (i, j)]
+        own_limits = dataclasses.replace(
+            limits,
+            comm_pairs=(),
+            corridors=limits.corridors[index : index + 1],
+            neighbours=slots,
+            neighbour_ranges=tuple(d for _, d in partners),
+        )
+        weights = parts.weights
+        own_weights = FleetWeights(
+            weights.terrain, weights.energy, weights.terminal, weights.tracked[index : index + 1]
+        )
+        problem = self.assembled.problem
+        functions = build_fleet_functions(
+            own,
+            parts.goals[index : index + 1],
+            own_weights,
+            own_limits,
+            has_current=parts.has_current,
+        )
+        template = fleet_problem(
+            own,
+            functions,
+            information_reward(own, self.preplan.maps, parts.reward_weight),
+            initial_state=problem.initial_state[layout.state_slice(index)],
+            dt=problem.dt,
+            stage_parameters=self.parameters(index, slots, [j for j, _ in partners], None),
+            n_substeps=problem.n_substeps,
+        )
+        return template, tuple(j for j, _ in partners)
+
+    def parameters(
+        self, index: int, slots: int, partners: list[int], where: FloatArray | None
+    ) -> FloatArray:
+        """Vehicle ``index``'s stage parameters: its own, then ``slots`` neighbours, partners.
+
+        ``where`` ``(n_vehicles, N + 1, 2)`` holds every vehicle's positions (None: all
+        slots parked). At each stage the slots hold the nearest others within the reach.
+        """
+        layout, has_current = self.layout, self.assembled.parts.has_current
+        own = self.assembled.problem.parameters[
+            :, layout.parameter_slice(index, has_current=has_current)
+        ]
+        desired = own[:, [layout.models[index].index(name) for name in ("north", "east")]]
+        n_stages = own.shape[0]
+        slotted = np.repeat((desired + PARKED)[:, None, :], slots, axis=1)
+        if where is not None and slots:
+            others, rank = _nearest_within(where, index, self.reach)
+            stage, column = np.nonzero(rank < slots)
+            slotted[stage, rank[stage, column].astype(np.int64)] = where[others[column], stage]
+        ranged = (
+            np.stack([where[j, :n_stages] for j in partners], axis=1)
+            if where is not None and partners
+            else np.repeat(desired[:, None, :], len(partners), axis=1)
+        )
+        return np.ascontiguousarray(
+            np.hstack([own, slotted.reshape(n_stages, -1), ranged.reshape(n_stages, -1)])
+        )
+
+
+def _nearest_within(where: FloatArray, index: int, reach: float) -> tuple[IntArray, FloatArray]:
+    """The others of ``index`` and, per stage, each one's rank by distance (``inf`` beyond reach).
+
+    Returns ``others`` ``(n_others,)`` and ``rank`` ``(N, n_others)`` over the stages ``0..N-1``.
+    """
+    n_stages = where.shape[1] - 1
+    others = np.array([j for j in range(where.shape[0]) if j != index], dtype=np.int64)
+    distance = np.linalg.norm(where[others, :n_stages] - where[index, :n_stages], axis=-1).T
+    rank = np.argsort(np.argsort(distance, axis=1), axis=1).astype(np.float64)
+    rank[distance > reach] = np.inf
+    return others, rank
+
+
+def _fleet_positions(layout: FleetLayout, vehicles: list[_Vehicle]) -> FloatArray:
+    """Every vehicle's positions ``(n_vehicles, N + 1, 2)`` along its latest trajectory."""
+    return np.stack([positions(layout.models[v.index], v.trajectory.states) for v in vehicles])
+
+
+def solve_decomposed(
+    assembled: AssembledProblem,
+    preplan: PreplanStage,
+    options: ProntoOptions,
+    *,
+    callback: Callable[[ProntoIteration], None] | None = None,
+) -> ProntoResult:
+    """Solve the fleet problem vehicle by vehicle (module docstring); the fleet's result.
+
+    ``assembled`` is the whole fleet's problem (:func:`auvplan.mission.assembly.
+    assemble_problem`) and its guess; ``options`` those of the first sweep (a replan's start
+    at a later barrier level and ``δ`` included). The result is that of the whole problem:
+    stacked trajectory, cost and smallest slack on every pair, the vehicles' regulator gains
+    block by block, the sub-problems' iterations one after the other in ``history``.
+    """
+    start = time.perf_counter()
+    layout = assembled.functions.layout
+    limits = assembled.parts.limits
+    fleet = _Fleet(
+        assembled,
+        layout,
+        preplan,
+        neighbour_reach(2 * limits.safety_radius + limits.separation_margin),
+    )
+    vehicles = []
+    for i in range(layout.n_vehicles):
+        template, partners = fleet.own_problem(i, 0)
+        guess = Trajectory(
+            assembled.guess.states[:, layout.state_slice(i)],
+            assembled.guess.inputs[:, layout.input_slice(i)],
+        )
+        vehicles.append(_Vehicle(i, template, 0, partners, ModelCache(max_entries=2), guess, 0.0))
+    history: list[ProntoIteration] = []
+    last_level = dataclasses.replace(options, eps_initial=options.eps_final)
+    clock = 0
+    sweep = 0
+    for sweep in range(MAX_SWEEPS + 1):
+        moved = False
+        for vehicle in vehicles:
+            where = _fleet_positions(layout, vehicles)
+            if sweep > 0 and not _is_dirty(vehicle, vehicles, where, fleet.reach):
+                continue
+            clock += 1
+            sweep_options = (
+                options
+                if sweep == 0
+                else dataclasses.replace(last_level, delta_initial=vehicle.delta)
+            )
+            result = _solve_vehicle(fleet, vehicle, where, sweep_options, history, callback)
+            vehicle.solved_at = clock
+            if result.n_iter > 0:
+                vehicle.moved_at = clock
+                moved = True
+        logger.info("decomposed sweep %d: %s", sweep, "moved" if moved else "settled")
+        if sweep > 0 and not moved:
+            break
+    settled = sweep > 0 and not moved
+    return _fleet_result(assembled, vehicles, history, settled, options, start)
+
+
+def _is_dirty(vehicle: _Vehicle, vehicles: list[_Vehicle], where: FloatArray, reach: float) -> bool:
+    """Whether a neighbour of ``vehicle`` (now or at its last solve) moved since that solve."""
+    others, rank = _nearest_within(where, vehicle.index, reach)
+    near = set(others[np.any(np.isfinite(rank), axis=0)].tolist())
+    relevant = near | vehicle.neighbours | set(vehicle.partners)
+    return any(vehicles[j].moved_at > vehicle.solved_at for j in relevant)
+
+
+def _solve_vehicle(
+    fleet: _Fleet,
+    vehicle: _Vehicle,
+    where: FloatArray,
+    options: ProntoOptions,
+    history: list[ProntoIteration],
+    callback: Callable[[ProntoIteration], None] | None,
+) -> ProntoResult:
+    """Solve ``vehicle``'s problem against ``where`` the others are; keep its solution."""
+    others, rank = _nearest_within(where, vehicle.index, fleet.reach)
+    needed = int(np.max(np.sum(np.isfinite(rank), axis=1), initial=0))
+    if needed > vehicle.slots:
+        vehicle.slots = needed
+        vehicle.template, _ = fleet.own_problem(vehicle.index, needed)
+        vehicle.cache = ModelCache(max_entries=2)
+    vehicle.neighbours = frozenset(others[np.any(np.isfinite(rank), axis=0)].tolist())
+    problem = vehicle.cache.rebind(
+        vehicle.template,
+        initial_state=vehicle.template.initial_state,
+        stage_parameters=fleet.parameters(
+            vehicle.index, vehicle.slots, list(vehicle.partners), where
+        ),
+        backend=options.backend,
+    )
+
+    def record(iteration: ProntoIteration) -> None:
+        entry = dataclasses.replace(iteration, iteration=len(history))
+        history.append(entry)
+        if callback is not None:
+            callback(entry)
+
+    result = solve_pronto(
+        problem, vehicle.trajectory, options=options, callback=record, cache=vehicle.cache
+    )
+    logger.info(
+        "vehicle %s: %s in %d steps (%d neighbours)",
+        fleet.layout.names[vehicle.index],
+        result.status.name,
+        result.n_iter,
+        len(vehicle.neighbours),
+    )
+    vehicle.result = result
+    vehicle.steps += result.n_iter
+    vehicle.trajectory = result.trajectory
+    vehicle.delta = result.delta
+    vehicle.gains = result.regulator_gains
+    return result
+
+
+def _fleet_result(
+    assembled: AssembledProblem,
+    vehicles: list[_Vehicle],
+    history: list[ProntoIteration],
+    settled: bool,
+    options: ProntoOptions,
+    start: float,
+) -> ProntoResult:
+    """The whole fleet's :class:`ProntoResult` from the vehicles' solutions."""
+    layout = assembled.functions.layout
+    problem = assembled.problem
+    trajectory = Trajectory(
+        layout.stack([v.trajectory.states for v in vehicles]),
+        layout.stack([v.trajectory.inputs for v in vehicles]),
+    )
+    gains = np.zeros((problem.n_steps, layout.n_u, layout.n_x))
+    for v in vehicles:
+        assert v.gains is not None
+        gains[:, layout.input_slice(v.index), layout.state_slice(v.index)] = v.gains
+    delta = min(v.delta for v in vehicles)
+    epsilon = options.eps_final
+    model = ModelCache(max_entries=1).get(problem, options.backend)
+    cost, smallest = evaluate_cost(model, trajectory, epsilon, delta)
+    results = [v.result for v in vehicles if v.result is not None]
+    steps = sum(v.steps for v in vehicles)
+    failed = [r for r in results if r.status is not ProntoStatus.CONVERGED]
+    if failed:
+        status, message = failed[0].status, failed[0].message
+        message = f"{layout.names[results.index(failed[0])]}: {message}"
+    elif not settled:
+        status = ProntoStatus.MAX_ITER
+        message = f"vehicles still moving after {MAX_SWEEPS} sweeps"
+    elif model.has_constraints and not smallest > 0.0:
+        status = ProntoStatus.INFEASIBLE
+        message = f"converged but infeasible: smallest scaled slack {smallest:.3g}"
+    else:
+        status = ProntoStatus.CONVERGED
+        message = f"converged vehicle by vehicle: {steps} steps"
+    return ProntoResult(
+        trajectory=trajectory,
+        status=status,
+        message=message,
+        cost=cost.objective,
+        running_cost=cost.running,
+        terminal_cost=cost.terminal,
+        barrier_cost=cost.barrier,
+        n_iter=steps,
+        history=tuple(history),
+        regulator_gains=gains,
+        epsilon=epsilon if model.has_constraints else 0.0,
+        delta=delta if model.has_constraints else float("inf"),
+        min_slack=smallest,
+        wall_time=time.perf_counter() - start,
+    )
