@@ -76,3 +76,22 @@ def test_a_solve_builds_only_the_functions_it_evaluates() -> None:
     built = set(vars(cache.get(problem).discrete.functions))
     assert {"first_order", "lagrangian_hessian", "closed_loop_step"} <= built
     assert not {"dyn_hessian", "cost_hessian", "cost_gradient"} & built
+
+
+def test_a_rebound_problem_shares_its_model_and_solves_like_a_fresh_one() -> None:
+    problem = unicycle_problem()
+    cache = ModelCache(max_entries=2)
+    model = cache.get(problem)
+    start = problem.initial_state + 0.1
+    rebound = [
+        cache.rebind(problem, initial_state=start, stage_parameters=problem.parameters.copy())
+        for _ in range(3)
+    ]
+    assert cache.get(rebound[-1]).discrete is model.discrete
+    assert cache.get(rebound[-1]).problem is rebound[-1]
+    assert cache.get(problem) is model  # kept: the least recently used entries go first
+    fresh = dataclasses.replace(problem, initial_state=start)
+    np.testing.assert_array_equal(
+        solve_pronto(rebound[-1], zero_guess(problem), cache=cache).trajectory.states,
+        solve_pronto(fresh, zero_guess(problem)).trajectory.states,
+    )

@@ -336,6 +336,7 @@ def plan(
             callback=None if reporter is None else reporter.iteration,
             progress=stages,
             before_optimization=None if companion is None else companion.wait_for_warm_up,
+            jobs=1 if companion is None else 2,
         )
     return MissionPlan.from_result(result, warnings=warnings)
 

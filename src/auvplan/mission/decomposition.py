@@ -36,14 +36,19 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
+import multiprocessing
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Final
+from contextlib import nullcontext
+from dataclasses import dataclass, field
+from multiprocessing.connection import Connection
+from typing import Final, Self
 
 import numpy as np
 
 from auvplan._typing import FloatArray, IntArray
+from auvplan.errors import SolverError
+from auvplan.interrupts import checkpoint, children_ignore_ctrl_c
 from auvplan.mission.assembly import AssembledProblem, fleet_problem
 from auvplan.mission.fleet import FleetLayout, FleetWeights, build_fleet_functions
 from auvplan.mission.preplan import PreplanStage
@@ -56,6 +61,7 @@ from auvplan.optimization import (
     ProntoStatus,
     Trajectory,
     TrajectoryProblem,
+    project_guess,
     solve_pronto,
 )
 from auvplan.optimization.stages import evaluate_cost
@@ -73,6 +79,8 @@ NEGLIGIBLE_SLACK: Final = 10.0
 MOVE_ALLOWANCE: Final = 30.0
 #: Offset [m] of a parked neighbour slot from the vehicle's own desired position.
 PARKED: Final = 1.0e6
+#: How often [s] a wait for the second process looks for a stop request.
+HELPER_POLL_S: Final = 0.2
 
 
 def neighbour_reach(separation: float) -> float:
@@ -201,6 +209,7 @@ def solve_decomposed(
     options: ProntoOptions,
     *,
     callback: Callable[[ProntoIteration], None] | None = None,
+    jobs: int = 1,
 ) -> ProntoResult:
     """Solve the fleet problem vehicle by vehicle (module docstring); the fleet's result.
 
@@ -208,7 +217,10 @@ def solve_decomposed(
     assemble_problem`) and its guess; ``options`` those of the first sweep (a replan's start
     at a later barrier level and ``δ`` included). The result is that of the whole problem:
     stacked trajectory, cost and smallest slack on every pair, the vehicles' regulator gains
-    block by block, the sub-problems' iterations one after the other in ``history``.
+    block by block, the vehicles' iterations one solve after another in ``history`` (given
+    to ``callback`` after each solve; ``StopIteration`` from it stops with ``MAX_ITER``).
+    With ``jobs = 2`` a second process solves, beside each vehicle, the next one due that is
+    not its neighbour: the two problems share no term, so the sweep is the same descent.
     """
     start = time.perf_counter()
     layout = assembled.functions.layout
@@ -226,59 +238,143 @@ def solve_decomposed(
             assembled.guess.states[:, layout.state_slice(i)],
             assembled.guess.inputs[:, layout.input_slice(i)],
         )
-        vehicles.append(_Vehicle(i, template, 0, partners, ModelCache(max_entries=2), guess, 0.0))
-    history: list[ProntoIteration] = []
-    last_level = dataclasses.replace(options, eps_initial=options.eps_final)
-    clock = 0
-    sweep = 0
-    for sweep in range(MAX_SWEEPS + 1):
-        moved = False
-        for vehicle in vehicles:
-            where = _fleet_positions(layout, vehicles)
-            if sweep > 0 and not _is_dirty(vehicle, vehicles, where, fleet.reach):
-                continue
-            clock += 1
-            sweep_options = (
-                options
-                if sweep == 0
-                else dataclasses.replace(last_level, delta_initial=vehicle.delta)
+        vehicles.append(
+            _Vehicle(
+                i, template, 0, partners, ModelCache(max_entries=2), guess, options.delta_initial
             )
-            result = _solve_vehicle(fleet, vehicle, where, sweep_options, history, callback)
-            vehicle.solved_at = clock
+        )
+    sweeps = _Sweeps(fleet, vehicles, options, callback)
+    with _Helper(fleet, vehicles) if jobs > 1 and len(vehicles) > 1 else nullcontext() as helper:
+        settled = sweeps.run(helper)
+    return _fleet_result(
+        assembled, vehicles, sweeps.history, settled, sweeps.stopped, options, start
+    )
+
+
+@dataclass
+class _Sweeps:
+    """The Gauss–Seidel sweeps over the vehicles (private; :func:`solve_decomposed`)."""
+
+    fleet: _Fleet
+    vehicles: list[_Vehicle]
+    options: ProntoOptions
+    callback: Callable[[ProntoIteration], None] | None
+    history: list[ProntoIteration] = field(default_factory=list)
+    clock: int = 0
+    stopped: bool = False
+
+    def run(self, helper: _Helper | None) -> bool:
+        """Sweep until one moves no vehicle (True) or :data:`MAX_SWEEPS` (False)."""
+        last_level = dataclasses.replace(self.options, eps_initial=self.options.eps_final)
+        for sweep in range(MAX_SWEEPS + 1):
+            moved = False
+            done: set[int] = set()
+            for vehicle in self.vehicles:
+                where = _fleet_positions(self.fleet.layout, self.vehicles)
+                if vehicle.index in done or not (sweep == 0 or self._is_dirty(vehicle, where)):
+                    continue
+                pair = [vehicle]
+                if helper is not None:
+                    pair += self._independent(vehicle, where, done, sweep)[:1]
+                done.update(v.index for v in pair)
+                options = [
+                    self.options
+                    if sweep == 0
+                    else dataclasses.replace(last_level, delta_initial=v.delta)
+                    for v in pair
+                ]
+                if len(pair) == 2:
+                    assert helper is not None
+                    helper.submit(pair[1], where, options[1])
+                solved = [_solve_vehicle(self.fleet, vehicle, where, options[0])]
+                if len(pair) == 2:
+                    assert helper is not None
+                    solved.append(helper.result())
+                moved |= self._keep(pair, solved)
+                if self.stopped:
+                    return False
+            logger.info("decomposed sweep %d: %s", sweep, "moved" if moved else "settled")
+            if sweep > 0 and not moved:
+                return True
+        return False
+
+    def _keep(
+        self, pair: list[_Vehicle], solved: list[tuple[ProntoResult, frozenset[int], int]]
+    ) -> bool:
+        """Keep the solutions of vehicles solved side by side; whether one moved."""
+        self.clock += 2
+        moved = False
+        for vehicle, (result, neighbours, slots) in zip(pair, solved, strict=True):
+            vehicle.result = result
+            vehicle.steps += result.n_iter
+            vehicle.trajectory = result.trajectory
+            vehicle.delta = result.delta
+            vehicle.gains = result.regulator_gains
+            vehicle.neighbours = neighbours
+            vehicle.solved_at = self.clock - 1
             if result.n_iter > 0:
-                vehicle.moved_at = clock
+                vehicle.moved_at = self.clock
                 moved = True
-        logger.info("decomposed sweep %d: %s", sweep, "moved" if moved else "settled")
-        if sweep > 0 and not moved:
-            break
-    settled = sweep > 0 and not moved
-    return _fleet_result(assembled, vehicles, history, settled, options, start)
+            logger.info(
+                "vehicle %s: %s in %d steps (%d neighbours, %d slots)",
+                self.fleet.layout.names[vehicle.index],
+                result.status.name,
+                result.n_iter,
+                len(neighbours),
+                slots,
+            )
+            for iteration in result.history:
+                entry = dataclasses.replace(iteration, iteration=len(self.history))
+                self.history.append(entry)
+                if self.callback is not None and not self.stopped:
+                    try:
+                        self.callback(entry)
+                    except StopIteration:
+                        self.stopped = True
+        return moved
+
+    def _is_dirty(self, vehicle: _Vehicle, where: FloatArray) -> bool:
+        """Whether a neighbour of ``vehicle`` (now or at its last solve) moved since then."""
+        relevant = _near(where, vehicle.index, self.fleet.reach) | vehicle.neighbours
+        relevant |= set(vehicle.partners)
+        return any(self.vehicles[j].moved_at > vehicle.solved_at for j in relevant)
+
+    def _independent(
+        self, vehicle: _Vehicle, where: FloatArray, done: set[int], sweep: int
+    ) -> list[_Vehicle]:
+        """The later vehicles due in this sweep that share no term with ``vehicle``."""
+        near = _near(where, vehicle.index, self.fleet.reach) | vehicle.neighbours
+        near |= set(vehicle.partners)
+        return [
+            other
+            for other in self.vehicles[vehicle.index + 1 :]
+            if other.index not in done
+            and other.index not in near
+            and vehicle.index not in other.partners
+            and (sweep == 0 or self._is_dirty(other, where))
+        ]
 
 
-def _is_dirty(vehicle: _Vehicle, vehicles: list[_Vehicle], where: FloatArray, reach: float) -> bool:
-    """Whether a neighbour of ``vehicle`` (now or at its last solve) moved since that solve."""
-    others, rank = _nearest_within(where, vehicle.index, reach)
-    near = set(others[np.any(np.isfinite(rank), axis=0)].tolist())
-    relevant = near | vehicle.neighbours | set(vehicle.partners)
-    return any(vehicles[j].moved_at > vehicle.solved_at for j in relevant)
+def _near(where: FloatArray, index: int, reach: float) -> set[int]:
+    """The vehicles within ``reach`` of vehicle ``index`` at some stage."""
+    others, rank = _nearest_within(where, index, reach)
+    return set(others[np.any(np.isfinite(rank), axis=0)].tolist())
 
 
 def _solve_vehicle(
-    fleet: _Fleet,
-    vehicle: _Vehicle,
-    where: FloatArray,
-    options: ProntoOptions,
-    history: list[ProntoIteration],
-    callback: Callable[[ProntoIteration], None] | None,
-) -> ProntoResult:
-    """Solve ``vehicle``'s problem against ``where`` the others are; keep its solution."""
+    fleet: _Fleet, vehicle: _Vehicle, where: FloatArray, options: ProntoOptions
+) -> tuple[ProntoResult, frozenset[int], int]:
+    """Solve ``vehicle``'s problem against ``where`` the others are.
+
+    Returns the result, the neighbours that entered the problem and its neighbour slots;
+    ``vehicle`` keeps its problem (rebuilt when it needs more slots), not the solution.
+    """
     others, rank = _nearest_within(where, vehicle.index, fleet.reach)
     needed = int(np.max(np.sum(np.isfinite(rank), axis=1), initial=0))
     if needed > vehicle.slots:
         vehicle.slots = needed
         vehicle.template, _ = fleet.own_problem(vehicle.index, needed)
         vehicle.cache = ModelCache(max_entries=2)
-    vehicle.neighbours = frozenset(others[np.any(np.isfinite(rank), axis=0)].tolist())
     problem = vehicle.cache.rebind(
         vehicle.template,
         initial_state=vehicle.template.initial_state,
@@ -287,29 +383,62 @@ def _solve_vehicle(
         ),
         backend=options.backend,
     )
+    result = solve_pronto(problem, vehicle.trajectory, options=options, cache=vehicle.cache)
+    neighbours = frozenset(others[np.any(np.isfinite(rank), axis=0)].tolist())
+    return result, neighbours, vehicle.slots
 
-    def record(iteration: ProntoIteration) -> None:
-        entry = dataclasses.replace(iteration, iteration=len(history))
-        history.append(entry)
-        if callback is not None:
-            callback(entry)
 
-    result = solve_pronto(
-        problem, vehicle.trajectory, options=options, callback=record, cache=vehicle.cache
-    )
-    logger.info(
-        "vehicle %s: %s in %d steps (%d neighbours)",
-        fleet.layout.names[vehicle.index],
-        result.status.name,
-        result.n_iter,
-        len(vehicle.neighbours),
-    )
-    vehicle.result = result
-    vehicle.steps += result.n_iter
-    vehicle.trajectory = result.trajectory
-    vehicle.delta = result.delta
-    vehicle.gains = result.regulator_gains
-    return result
+class _Helper:
+    """A second process that solves one vehicle's problem while this one solves another.
+
+    Forked, so it starts with the fleet's problems; it ignores Ctrl-C (this process stops
+    it) and is killed when the block ends, finished or not.
+    """
+
+    def __init__(self, fleet: _Fleet, vehicles: list[_Vehicle]) -> None:
+        context = multiprocessing.get_context("fork")
+        self._connection, child = context.Pipe()
+        with children_ignore_ctrl_c():
+            self._process = context.Process(
+                target=_serve, args=(child, fleet, vehicles), daemon=True
+            )
+            self._process.start()
+        child.close()
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self._process.kill()
+        self._process.join()
+        self._connection.close()
+
+    def submit(self, vehicle: _Vehicle, where: FloatArray, options: ProntoOptions) -> None:
+        """Start solving ``vehicle`` (at its latest trajectory and ``δ``) against ``where``."""
+        self._connection.send((vehicle.index, vehicle.trajectory, where, options))
+
+    def result(self) -> tuple[ProntoResult, frozenset[int], int]:
+        """What :func:`_solve_vehicle` returned in the helper; its error raised here."""
+        while not self._connection.poll(HELPER_POLL_S):
+            checkpoint()
+            if not self._process.is_alive():
+                raise SolverError("the optimiser's second process ended unexpectedly")
+        kind, value = self._connection.recv()
+        if kind == "error":
+            raise value
+        return value  # type: ignore[no-any-return]
+
+
+def _serve(connection: Connection, fleet: _Fleet, vehicles: list[_Vehicle]) -> None:
+    """The helper's loop: solve each vehicle sent, send back the outcome or the error."""
+    while True:
+        index, trajectory, where, options = connection.recv()
+        vehicle = vehicles[index]
+        vehicle.trajectory = trajectory
+        try:
+            connection.send(("ok", _solve_vehicle(fleet, vehicle, where, options)))
+        except Exception as error:  # noqa: BLE001 (sent to the parent, which raises it)
+            connection.send(("error", error))
 
 
 def _fleet_result(
@@ -317,20 +446,23 @@ def _fleet_result(
     vehicles: list[_Vehicle],
     history: list[ProntoIteration],
     settled: bool,
+    stopped: bool,
     options: ProntoOptions,
     start: float,
 ) -> ProntoResult:
     """The whole fleet's :class:`ProntoResult` from the vehicles' solutions."""
     layout = assembled.functions.layout
     problem = assembled.problem
+    gains = np.zeros((problem.n_steps, layout.n_u, layout.n_x))
+    for v in vehicles:
+        if v.gains is None:  # stopped before its first solve: its guess on its dynamics
+            model = v.cache.get(v.template, options.backend)
+            v.trajectory, v.gains = project_guess(model, v.trajectory, options)
+        gains[:, layout.input_slice(v.index), layout.state_slice(v.index)] = v.gains
     trajectory = Trajectory(
         layout.stack([v.trajectory.states for v in vehicles]),
         layout.stack([v.trajectory.inputs for v in vehicles]),
     )
-    gains = np.zeros((problem.n_steps, layout.n_u, layout.n_x))
-    for v in vehicles:
-        assert v.gains is not None
-        gains[:, layout.input_slice(v.index), layout.state_slice(v.index)] = v.gains
     delta = min(v.delta for v in vehicles)
     epsilon = options.eps_final
     model = ModelCache(max_entries=1).get(problem, options.backend)
@@ -341,6 +473,8 @@ def _fleet_result(
     if failed:
         status, message = failed[0].status, failed[0].message
         message = f"{layout.names[results.index(failed[0])]}: {message}"
+    elif stopped:
+        status, message = ProntoStatus.MAX_ITER, "stopped by the callback"
     elif not settled:
         status = ProntoStatus.MAX_ITER
         message = f"vehicles still moving after {MAX_SWEEPS} sweeps"

@@ -108,6 +108,7 @@ def run_mission(
     callback: Callable[[Any], None] | None = None,
     progress: ProgressReporter = no_progress,
     before_optimization: Callable[[], None] | None = None,
+    jobs: int = 1,
 ) -> MissionResult:
     """Run the pipeline on a validated mission up to ``stage``.
 
@@ -133,6 +134,8 @@ def run_mission(
     before_optimization : callable, optional
         Called once when stage 3 is about to start (after stage 2), e.g. to wait for the
         optimiser's kernels compiled in another process (:mod:`auvplan.api.companion`).
+    jobs : int
+        Processes stage 3 may use (1 or 2; a decomposed fleet solve uses a second one).
     """
     timings: dict[str, float] = {}
     progress = with_checkpoints(progress)
@@ -163,7 +166,7 @@ def run_mission(
 
     def optimize(terrain_weight: float) -> OptimizedPlan:
         return run_optimization(
-            config, layout, preplan, deconfliction, terrain_weight, callback=callback
+            config, layout, preplan, deconfliction, terrain_weight, callback=callback, jobs=jobs
         )
 
     if before_optimization is not None:
@@ -255,6 +258,7 @@ def run_optimization(
     *,
     callback: Callable[[Any], None] | None = None,
     warm_start: WarmStart | None = None,
+    jobs: int = 1,
 ) -> OptimizedPlan:
     """Stage 3: PRONTO with barrier continuation from the projected desired trajectories.
 
@@ -263,7 +267,9 @@ def run_optimization(
     level for other starts, and a vehicle moved off its plan can leave it infeasible (4 × 1 h
     MEDUSAs, one moved 30 m: scaled slack −0.05). One level up the barrier re-centres it; at
     the last level its iterates hug the constraint it crossed (``δ`` shrank to 2e-9, 12
-    iterations against 8, ``benchmarks/bench_replan.py``).
+    iterations against 8, ``benchmarks/bench_replan.py``). ``config.solver.fleet`` chooses
+    the coupled solve or the vehicle-by-vehicle one (:mod:`auvplan.mission.decomposition`,
+    with ``jobs`` processes).
     """
     decomposed = config.solver.decomposes(layout.n_vehicles)
     assembled = assemble_problem(
@@ -280,7 +286,7 @@ def run_optimization(
             options, eps_initial=levels[-min(2, len(levels))], delta_initial=delta
         )
     if decomposed:
-        result = solve_decomposed(assembled, preplan, options, callback=callback)
+        result = solve_decomposed(assembled, preplan, options, callback=callback, jobs=jobs)
     else:
         result = solve_pronto(
             assembled.problem, assembled.guess, options=options, callback=callback

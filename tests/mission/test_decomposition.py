@@ -1,0 +1,218 @@
+"""The decomposed fleet solve (issue 27): vehicle by vehicle against the others' plans.
+
+Four MEDUSAs cross in a 60 m square (two pairs 20 m apart on parallel lanes, a comm range
+between two of them), so separations are active and every vehicle is every other's
+neighbour: the vehicle-by-vehicle solve must reach the coupled Newton solve's optimum, keep
+every constraint between samples, and be a fixed point of its own sweeps.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+from typing import Any
+
+import numpy as np
+import pytest
+
+from auvplan.errors import InputError
+from auvplan.mission import pipeline
+from auvplan.mission.assembly import AssembledProblem, assemble_problem, check_optimizer_memory
+from auvplan.mission.config import MissionConfig, parse_mission
+from auvplan.mission.decomposition import _Helper, _nearest_within, solve_decomposed
+from auvplan.mission.fleet import FleetLayout
+from auvplan.mission.models import vehicle_model
+from auvplan.mission.pipeline import Stage
+from auvplan.mission.preplan import PreplanStage
+from auvplan.optimization import ProntoStatus, Trajectory
+
+CROSSING = """
+[terrain]
+synthetic = true
+[fleet]
+horizon_s = 240.0
+safety_radius_m = 5.0
+[[vehicle]]
+name = "a"
+start = { north = 150.0, east = 400.0, heading_deg = 0.0, speed = 0.5 }
+goal = { north = 250.0, east = 400.0, heading_deg = 0.0 }
+[[vehicle]]
+name = "b"
+start = { north = 200.0, east = 350.0, heading_deg = 90.0, speed = 0.5 }
+goal = { north = 200.0, east = 450.0, heading_deg = 90.0 }
+[[vehicle]]
+name = "c"
+start = { north = 150.0, east = 420.0, heading_deg = 0.0, speed = 0.5 }
+goal = { north = 250.0, east = 420.0, heading_deg = 0.0 }
+[[vehicle]]
+name = "d"
+start = { north = 220.0, east = 350.0, heading_deg = 90.0, speed = 0.5 }
+goal = { north = 220.0, east = 450.0, heading_deg = 90.0 }
+[[comm]]
+pair = ["a", "d"]
+max_range_m = 90.0
+[solver]
+dt_s = 1.0
+"""
+
+
+def _config(text: str, fleet: str) -> MissionConfig:
+    return parse_mission(tomllib.loads(text + f'fleet = "{fleet}"\n'))
+
+
+def _assembled(
+    config: MissionConfig, run: pipeline.MissionResult
+) -> tuple[AssembledProblem, PreplanStage]:
+    """The stage-3 problem of a run's stages 1 and 2, for the decomposed solve."""
+    assert run.deconfliction is not None
+    assembled = assemble_problem(
+        pipeline.fleet_layout(config), run.preplan, run.deconfliction, weights=config.weights,
+        terrain_weight=config.weights.terrain, safety_radius=config.fleet.safety_radius,
+        comms=config.comms, decomposed=True,
+    )  # fmt: skip
+    return assembled, run.preplan
+
+
+@pytest.fixture(scope="module")
+def planned() -> dict[str, pipeline.MissionResult]:
+    return {
+        mode: pipeline.run_mission(_config(CROSSING, mode)) for mode in ("coupled", "decomposed")
+    }
+
+
+def test_the_decomposed_plan_reaches_the_coupled_optimum(
+    planned: dict[str, pipeline.MissionResult],
+) -> None:
+    coupled, decomposed = planned["coupled"].plan, planned["decomposed"].plan
+    assert coupled is not None
+    assert decomposed is not None
+    for plan in (coupled, decomposed):
+        assert plan.result.status is ProntoStatus.CONVERGED
+        assert plan.verdict.success, plan.verdict.message  # every constraint between samples
+    assert decomposed.result.message.startswith("converged vehicle by vehicle")
+    # each vehicle optimal given the others: the same optimum as Newton on the whole fleet,
+    # to the relative accuracy the sweeps stop at (the coupled optimum is 46,195.8 J)
+    objective = {
+        name: plan.result.running_cost + plan.result.terminal_cost
+        for name, plan in (("coupled", coupled), ("decomposed", decomposed))
+    }
+    assert objective["decomposed"] == pytest.approx(objective["coupled"], rel=1e-3)
+    # the active separations: both plans fly the pairs within 5 % of 2 r_c + margin
+    closest = [min(d.values()) for d in decomposed.separations.values()]
+    assert 10.0 <= min(closest) < 10.5
+
+
+def test_the_decomposed_plan_is_a_fixed_point_of_its_sweeps(
+    planned: dict[str, pipeline.MissionResult],
+) -> None:
+    """From its own plan at the last barrier level, no vehicle's problem takes a step."""
+    result = planned["decomposed"]
+    assert result.plan is not None
+    config = _config(CROSSING, "decomposed")
+    assembled, preplan = _assembled(config, result)
+    solved = result.plan.result
+    options = config.solver.pronto_options()
+    options = dataclasses.replace(
+        options, eps_initial=options.eps_final, delta_initial=solved.delta
+    )
+    again = solve_decomposed(
+        dataclasses.replace(assembled, guess=solved.trajectory), preplan, options
+    )
+    assert again.status is ProntoStatus.CONVERGED
+    assert again.n_iter == 0
+    assert len(again.history) == 4  # one convergence check each, one sweep
+    np.testing.assert_array_equal(again.trajectory.states, solved.trajectory.states)
+
+
+GROUPS = """
+[terrain]
+synthetic = true
+[fleet]
+horizon_s = 200.0
+safety_radius_m = 5.0
+[[vehicle]]
+name = "a"
+start = { north = 150.0, east = 100.0, heading_deg = 0.0, speed = 0.5 }
+goal = { north = 230.0, east = 100.0, heading_deg = 0.0 }
+[[vehicle]]
+name = "b"
+start = { north = 190.0, east = 60.0, heading_deg = 90.0, speed = 0.5 }
+goal = { north = 190.0, east = 140.0, heading_deg = 90.0 }
+[[vehicle]]
+name = "c"
+start = { north = 150.0, east = 600.0, heading_deg = 0.0, speed = 0.5 }
+goal = { north = 230.0, east = 600.0, heading_deg = 0.0 }
+[[vehicle]]
+name = "d"
+start = { north = 190.0, east = 560.0, heading_deg = 90.0, speed = 0.5 }
+goal = { north = 190.0, east = 640.0, heading_deg = 90.0 }
+[solver]
+dt_s = 1.0
+"""
+
+
+def test_two_processes_solve_vehicles_that_share_no_term_side_by_side(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Two crossings 500 m apart: the second process takes the far group's vehicles, and
+    the plan is the one a single process makes, to the last bit."""
+    config = _config(GROUPS, "decomposed")
+    assembled, preplan = _assembled(config, pipeline.run_mission(config, stage=Stage.DECONFLICT))
+    options = config.solver.pronto_options()
+    submitted: list[int] = []
+    submit = _Helper.submit
+
+    def spy(self: _Helper, vehicle: Any, *args: Any) -> None:
+        submitted.append(vehicle.index)
+        submit(self, vehicle, *args)
+
+    monkeypatch.setattr(_Helper, "submit", spy)
+    one = solve_decomposed(assembled, preplan, options, jobs=1)
+    two = solve_decomposed(assembled, preplan, options, jobs=2)
+    assert submitted[:2] == [2, 3]  # a beside c, then b beside d
+    for result in (one, two):
+        assert result.status is ProntoStatus.CONVERGED
+    np.testing.assert_array_equal(one.trajectory.states, two.trajectory.states)
+    np.testing.assert_array_equal(one.regulator_gains, two.regulator_gains)
+    assert one.cost == two.cost
+
+
+def test_a_stop_from_the_callback_ends_the_solve_with_max_iter() -> None:
+    config = _config(GROUPS, "decomposed")
+    assembled, preplan = _assembled(config, pipeline.run_mission(config, stage=Stage.DECONFLICT))
+
+    def stop(_record: object) -> None:
+        raise StopIteration
+
+    result = solve_decomposed(assembled, preplan, config.solver.pronto_options(), callback=stop)
+    assert result.status is ProntoStatus.MAX_ITER
+    assert result.message == "stopped by the callback"
+    assert isinstance(result.trajectory, Trajectory)
+
+
+def test_neighbours_are_ranked_by_distance_within_the_reach_only() -> None:
+    # vehicle 0 at the origin; 1 passes 30 m away at stage 1; 2 stays 100 m away; 3 at 10 m
+    where = np.zeros((4, 4, 2))
+    where[1, :, 1] = [90.0, 30.0, 60.0, 90.0]
+    where[2, :, 1] = 100.0
+    where[3, :, 0] = 10.0
+    others, rank = _nearest_within(where, 0, reach=50.0)
+    np.testing.assert_array_equal(others, [1, 2, 3])
+    np.testing.assert_array_equal(
+        rank, [[np.inf, np.inf, 0.0], [1.0, np.inf, 0.0], [np.inf, np.inf, 0.0]]
+    )  # the last node (stage N) is no stage: its parameters are stage N-1's
+
+
+def test_auto_decomposes_from_eight_vehicles_and_the_memory_check_follows() -> None:
+    config = _config(CROSSING, "auto")
+    assert not config.solver.decomposes(7)
+    assert config.solver.decomposes(8)
+    assert not _config(CROSSING, "coupled").solver.decomposes(32)
+    assert _config(CROSSING, "decomposed").solver.decomposes(2)
+    with pytest.raises(InputError, match=r"solver\.fleet"):
+        _config(CROSSING, "jacobi")
+    medusa = vehicle_model("medusa", 3)
+    fleet = FleetLayout(tuple(f"v{i}" for i in range(32)), (medusa,) * 32)
+    with pytest.raises(InputError, match="GiB"):
+        check_optimizer_memory(fleet, 3600)  # 32 coupled MEDUSAs x 1 h at 1 s: ~47 GiB
+    check_optimizer_memory(fleet, 3600, decomposed=True)  # one vehicle at a time
