@@ -24,8 +24,9 @@ import tomli_w
 
 from auvplan.mission import load_mission
 from auvplan.mission.assembly import AssembledProblem, assemble_problem
+from auvplan.mission.decomposition import solve_decomposed
 from auvplan.mission.pipeline import fleet_layout
-from auvplan.mission.preplan import run_preplan
+from auvplan.mission.preplan import PreplanStage, run_preplan
 from auvplan.mission.timing import run_deconfliction
 from auvplan.optimization import (
     ModelCache,
@@ -86,8 +87,13 @@ def lane_mission(n_vehicles: int, horizon: float, dt: float, folder: Path) -> Pa
     return path
 
 
-def build_case(name: str, folder: Path) -> tuple[AssembledProblem, ProntoOptions]:
-    """The stage-3 problem of a case (``demo`` energy-only, or ``fleet-N-T-DT``)."""
+def build_case(
+    name: str, folder: Path, *, decomposed: bool = False
+) -> tuple[AssembledProblem, ProntoOptions, PreplanStage]:
+    """The stage-3 problem of a case (``demo`` energy-only, or ``fleet-N-T-DT``).
+
+    Also returns stage 1's result, which the ``decomposed`` solve reads (the maps).
+    """
     if name == "demo":
         config, terrain_weight = load_mission(DEMO), 0.0
     else:
@@ -103,9 +109,9 @@ def build_case(name: str, folder: Path) -> tuple[AssembledProblem, ProntoOptions
     )  # fmt: skip
     assembled = assemble_problem(
         layout, preplan, deconfliction, weights=config.weights, terrain_weight=terrain_weight,
-        safety_radius=config.fleet.safety_radius, comms=config.comms,
+        safety_radius=config.fleet.safety_radius, comms=config.comms, decomposed=decomposed,
     )  # fmt: skip
-    return assembled, config.solver.pronto_options()
+    return assembled, config.solver.pronto_options(), preplan
 
 
 def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, Any]:
@@ -120,10 +126,13 @@ def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, An
     compilation); ``fatrop``/``fatrop-c``: CasADi + FATROP alike on the MX NLP (expanded, the
     crossing's took > 10 GB to build and compile), the stage Function on CasADi's virtual
     machine or compiled (``solve_s``: the solve alone).
+    ``decomposed``/``decomposed-2``: vehicle by vehicle (:mod:`auvplan.mission.decomposition`)
+    in one or two processes; ``directions`` counts the vehicles' iterations.
     ``max_iter`` caps the solver's iterations (for per-iteration timing).
     """
+    decomposed = solver.startswith("decomposed")
     with tempfile.TemporaryDirectory() as scratch:
-        assembled, options = build_case(case, Path(scratch))
+        assembled, options, preplan = build_case(case, Path(scratch), decomposed=decomposed)
     problem, guess = assembled.problem, assembled.guess
     if max_iter is not None:
         options = ProntoOptions(**{**options.__dict__, "max_iter": max_iter})
@@ -146,6 +155,14 @@ def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, An
             status=str(result.status), iterations=result.n_iter, cost=result.cost,
             solve_s=result.solve_time,
         )  # fmt: skip
+    elif decomposed:
+        jobs = 2 if solver.endswith("-2") else 1
+        outcome = solve_decomposed(assembled, preplan, options, jobs=jobs)
+        record.update(
+            status=outcome.status.name, iterations=outcome.n_iter, cost=outcome.cost,
+            objective=outcome.running_cost + outcome.terminal_cost,
+            directions=len(outcome.history), jobs=jobs,
+        )  # fmt: skip
     else:
         backend = StageBackend(stage_kernels=solver == "kernels")
         options = ProntoOptions(**{**options.__dict__, "stage_kernels": backend.stage_kernels})
@@ -163,6 +180,8 @@ def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, An
         )
     record["wall_s"] = time.perf_counter() - started
     record["peak_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    # the decomposed solve's second process (forked, ended by now): its own peak
+    record["peak_child_mb"] = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
     return record
 
 

@@ -4,7 +4,7 @@ Run::
 
     .venv/bin/python benchmarks/bench_reliability.py N [--first-seed S] [--jobs 1]
         [--timeout 1800] [--max-horizon-s T] [--output DIR] [--data-dir DIR]
-        [--edge-model navigation|paper|crossed]
+        [--edge-model navigation|paper|crossed] [--fleet auto|coupled|decomposed]
 
 For seeds ``S .. S+N-1`` (with ``--max-horizon-s``, seeds whose horizon is longer are skipped
 and the following seeds taken instead, until N scenarios ran), each scenario of
@@ -20,7 +20,7 @@ Prints the success rate, a table of failure classes with counts and seeds, and t
 95th percentile of wall time and peak memory; writes the rows to ``DIR/results.json`` and
 ``DIR/results.csv``. ``--edge-model`` plans every scenario on those routes instead of its own
 draw (the family draws the paper's and the crossed edge model; ``navigation`` is the default
-of a mission that names none).
+of a mission that names none); ``--fleet`` solves every fleet coupled or vehicle by vehicle.
 """
 
 from __future__ import annotations
@@ -147,12 +147,20 @@ def classify(row: Row, stderr: str) -> str:
 
 
 def run_scenario(
-    scenario: Scenario, root: Path, timeout: float, edge_model: str | None = None
+    scenario: Scenario,
+    root: Path,
+    timeout: float,
+    edge_model: str | None = None,
+    fleet: str | None = None,
 ) -> Row:
-    """Write, plan and check one scenario (its routes' ``edge_model`` replaced if given)."""
+    """Write, plan and check one scenario (its routes' ``edge_model`` and its
+    ``solver.fleet`` replaced if given)."""
     if edge_model is not None:
         planner = {**scenario.mission.get("planner", {}), "edge_model": edge_model}
         scenario = dataclasses.replace(scenario, mission={**scenario.mission, "planner": planner})
+    if fleet is not None:
+        solver = {**scenario.mission.get("solver", {}), "fleet": fleet}
+        scenario = dataclasses.replace(scenario, mission={**scenario.mission, "solver": solver})
     folder = scenario_folder(root, scenario.seed)
     mission = scenario.write(folder)
     row = Row(
@@ -240,6 +248,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         default=None,
         help="plan every scenario with these routes (default: each scenario's own draw)",
     )
+    parser.add_argument(
+        "--fleet",
+        choices=("auto", "coupled", "decomposed"),
+        default=None,
+        help="solve every scenario's fleet so (solver.fleet; default: the mission's own)",
+    )
     args = parser.parse_args(argv)
     scenarios = select_scenarios(args.n, args.first_seed, args.max_horizon_s, args.data_dir)
     args.output.mkdir(parents=True, exist_ok=True)
@@ -250,7 +264,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
 
     def one(scenario: Scenario) -> Row:
-        row = run_scenario(scenario, args.output, args.timeout, args.edge_model)
+        row = run_scenario(scenario, args.output, args.timeout, args.edge_model, args.fleet)
         print(
             f"seed {row.seed:4d}  {row.failure_class:<40.40s} {row.wall_s:7.1f} s "
             f"{row.peak_rss_mb:7.0f} MB  {row.description}",
