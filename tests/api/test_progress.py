@@ -79,3 +79,23 @@ def test_on_a_terminal_progress_is_a_live_display(caplog: pytest.LogCaptureFixtu
     assert "optimize  it 4  h 96  −Dh·ζ 1.0e-04  ε 1e-02" in shown
     assert "a warning above the bars" in shown
     assert progress_lines(caplog) == []
+
+
+def test_a_decomposed_solve_reports_its_vehicles_not_each_ones_barrier_levels(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    caplog.set_level(logging.INFO, logger="auvplan")
+    with (
+        ConsoleProgress(epsilon_levels=(1.0, 0.1), live=False) as progress,
+        progress("optimize"),
+        progress("sweep 1", total=2) as advance,
+    ):
+        for name in ("blue", "green"):
+            for index, epsilon in enumerate((1.0, 0.1)):
+                progress.iteration(iteration(index, epsilon))
+            advance(name)
+    lines = progress_lines(caplog)
+    assert not [line for line in lines if "barrier level" in line]
+    assert [line.split(" (")[0] for line in lines if line.startswith("sweep 1 ")] == [
+        "sweep 1 1/2: blue", "sweep 1 2/2: green",
+    ]  # fmt: skip

@@ -103,7 +103,10 @@ def _wide_fleet_mission(n_vehicles: int, dt_s: float) -> str:
         f"goal = {{ north = 380.0, east = {300.0 + 8.0 * i}, heading_deg = 0.0 }}\n"
         for i in range(n_vehicles)
     )
-    return f'{head}{vehicles}[planner]\nedge_model = "paper"\n[solver]\ndt_s = {dt_s}\n'
+    return (
+        f'{head}{vehicles}[planner]\nedge_model = "paper"\n[solver]\ndt_s = {dt_s}\n'
+        'fleet = "coupled"\n'  # the decomposed solve needs one vehicle's memory at a time
+    )
 
 
 def test_memory_budget_applies_only_to_the_stage_that_optimises(

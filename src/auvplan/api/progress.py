@@ -43,10 +43,15 @@ PLAIN_STEPS = 10
 
 @dataclass
 class _Stage:
-    """A stage in progress: its name, units of work, and its rich task (live mode)."""
+    """A stage in progress: its name, units of work, and its rich task (live mode).
+
+    ``units``: entered with a ``total`` of units it counts; the optimiser's iterations are
+    shown on the innermost stage, unless it counts units (the decomposed solve's vehicles).
+    """
 
     name: str
     total: int | None
+    units: bool = False
     started: float = field(default_factory=time.perf_counter)
     done: int = 0
     level: int = -1
@@ -123,7 +128,7 @@ class ConsoleProgress:
     @contextmanager
     def __call__(self, name: str, *, total: int | None = None) -> Iterator[Callable[[str], None]]:
         """Report stage ``name`` of ``total`` units while the block runs; yields ``advance``."""
-        stage = _Stage(name, total)
+        stage = _Stage(name, total, units=total is not None)
         if self._display is not None:
             stage.task = self._display.add_task(name, total=total)
         self._stages.append(stage)
@@ -140,9 +145,9 @@ class ConsoleProgress:
 
     def iteration(self, record: ProntoIteration) -> None:
         """The optimiser's ``callback``: show iteration, cost, decrement and ``ε``."""
-        if not self._stages:
+        stage = next((s for s in reversed(self._stages) if not s.units), None)
+        if stage is None or self._stages[-1].units:  # a unit (a vehicle's solve) reports
             return
-        stage = self._stages[-1]
         levels = self._levels if record.epsilon > 0.0 else ()
         level = sum(value > record.epsilon * (1.0 + 1e-9) for value in levels)
         stage.total = len(levels) or None

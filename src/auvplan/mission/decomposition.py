@@ -52,6 +52,7 @@ from auvplan.interrupts import checkpoint, children_ignore_ctrl_c
 from auvplan.mission.assembly import AssembledProblem, fleet_problem
 from auvplan.mission.fleet import FleetLayout, FleetWeights, build_fleet_functions
 from auvplan.mission.preplan import PreplanStage
+from auvplan.mission.progress import ProgressReporter, no_progress
 from auvplan.mission.reward import information_reward
 from auvplan.optimization import (
     ModelCache,
@@ -210,6 +211,7 @@ def solve_decomposed(
     *,
     callback: Callable[[ProntoIteration], None] | None = None,
     jobs: int = 1,
+    progress: ProgressReporter = no_progress,
 ) -> ProntoResult:
     """Solve the fleet problem vehicle by vehicle (module docstring); the fleet's result.
 
@@ -221,6 +223,8 @@ def solve_decomposed(
     to ``callback`` after each solve; ``StopIteration`` from it stops with ``MAX_ITER``).
     With ``jobs = 2`` a second process solves, beside each vehicle, the next one due that is
     not its neighbour: the two problems share no term, so the sweep is the same descent.
+    ``progress`` is told of each sweep (``"sweep k"``) and of each vehicle in it, solved or
+    left as it was.
     """
     start = time.perf_counter()
     layout = assembled.functions.layout
@@ -243,7 +247,7 @@ def solve_decomposed(
                 i, template, 0, partners, ModelCache(max_entries=2), guess, options.delta_initial
             )
         )
-    sweeps = _Sweeps(fleet, vehicles, options, callback)
+    sweeps = _Sweeps(fleet, vehicles, options, callback, progress)
     with _Helper(fleet, vehicles) if jobs > 1 and len(vehicles) > 1 else nullcontext() as helper:
         settled = sweeps.run(helper)
     return _fleet_result(
@@ -259,44 +263,58 @@ class _Sweeps:
     vehicles: list[_Vehicle]
     options: ProntoOptions
     callback: Callable[[ProntoIteration], None] | None
+    progress: ProgressReporter
     history: list[ProntoIteration] = field(default_factory=list)
     clock: int = 0
     stopped: bool = False
 
     def run(self, helper: _Helper | None) -> bool:
         """Sweep until one moves no vehicle (True) or :data:`MAX_SWEEPS` (False)."""
-        last_level = dataclasses.replace(self.options, eps_initial=self.options.eps_final)
         for sweep in range(MAX_SWEEPS + 1):
-            moved = False
-            done: set[int] = set()
-            for vehicle in self.vehicles:
-                where = _fleet_positions(self.fleet.layout, self.vehicles)
-                if vehicle.index in done or not (sweep == 0 or self._is_dirty(vehicle, where)):
-                    continue
-                pair = [vehicle]
-                if helper is not None:
-                    pair += self._independent(vehicle, where, done, sweep)[:1]
-                done.update(v.index for v in pair)
-                options = [
-                    self.options
-                    if sweep == 0
-                    else dataclasses.replace(last_level, delta_initial=v.delta)
-                    for v in pair
-                ]
-                if len(pair) == 2:
-                    assert helper is not None
-                    helper.submit(pair[1], where, options[1])
-                solved = [_solve_vehicle(self.fleet, vehicle, where, options[0])]
-                if len(pair) == 2:
-                    assert helper is not None
-                    solved.append(helper.result())
-                moved |= self._keep(pair, solved)
-                if self.stopped:
-                    return False
+            with self.progress(f"sweep {sweep + 1}", total=len(self.vehicles)) as advance:
+                moved = self._sweep(sweep, helper, advance)
             logger.info("decomposed sweep %d: %s", sweep, "moved" if moved else "settled")
+            if self.stopped:
+                return False
             if sweep > 0 and not moved:
                 return True
         return False
+
+    def _sweep(self, sweep: int, helper: _Helper | None, advance: Callable[[str], None]) -> bool:
+        """One sweep over the vehicles due; whether one moved."""
+        last_level = dataclasses.replace(self.options, eps_initial=self.options.eps_final)
+        moved = False
+        done: set[int] = set()
+        for vehicle in self.vehicles:
+            where = _fleet_positions(self.fleet.layout, self.vehicles)
+            if vehicle.index in done:
+                continue
+            if not (sweep == 0 or self._is_dirty(vehicle, where)):
+                advance(f"{self.fleet.layout.names[vehicle.index]} (no neighbour moved)")
+                continue
+            pair = [vehicle]
+            if helper is not None:
+                pair += self._independent(vehicle, where, done, sweep)[:1]
+            done.update(v.index for v in pair)
+            options = [
+                self.options
+                if sweep == 0
+                else dataclasses.replace(last_level, delta_initial=v.delta)
+                for v in pair
+            ]
+            if len(pair) == 2:
+                assert helper is not None
+                helper.submit(pair[1], where, options[1])
+            solved = [_solve_vehicle(self.fleet, vehicle, where, options[0])]
+            if len(pair) == 2:
+                assert helper is not None
+                solved.append(helper.result())
+            moved |= self._keep(pair, solved)
+            for solved_vehicle in pair:
+                advance(self.fleet.layout.names[solved_vehicle.index])
+            if self.stopped:
+                return moved
+        return moved
 
     def _keep(
         self, pair: list[_Vehicle], solved: list[tuple[ProntoResult, frozenset[int], int]]

@@ -166,8 +166,9 @@ def run_mission(
 
     def optimize(terrain_weight: float) -> OptimizedPlan:
         return run_optimization(
-            config, layout, preplan, deconfliction, terrain_weight, callback=callback, jobs=jobs
-        )
+            config, layout, preplan, deconfliction, terrain_weight,
+            callback=callback, jobs=jobs, progress=progress,
+        )  # fmt: skip
 
     if before_optimization is not None:
         before_optimization()
@@ -259,6 +260,7 @@ def run_optimization(
     callback: Callable[[Any], None] | None = None,
     warm_start: WarmStart | None = None,
     jobs: int = 1,
+    progress: ProgressReporter = no_progress,
 ) -> OptimizedPlan:
     """Stage 3: PRONTO with barrier continuation from the projected desired trajectories.
 
@@ -269,7 +271,7 @@ def run_optimization(
     the last level its iterates hug the constraint it crossed (``δ`` shrank to 2e-9, 12
     iterations against 8, ``benchmarks/bench_replan.py``). ``config.solver.fleet`` chooses
     the coupled solve or the vehicle-by-vehicle one (:mod:`auvplan.mission.decomposition`,
-    with ``jobs`` processes).
+    with ``jobs`` processes, its sweeps told to ``progress``).
     """
     decomposed = config.solver.decomposes(layout.n_vehicles)
     assembled = assemble_problem(
@@ -286,7 +288,9 @@ def run_optimization(
             options, eps_initial=levels[-min(2, len(levels))], delta_initial=delta
         )
     if decomposed:
-        result = solve_decomposed(assembled, preplan, options, callback=callback, jobs=jobs)
+        result = solve_decomposed(
+            assembled, preplan, options, callback=callback, jobs=jobs, progress=progress
+        )
     else:
         result = solve_pronto(
             assembled.problem, assembled.guess, options=options, callback=callback
