@@ -12,6 +12,7 @@ or figures. Target: the replan within 25 % of the plan from scratch. Run as a sc
 
     nice .venv/bin/python benchmarks/bench_replan.py           # 4 MEDUSAs x 1 h at 30 min
     nice .venv/bin/python benchmarks/bench_replan.py --quick   # 4 MEDUSAs x 10 min at 5 min
+    nice .venv/bin/python benchmarks/bench_replan.py --fleet16 # 16 MEDUSAs x 1 h, decomposed
 
 It prints one JSON line per measurement and a summary table of wall and CPU (process, all
 threads) seconds; on a loaded shared machine the CPU ratio is the steadier one.
@@ -32,7 +33,11 @@ import auvplan
 from _fleet import lane_mission  # the script's folder is on sys.path
 
 #: The missions (vehicles, horizon [s], dt [s]) and their replanning times [s].
-CASES = {"full": ((4, 3600.0, 1.0), 1800.0), "quick": ((4, 600.0, 1.0), 300.0)}
+CASES = {
+    "full": ((4, 3600.0, 1.0), 1800.0),
+    "quick": ((4, 600.0, 1.0), 300.0),
+    "fleet16": ((16, 3600.0, 1.0), 1800.0),
+}
 #: The vehicle moved and by how much (north, east) [m].
 MOVED = ("v0", 0.0, 30.0)
 TARGET = 0.25
@@ -115,6 +120,7 @@ def report(case: tuple[int, float, float], at: float, records: list[dict[str, An
 
 
 if __name__ == "__main__":
-    case, at = CASES["quick" if "--quick" in sys.argv[1:] else "full"]
+    flags = [arg.removeprefix("--") for arg in sys.argv[1:]]
+    case, at = CASES[next((flag for flag in flags if flag in CASES), "full")]
     with tempfile.TemporaryDirectory() as work:
         report(case, at, measure(case, at, Path(work)))
