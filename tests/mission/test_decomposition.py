@@ -90,6 +90,7 @@ def test_the_decomposed_plan_reaches_the_coupled_optimum(
         assert plan.result.status is ProntoStatus.CONVERGED
         assert plan.verdict.success, plan.verdict.message  # every constraint between samples
     assert decomposed.result.message.startswith("converged vehicle by vehicle")
+    assert (coupled.fleet_solve, decomposed.fleet_solve) == ("coupled", "decomposed")
     # each vehicle optimal given the others: the same optimum as Newton on the whole fleet,
     # to the relative accuracy the sweeps stop at (the coupled optimum is 46,195.8 J)
     objective = {

@@ -55,7 +55,9 @@ class OptimizedPlan:
     ``depth_m``; :mod:`auvplan.mission.depth_profile`). ``verdict`` says whether every
     constraint holds between samples (:func:`auvplan.mission.checks.judge_plan`). ``costs`` is
     the objective by named term and ``constraint_slack[block][pair]`` the smallest value of
-    each constraint row at the solver nodes (:mod:`auvplan.mission.costs`).
+    each constraint row at the solver nodes (:mod:`auvplan.mission.costs`). ``fleet_solve``
+    says how stage 3 solved the fleet: ``"coupled"`` or ``"decomposed"``
+    (:mod:`auvplan.mission.decomposition`).
     """
 
     result: ProntoResult
@@ -75,6 +77,7 @@ class OptimizedPlan:
     verdict: PlanVerdict
     costs: CostBreakdown
     constraint_slack: dict[str, dict[str, float]]
+    fleet_solve: str = "coupled"
 
 
 def evaluate_plan(
@@ -86,11 +89,13 @@ def evaluate_plan(
     functions: FleetProblemFunctions,
     result: ProntoResult,
     terrain_weight: float,
+    fleet_solve: str = "coupled",
 ) -> OptimizedPlan:
     """Energy, information, arrival error and sampled-and-between separations of a result.
 
     ``time`` is the solver grid of control interval ``dt`` [s]; ``problem`` and ``functions``
-    the solved fleet problem (for the cost terms and constraint slacks).
+    the solved fleet problem (for the cost terms and constraint slacks); ``fleet_solve`` how
+    it was solved (:attr:`OptimizedPlan.fleet_solve`).
     """
     layout = functions.layout
     models = layout.models
@@ -163,6 +168,7 @@ def evaluate_plan(
             BatteryUse(time, used, tuple(model.vehicle.battery_capacity for model in models)),
             profiles,
         ),
+        fleet_solve=fleet_solve,
     )
 
 

@@ -311,4 +311,5 @@ def run_optimization(
         assembled.functions,
         result,
         terrain_weight,
+        fleet_solve="decomposed" if decomposed else "coupled",
     )

@@ -77,6 +77,7 @@ def _plan_summary(
         "violations": [dataclasses.asdict(violation) for violation in plan.verdict.violations],
         "status": result.status.name,
         "message": result.message,
+        "fleet_solve": plan.fleet_solve,
         "n_iter": result.n_iter,
         "cost": result.cost,
         "history": [_record(record) for record in result.history],

@@ -145,6 +145,8 @@ class PlanOutcome(_Entry):
     """A plan's record (``optimization``, ``energy_only``, ``paper``): status and figures.
 
     A plan whose optimiser failed has only ``plan_status`` (``"FAILED"``) and ``verdict``.
+    ``fleet_solve`` is ``"coupled"`` or ``"decomposed"`` (``solver.fleet``; None in folders
+    written before it was recorded).
     """
 
     terrain_weight: float | None = None
@@ -153,6 +155,7 @@ class PlanOutcome(_Entry):
     violations: list[Any] | None = None
     status: str | None = None
     message: str | None = None
+    fleet_solve: str | None = None
     n_iter: int | None = None
     cost: float | None = None
     history: list[Any] | None = None
