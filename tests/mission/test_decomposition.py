@@ -217,3 +217,14 @@ def test_auto_decomposes_from_eight_vehicles_and_the_memory_check_follows() -> N
     with pytest.raises(InputError, match="GiB"):
         check_optimizer_memory(fleet, 3600)  # 32 coupled MEDUSAs x 1 h at 1 s: ~47 GiB
     check_optimizer_memory(fleet, 3600, decomposed=True)  # one vehicle at a time
+
+
+def test_a_vehicle_whose_problem_fails_names_itself_in_the_fleet_status() -> None:
+    config = _config(GROUPS, "decomposed")
+    assembled, preplan = _assembled(config, pipeline.run_mission(config, stage=Stage.DECONFLICT))
+    options = dataclasses.replace(config.solver.pronto_options(), max_iter=2)
+    result = solve_decomposed(assembled, preplan, options)
+    assert result.status is ProntoStatus.MAX_ITER
+    assert result.message == "a: reached max_iter = 2"
+    assert result.min_slack > 0.0  # the best plan, whole and flyable: every vehicle projected
+    np.testing.assert_array_equal(result.trajectory.states[0], assembled.problem.initial_state)
