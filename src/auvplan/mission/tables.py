@@ -517,6 +517,9 @@ class SolverConfig(TableModel):
     approximation) or ``"full"``. ``kernels`` evaluates each vehicle's stage derivatives with
     compiled kernels (numba, built once per vehicle model and cached on disk); without them
     ``compile`` C-compiles the stacked CasADi functions (cached on disk, needs a C compiler).
+    ``fleet`` solves the fleet ``"coupled"`` (Newton on all vehicles at once),
+    ``"decomposed"`` (vehicle by vehicle, :mod:`auvplan.mission.decomposition`) or ``"auto"``
+    (decomposed from :data:`DECOMPOSED_FROM` vehicles).
     """
 
     dt: Number = Field(
