@@ -26,34 +26,32 @@ from auvplan.mission.pipeline import Stage
 from auvplan.mission.preplan import PreplanStage
 from auvplan.optimization import ProntoStatus, Trajectory
 
-CROSSING = """
-[terrain]
-synthetic = true
-[fleet]
-horizon_s = 240.0
-safety_radius_m = 5.0
-[[vehicle]]
-name = "a"
-start = { north = 150.0, east = 400.0, heading_deg = 0.0, speed = 0.5 }
-goal = { north = 250.0, east = 400.0, heading_deg = 0.0 }
-[[vehicle]]
-name = "b"
-start = { north = 200.0, east = 350.0, heading_deg = 90.0, speed = 0.5 }
-goal = { north = 200.0, east = 450.0, heading_deg = 90.0 }
-[[vehicle]]
-name = "c"
-start = { north = 150.0, east = 420.0, heading_deg = 0.0, speed = 0.5 }
-goal = { north = 250.0, east = 420.0, heading_deg = 0.0 }
-[[vehicle]]
-name = "d"
-start = { north = 220.0, east = 350.0, heading_deg = 90.0, speed = 0.5 }
-goal = { north = 220.0, east = 450.0, heading_deg = 90.0 }
-[[comm]]
-pair = ["a", "d"]
-max_range_m = 90.0
-[solver]
-dt_s = 1.0
-"""
+
+def _mission(
+    horizon_s: float, length: float, lanes: list[tuple[str, float, float, float]], extra: str = ""
+) -> str:
+    """A mission of MEDUSAs on straight lanes: ``(name, north, east, heading_deg)`` starts at
+    0.5 m/s, each going ``length`` [m] along its heading; ``extra`` TOML after them."""
+    vehicles = "".join(
+        f'[[vehicle]]\nname = "{name}"\n'
+        f"start = {{ north = {north}, east = {east}, heading_deg = {heading}, speed = 0.5 }}\n"
+        f"goal = {{ north = {north + length * np.cos(np.radians(heading)):g}, "
+        f"east = {east + length * np.sin(np.radians(heading)):g}, heading_deg = {heading} }}\n"
+        for name, north, east, heading in lanes
+    )
+    return (
+        f"[terrain]\nsynthetic = true\n[fleet]\nhorizon_s = {horizon_s}\n"
+        f"safety_radius_m = 5.0\n{vehicles}{extra}[solver]\ndt_s = 1.0\n"
+    )
+
+
+CROSSING = _mission(
+    240.0,
+    100.0,
+    [("a", 150.0, 400.0, 0.0), ("b", 200.0, 350.0, 90.0), ("c", 150.0, 420.0, 0.0),
+     ("d", 220.0, 350.0, 90.0)],
+    '[[comm]]\npair = ["a", "d"]\nmax_range_m = 90.0\n',
+)  # fmt: skip
 
 
 def _config(text: str, fleet: str) -> MissionConfig:
@@ -125,40 +123,27 @@ def test_the_decomposed_plan_is_a_fixed_point_of_its_sweeps(
     np.testing.assert_array_equal(again.trajectory.states, solved.trajectory.states)
 
 
-GROUPS = """
-[terrain]
-synthetic = true
-[fleet]
-horizon_s = 200.0
-safety_radius_m = 5.0
-[[vehicle]]
-name = "a"
-start = { north = 150.0, east = 100.0, heading_deg = 0.0, speed = 0.5 }
-goal = { north = 230.0, east = 100.0, heading_deg = 0.0 }
-[[vehicle]]
-name = "b"
-start = { north = 190.0, east = 60.0, heading_deg = 90.0, speed = 0.5 }
-goal = { north = 190.0, east = 140.0, heading_deg = 90.0 }
-[[vehicle]]
-name = "c"
-start = { north = 150.0, east = 600.0, heading_deg = 0.0, speed = 0.5 }
-goal = { north = 230.0, east = 600.0, heading_deg = 0.0 }
-[[vehicle]]
-name = "d"
-start = { north = 190.0, east = 560.0, heading_deg = 90.0, speed = 0.5 }
-goal = { north = 190.0, east = 640.0, heading_deg = 90.0 }
-[solver]
-dt_s = 1.0
-"""
+GROUPS = _mission(
+    200.0,
+    80.0,
+    [("a", 150.0, 100.0, 0.0), ("b", 190.0, 60.0, 90.0), ("c", 150.0, 600.0, 0.0),
+     ("d", 190.0, 560.0, 90.0)],
+)  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def groups() -> tuple[MissionConfig, AssembledProblem, PreplanStage]:
+    """Two crossings 500 m apart, through stage 2, and their stage-3 problem."""
+    config = _config(GROUPS, "decomposed")
+    return (config, *_assembled(config, pipeline.run_mission(config, stage=Stage.DECONFLICT)))
 
 
 def test_two_processes_solve_vehicles_that_share_no_term_side_by_side(
-    monkeypatch: pytest.MonkeyPatch,
+    groups: tuple[MissionConfig, AssembledProblem, PreplanStage], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Two crossings 500 m apart: the second process takes the far group's vehicles, and
     the plan is the one a single process makes, to the last bit."""
-    config = _config(GROUPS, "decomposed")
-    assembled, preplan = _assembled(config, pipeline.run_mission(config, stage=Stage.DECONFLICT))
+    config, assembled, preplan = groups
     options = config.solver.pronto_options()
     submitted: list[int] = []
     submit = _Helper.submit
@@ -178,9 +163,10 @@ def test_two_processes_solve_vehicles_that_share_no_term_side_by_side(
     assert one.cost == two.cost
 
 
-def test_a_stop_from_the_callback_ends_the_solve_with_max_iter() -> None:
-    config = _config(GROUPS, "decomposed")
-    assembled, preplan = _assembled(config, pipeline.run_mission(config, stage=Stage.DECONFLICT))
+def test_a_stop_from_the_callback_ends_the_solve_with_max_iter(
+    groups: tuple[MissionConfig, AssembledProblem, PreplanStage],
+) -> None:
+    config, assembled, preplan = groups
 
     def stop(_record: object) -> None:
         raise StopIteration
@@ -219,9 +205,10 @@ def test_auto_decomposes_from_eight_vehicles_and_the_memory_check_follows() -> N
     check_optimizer_memory(fleet, 3600, decomposed=True)  # one vehicle at a time
 
 
-def test_a_vehicle_whose_problem_fails_names_itself_in_the_fleet_status() -> None:
-    config = _config(GROUPS, "decomposed")
-    assembled, preplan = _assembled(config, pipeline.run_mission(config, stage=Stage.DECONFLICT))
+def test_a_vehicle_whose_problem_fails_names_itself_in_the_fleet_status(
+    groups: tuple[MissionConfig, AssembledProblem, PreplanStage],
+) -> None:
+    config, assembled, preplan = groups
     options = dataclasses.replace(config.solver.pronto_options(), max_iter=2)
     result = solve_decomposed(assembled, preplan, options)
     assert result.status is ProntoStatus.MAX_ITER

@@ -66,10 +66,11 @@ from auvplan.optimization import (
     ProntoStatus,
     Trajectory,
     TrajectoryProblem,
+    build_model,
     project_guess,
     solve_pronto,
 )
-from auvplan.optimization.stages import evaluate_cost
+from auvplan.optimization.pronto import final_result
 from auvplan.vehicle import positions
 
 __all__ = ["MAX_SWEEPS", "neighbour_reach", "solve_decomposed"]
@@ -108,7 +109,6 @@ class _Vehicle:
     cache: ModelCache
     trajectory: Trajectory
     delta: float
-    gains: FloatArray | None = None
     result: ProntoResult | None = None
     steps: int = 0
     solved_at: int = -1
@@ -156,18 +156,25 @@ class _Fleet:
             information_reward(own, self.preplan.maps, parts.reward_weight),
             initial_state=problem.initial_state[layout.state_slice(index)],
             dt=problem.dt,
-            stage_parameters=self.parameters(index, slots, [j for j, _ in partners], None),
+            stage_parameters=self.parameters(index, slots, [j for j, _ in partners]),
             n_substeps=problem.n_substeps,
         )
         return template, tuple(j for j, _ in partners)
 
     def parameters(
-        self, index: int, slots: int, partners: list[int], where: FloatArray | None
+        self,
+        index: int,
+        slots: int,
+        partners: list[int],
+        where: FloatArray | None = None,
+        nearest: tuple[IntArray, FloatArray] | None = None,
     ) -> FloatArray:
         """Vehicle ``index``'s stage parameters: its own, then ``slots`` neighbours, partners.
 
         ``where`` ``(n_vehicles, N + 1, 2)`` holds every vehicle's positions (None: all
-        slots parked). At each stage the slots hold the nearest others within the reach.
+        slots parked) and ``nearest`` their ranking around the vehicle
+        (:func:`_nearest_within`): at each stage the slots hold the nearest others within
+        the reach.
         """
         layout, has_current = self.layout, self.assembled.parts.has_current
         own = self.assembled.problem.parameters[
@@ -176,8 +183,8 @@ class _Fleet:
         desired = own[:, [layout.models[index].index(name) for name in ("north", "east")]]
         n_stages = own.shape[0]
         slotted = np.repeat((desired + PARKED)[:, None, :], slots, axis=1)
-        if where is not None and slots:
-            others, rank = _nearest_within(where, index, self.reach)
+        if where is not None and nearest is not None and slots:
+            others, rank = nearest
             stage, column = np.nonzero(rank < slots)
             slotted[stage, rank[stage, column].astype(np.int64)] = where[others[column], stage]
         ranged = (
@@ -195,12 +202,18 @@ def _nearest_within(where: FloatArray, index: int, reach: float) -> tuple[IntArr
 
     Returns ``others`` ``(n_others,)`` and ``rank`` ``(N, n_others)`` over the stages ``0..N-1``.
     """
-    n_stages = where.shape[1] - 1
-    others = np.array([j for j in range(where.shape[0]) if j != index], dtype=np.int64)
-    distance = np.linalg.norm(where[others, :n_stages] - where[index, :n_stages], axis=-1).T
+    others, distance = _distances(where, index)
     rank = np.argsort(np.argsort(distance, axis=1), axis=1).astype(np.float64)
     rank[distance > reach] = np.inf
     return others, rank
+
+
+def _distances(where: FloatArray, index: int) -> tuple[IntArray, FloatArray]:
+    """The others of ``index`` and their distances [m] from it ``(N, n_others)``, stages < N."""
+    n_stages = where.shape[1] - 1
+    others = np.array([j for j in range(where.shape[0]) if j != index], dtype=np.int64)
+    distance = np.linalg.norm(where[others, :n_stages] - where[index, :n_stages], axis=-1).T
+    return others, distance
 
 
 def _fleet_positions(layout: FleetLayout, vehicles: list[_Vehicle]) -> FloatArray:
@@ -286,32 +299,23 @@ class _Sweeps:
 
     def _sweep(self, sweep: int, helper: _Helper | None, advance: Callable[[str], None]) -> bool:
         """One sweep over the vehicles due; whether one moved."""
-        last_level = dataclasses.replace(self.options, eps_initial=self.options.eps_final)
         moved = False
         done: set[int] = set()
         for vehicle in self.vehicles:
-            where = _fleet_positions(self.fleet.layout, self.vehicles)
             if vehicle.index in done:
                 continue
+            where = _fleet_positions(self.fleet.layout, self.vehicles)
             if not (sweep == 0 or self._is_dirty(vehicle, where)):
                 advance(f"{self.fleet.layout.names[vehicle.index]} (no neighbour moved)")
                 continue
             pair = [vehicle]
-            if helper is not None:
-                pair += self._independent(vehicle, where, done, sweep)[:1]
+            partner = None if helper is None else self._independent(vehicle, where, done, sweep)
+            if helper is not None and partner is not None:
+                pair.append(partner)
+                helper.submit(partner, where, self._options(partner, sweep))
             done.update(v.index for v in pair)
-            options = [
-                self.options
-                if sweep == 0
-                else dataclasses.replace(last_level, delta_initial=v.delta)
-                for v in pair
-            ]
-            if len(pair) == 2:
-                assert helper is not None
-                helper.submit(pair[1], where, options[1])
-            solved = [_solve_vehicle(self.fleet, vehicle, where, options[0])]
-            if len(pair) == 2:
-                assert helper is not None
+            solved = [_solve_vehicle(self.fleet, vehicle, where, self._options(vehicle, sweep))]
+            if helper is not None and partner is not None:
                 solved.append(helper.result())
             moved |= self._keep(pair, solved)
             for solved_vehicle in pair:
@@ -319,6 +323,14 @@ class _Sweeps:
             if self.stopped:
                 return moved
         return moved
+
+    def _options(self, vehicle: _Vehicle, sweep: int) -> ProntoOptions:
+        """The first sweep's options, or the last barrier level from ``vehicle``'s ``δ``."""
+        if sweep == 0:
+            return self.options
+        return dataclasses.replace(
+            self.options, eps_initial=self.options.eps_final, delta_initial=vehicle.delta
+        )
 
     def _keep(
         self, pair: list[_Vehicle], solved: list[tuple[ProntoResult, frozenset[int], int]]
@@ -331,7 +343,6 @@ class _Sweeps:
             vehicle.steps += result.n_iter
             vehicle.trajectory = result.trajectory
             vehicle.delta = result.delta
-            vehicle.gains = result.regulator_gains
             vehicle.neighbours = neighbours
             vehicle.solved_at = self.clock - 1
             if result.n_iter > 0:
@@ -363,24 +374,27 @@ class _Sweeps:
 
     def _independent(
         self, vehicle: _Vehicle, where: FloatArray, done: set[int], sweep: int
-    ) -> list[_Vehicle]:
-        """The later vehicles due in this sweep that share no term with ``vehicle``."""
+    ) -> _Vehicle | None:
+        """The next vehicle due in this sweep that shares no term with ``vehicle`` (or None)."""
         near = _near(where, vehicle.index, self.fleet.reach) | vehicle.neighbours
         near |= set(vehicle.partners)
-        return [
-            other
-            for other in self.vehicles[vehicle.index + 1 :]
-            if other.index not in done
-            and other.index not in near
-            and vehicle.index not in other.partners
-            and (sweep == 0 or self._is_dirty(other, where))
-        ]
+        return next(
+            (
+                other
+                for other in self.vehicles[vehicle.index + 1 :]
+                if other.index not in done
+                and other.index not in near
+                and vehicle.index not in other.partners
+                and (sweep == 0 or self._is_dirty(other, where))
+            ),
+            None,
+        )
 
 
 def _near(where: FloatArray, index: int, reach: float) -> set[int]:
     """The vehicles within ``reach`` of vehicle ``index`` at some stage."""
-    others, rank = _nearest_within(where, index, reach)
-    return set(others[np.any(np.isfinite(rank), axis=0)].tolist())
+    others, distance = _distances(where, index)
+    return set(others[np.any(distance <= reach, axis=0)].tolist())
 
 
 def _solve_vehicle(
@@ -401,7 +415,7 @@ def _solve_vehicle(
         vehicle.template,
         initial_state=vehicle.template.initial_state,
         stage_parameters=fleet.parameters(
-            vehicle.index, vehicle.slots, list(vehicle.partners), where
+            vehicle.index, vehicle.slots, list(vehicle.partners), where, (others, rank)
         ),
         backend=options.backend,
     )
@@ -477,24 +491,24 @@ def _fleet_result(
     problem = assembled.problem
     gains = np.zeros((problem.n_steps, layout.n_u, layout.n_x))
     for v in vehicles:
-        if v.gains is None:  # stopped before its first solve: its guess on its dynamics
+        if v.result is None:  # stopped before its first solve: its guess on its dynamics
             model = v.cache.get(v.template, options.backend)
-            v.trajectory, v.gains = project_guess(model, v.trajectory, options)
-        gains[:, layout.input_slice(v.index), layout.state_slice(v.index)] = v.gains
+            v.trajectory, own_gains = project_guess(model, v.trajectory, options)
+        else:
+            own_gains = v.result.regulator_gains
+        gains[:, layout.input_slice(v.index), layout.state_slice(v.index)] = own_gains
     trajectory = Trajectory(
         layout.stack([v.trajectory.states for v in vehicles]),
         layout.stack([v.trajectory.inputs for v in vehicles]),
     )
-    delta = min(v.delta for v in vehicles)
-    epsilon = options.eps_final
-    model = ModelCache(max_entries=1).get(problem, options.backend)
-    cost, smallest = evaluate_cost(model, trajectory, epsilon, delta)
     steps = sum(v.steps for v in vehicles)
     failed = [
         v
         for v in vehicles
         if v.result is not None and v.result.status is not ProntoStatus.CONVERGED
     ]
+    status: ProntoStatus | None = None
+    message = f"converged vehicle by vehicle: {steps} steps"
     if failed:
         assert failed[0].result is not None
         status = failed[0].result.status
@@ -504,25 +518,8 @@ def _fleet_result(
     elif not settled:
         status = ProntoStatus.MAX_ITER
         message = f"vehicles still moving after {MAX_SWEEPS} sweeps"
-    elif model.has_constraints and not smallest > 0.0:
-        status = ProntoStatus.INFEASIBLE
-        message = f"converged but infeasible: smallest scaled slack {smallest:.3g}"
-    else:
-        status = ProntoStatus.CONVERGED
-        message = f"converged vehicle by vehicle: {steps} steps"
-    return ProntoResult(
-        trajectory=trajectory,
-        status=status,
-        message=message,
-        cost=cost.objective,
-        running_cost=cost.running,
-        terminal_cost=cost.terminal,
-        barrier_cost=cost.barrier,
-        n_iter=steps,
-        history=tuple(history),
-        regulator_gains=gains,
-        epsilon=epsilon if model.has_constraints else 0.0,
-        delta=delta if model.has_constraints else float("inf"),
-        min_slack=smallest,
-        wall_time=time.perf_counter() - start,
-    )
+    return final_result(
+        build_model(problem, options.backend), trajectory, gains, status=status,
+        message=message, epsilon=options.eps_final, delta=min(v.delta for v in vehicles),
+        n_iter=steps, history=tuple(history), options=options, start=start,
+    )  # fmt: skip

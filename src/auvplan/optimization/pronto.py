@@ -43,7 +43,7 @@ from auvplan.optimization.result import ProntoIteration, ProntoResult, ProntoSta
 from auvplan.optimization.stages import evaluate_cost, min_slack
 from auvplan.optimization.steps import compute_direction
 
-__all__ = ["check_guess", "solve_pronto"]
+__all__ = ["check_guess", "final_result", "solve_pronto"]
 
 logger = logging.getLogger(__name__)
 
@@ -276,7 +276,34 @@ def solve_pronto(
         trajectory, gains = project_guess(model, guess, options)
         state = _State(trajectory, gains, options.delta_initial)
         status, message, epsilon = _continuation(model, state, options, start, callback)
-        cost, smallest = evaluate_cost(model, state.trajectory, epsilon, state.delta)
+        return final_result(
+            model, state.trajectory, state.gains, status=status, message=message,
+            epsilon=epsilon, delta=state.delta, n_iter=state.n_iter,
+            history=tuple(state.history), options=options, start=start,
+        )  # fmt: skip
+
+
+def final_result(
+    model: ProntoModel,
+    trajectory: Trajectory,
+    gains: FloatArray,
+    *,
+    status: ProntoStatus | None,
+    message: str,
+    epsilon: float,
+    delta: float,
+    n_iter: int,
+    history: tuple[ProntoIteration, ...],
+    options: ProntoOptions,
+    start: float,
+) -> ProntoResult:
+    """The :class:`ProntoResult` of a solve that ended at ``trajectory`` (barrier ``ε``, ``δ``).
+
+    ``status`` None means converged: CONVERGED (with ``message``, or the stopping bound),
+    unless the smallest scaled slack is not positive (INFEASIBLE). An empty ``message`` of
+    another status gets that status's own. ``start`` is the solve's ``perf_counter`` start.
+    """
+    cost, smallest = evaluate_cost(model, trajectory, epsilon, delta)
     if status is None:
         if model.has_constraints and not smallest > 0.0:
             status = ProntoStatus.INFEASIBLE
@@ -284,7 +311,7 @@ def solve_pronto(
         else:
             status = ProntoStatus.CONVERGED
             bound = max(options.tol, options.rtol * abs(cost.objective))
-            message = f"converged: -Dh·ζ < {bound:.3g} after {state.n_iter} steps"
+            message = message or f"converged: -Dh·ζ < {bound:.3g} after {n_iter} steps"
     elif not message:
         message = {
             ProntoStatus.MAX_ITER: f"reached max_iter = {options.max_iter}",
@@ -295,18 +322,18 @@ def solve_pronto(
             ProntoStatus.CONVERGED: "converged",
         }[status]
     return ProntoResult(
-        trajectory=state.trajectory,
+        trajectory=trajectory,
         status=status,
         message=message,
         cost=cost.objective,
         running_cost=cost.running,
         terminal_cost=cost.terminal,
         barrier_cost=cost.barrier,
-        n_iter=state.n_iter,
-        history=tuple(state.history),
-        regulator_gains=state.gains,
+        n_iter=n_iter,
+        history=history,
+        regulator_gains=gains,
         epsilon=epsilon if model.has_constraints else 0.0,
-        delta=state.delta if model.has_constraints else float("inf"),
+        delta=delta if model.has_constraints else float("inf"),
         min_slack=smallest,
         wall_time=time.perf_counter() - start,
     )
