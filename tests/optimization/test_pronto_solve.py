@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from auvplan.optimization import (
+    PathConstraint,
     ProntoIteration,
     ProntoOptions,
     ProntoStatus,
@@ -20,6 +21,7 @@ from auvplan.optimization import (
     solve_ipopt,
     solve_pronto,
 )
+from auvplan.optimization import pronto
 from auvplan.optimization.reference import _objective_scale
 
 from ._problems import (
@@ -201,3 +203,28 @@ def test_fatrop_objective_scale_is_ipopts_gradient_rule() -> None:
     steep = 1000.0 * w[0] ** 2 + w[1]  # ∇f(1, 0) = (2000, 1)
     assert _objective_scale(steep, w, np.array([1.0, 0.0])) == pytest.approx(0.05)
     assert _objective_scale(w[0] ** 2, w, np.array([3.0, 0.0])) == 1.0
+
+
+def test_levels_the_barrier_does_not_move_are_skipped(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A bound far from active, which moves the optimum by less than the tolerance: after the
+    first level the solve goes to the last ε (visiting the levels between would take no
+    step) and ends where the full continuation ends; a tighter tolerance visits them all."""
+    x, u, p = ca.SX.sym("x", 4), ca.SX.sym("u", 2), ca.SX.sym("p", 0)
+    bound = ca.Function("turn", [x, u, p], [40.0 - u[0]])
+    problem = dataclasses.replace(
+        unicycle_problem(), constraints=(PathConstraint(bound, "plain", 40.0, "turn rate"),)
+    )
+    options = ProntoOptions(tol=1e-4, rtol=0.0)
+    skipped = solve_pronto(problem, zero_guess(problem), options=options)
+    monkeypatch.setattr(pronto, "SKIP_MARGIN", 1e-300)  # never predicted converged
+    full = solve_pronto(problem, zero_guess(problem), options=options)
+    assert skipped.status is full.status is ProntoStatus.CONVERGED
+    levels = ProntoOptions().epsilon_levels()
+    assert sorted({h.epsilon for h in full.history}) == sorted(levels)
+    assert sorted({h.epsilon for h in skipped.history}) == [levels[-1], levels[0]]
+    assert len(skipped.history) == len(full.history) - (len(levels) - 2)
+    assert skipped.cost == pytest.approx(full.cost, rel=1e-12)
+    np.testing.assert_array_equal(skipped.trajectory.states, full.trajectory.states)
+    monkeypatch.undo()
+    tight = solve_pronto(problem, zero_guess(problem), options=ProntoOptions(tol=1e-6))
+    assert sorted({h.epsilon for h in tight.history}) == sorted(levels)

@@ -13,6 +13,7 @@ import scipy.linalg
 from auvplan.optimization import (
     DirectionType,
     LqDirection,
+    PathConstraint,
     ProntoOptions,
     StageWeights,
     Trajectory,
@@ -32,6 +33,7 @@ from auvplan.optimization import (
     solve_pronto,
 )
 from auvplan.optimization.lq import quadratic_form
+from auvplan.optimization.steps import compute_direction, predicted_decrement
 
 from ._problems import (
     crossing_problem,
@@ -311,3 +313,42 @@ def test_converged() -> None:
     assert converged(1e-5, 1e2, 1e-6, 1e-6)  # relative bound 1e-4 above the absolute one
     assert not converged(1e-3, 1e2, 1e-6, 1e-6)
     assert not converged(1e-5, -1e-2, 1e-6, 1e-6)  # |h| scales the relative bound
+
+
+def test_linearization_at_another_barrier_weight_equals_linearizing_there(
+    rng: np.random.Generator,
+) -> None:
+    """Known answer: every barrier term is proportional to ε, the rest does not depend on it."""
+    problem = obstacle_problem()
+    model = build_model(problem)
+    xi, _ = project_guess(model, random_guess(problem, rng), ProntoOptions())
+    delta = 0.5
+    moved = linearize(model, xi, 1.0, delta).at_barrier_weight(1e-3)
+    direct = linearize(model, xi, 1e-3, delta)
+    assert direct.cost.barrier != 0.0
+    for name in ("a", "b", "m_x", "barrier_weight", "barrier_outer", "A", "B"):
+        np.testing.assert_allclose(
+            getattr(moved, name), getattr(direct, name), rtol=1e-12, atol=1e-14, err_msg=name
+        )
+    assert moved.cost.total == pytest.approx(direct.cost.total, rel=1e-12)
+    assert moved.epsilon == direct.epsilon
+
+
+def test_predicted_decrement_at_the_same_weight_is_the_directions() -> None:
+    """At its own ε the prediction is the direction's decrement; at another ε it has the exact
+    gradient (only the weights are the first ε's), so it is much closer to the exact decrement
+    there than the first ε's decrement is (a one-sided turn-rate bound, far from active)."""
+    x, u, p = ca.SX.sym("x", 4), ca.SX.sym("u", 2), ca.SX.sym("p", 0)
+    bound = ca.Function("turn", [x, u, p], [6.0 - u[0]])
+    problem = dataclasses.replace(
+        unicycle_problem(), constraints=(PathConstraint(bound, "plain", 6.0, "turn rate"),)
+    )
+    model = build_model(problem)
+    xi, _ = project_guess(model, zero_guess(problem), ProntoOptions())
+    local, direction = compute_direction(model, xi, 1.0, 0.5)
+    same, _ = predicted_decrement(model, local, 1.0)
+    assert same == pytest.approx(-direction.slope, rel=1e-12)
+    predicted, cost = predicted_decrement(model, local, 1e-4)
+    exact_local, exact = compute_direction(model, xi, 1e-4, 0.5)
+    assert cost == pytest.approx(exact_local.linearization.cost.total, rel=1e-12)
+    assert abs(predicted + exact.slope) < 0.25 * abs(same + exact.slope)

@@ -10,6 +10,7 @@ The solver loop is written as named, individually testable steps (STYLE B2)::
             if converged(−Dh·ζ): break                   # stopping criterion
             ξ = armijo_step(ξ, ζ, K)                     # try_step(γ) = h(P(ξ + γζ)), K fixed
             shrink δ once strictly feasible
+        skip to the last ε if ξ is predicted converged there (one LQ solve)
 
 Equations and defaults follow ``reference/pronto.md`` §6 (discrete PRONTO), §7 (barrier) and
 §11. The discrete problem is stated in :mod:`auvplan.optimization.problem`.
@@ -41,7 +42,7 @@ from auvplan.optimization.problem import Trajectory, TrajectoryProblem
 from auvplan.optimization.projection import project_guess
 from auvplan.optimization.result import ProntoIteration, ProntoResult, ProntoStatus
 from auvplan.optimization.stages import evaluate_cost, min_slack
-from auvplan.optimization.steps import compute_direction
+from auvplan.optimization.steps import LocalModel, compute_direction, predicted_decrement
 
 __all__ = ["check_guess", "final_result", "solve_pronto"]
 
@@ -78,6 +79,8 @@ class _State:
     delta: float
     n_iter: int = 0
     history: list[ProntoIteration] = field(default_factory=list)
+    local: LocalModel | None = None
+    """The model of the last direction (at ``trajectory`` when a level has converged)."""
 
 
 def _iterate_level(
@@ -101,6 +104,7 @@ def _iterate_level(
         )
         lin = local.linearization
         state.gains = local.gains
+        state.local = local
         decrement = -direction.slope
         current = lin.cost.total
         is_done = converged(decrement, current, *tol)
@@ -177,6 +181,33 @@ def infeasible_restart_delta(delta: float, smallest: float) -> float:
     return min(0.5 * delta, delta**2 / (violation + 2.0 * delta))
 
 
+#: The predicted decrement at the last barrier level must be below this share of its tolerance
+#: for the levels between to be skipped (the prediction keeps the current level's weights).
+SKIP_MARGIN = 0.5
+
+
+def _next_level(
+    model: ProntoModel, state: _State, levels: tuple[float, ...], index: int,
+    options: ProntoOptions,
+) -> int:  # fmt: skip
+    """The level after ``levels[index]``, which ``state.trajectory`` has just solved.
+
+    The last level when the trajectory is predicted to pass its stopping test already
+    (:func:`predicted_decrement` below ``SKIP_MARGIN`` of the tolerance): the levels between
+    would only confirm, each with a full direction, that the barrier does not move it. The
+    last level's own test then decides, with an exact direction, as before.
+    """
+    last = len(levels) - 1
+    local = state.local
+    if index + 1 >= last or local is None or local.trajectory is not state.trajectory:
+        return index + 1
+    decrement, cost = predicted_decrement(model, local, levels[last], options=options)
+    if converged(decrement / SKIP_MARGIN, cost, options.tol, options.rtol):
+        logger.info("level eps=%.1e: predicted converged at eps=%.1e", levels[index], levels[last])
+        return last
+    return index + 1
+
+
 def _continuation(
     model: ProntoModel,
     state: _State,
@@ -186,9 +217,10 @@ def _continuation(
 ) -> tuple[ProntoStatus | None, str, float]:
     """Run the barrier levels; return the status (``None``: converged), message and last ``ε``."""
     levels = options.epsilon_levels() if model.has_constraints else (0.0,)
-    epsilon = levels[0]
+    index, epsilon = 0, levels[0]
     try:
-        for index, epsilon in enumerate(levels):
+        while index < len(levels):
+            epsilon = levels[index]
             last = index == len(levels) - 1
             tol = (options.tol, options.rtol) if last else (options.inner_tol, options.inner_rtol)
             restarts = 0
@@ -212,6 +244,7 @@ def _continuation(
                 )
             if status is not None:
                 return status, "", epsilon
+            index = _next_level(model, state, levels, index, options)
     except StopIteration:
         return ProntoStatus.MAX_ITER, "stopped by the callback", epsilon
     except SolverError as error:  # no descent direction from any model of the ladder

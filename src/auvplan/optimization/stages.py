@@ -7,6 +7,7 @@ recursion (numba, :mod:`auvplan.optimization._kernels`). Equations: ``reference/
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -176,6 +177,25 @@ class Linearization:
     barrier_outer: FloatArray
     barrier_weight: FloatArray
     constraint_jacobians: SparseJacobians | None
+
+    def at_barrier_weight(self, epsilon: float) -> Linearization:
+        """The same trajectory's linearisation at barrier weight ``epsilon`` (exact).
+
+        Every barrier term is proportional to ``ε``: with ``ρ = epsilon / self.epsilon`` the
+        gradients become ``a + (ρ − 1) ε dt Σ_j b'_j c_{x,j} / scale_j`` (likewise ``b`` and
+        ``m_x``), the barrier cost and weights ``ρ`` times theirs; ``A``, ``B`` stay.
+        """
+        if self.constraint_jacobians is None or epsilon == self.epsilon:
+            return dataclasses.replace(self, epsilon=epsilon)
+        ratio = epsilon / self.epsilon
+        shift = (ratio - 1.0) * self.constraint_jacobians.weighted_sum(self.barrier_weight)
+        n_x = self.A.shape[1]
+        cost = CostParts(self.cost.running, self.cost.terminal, ratio * self.cost.barrier)
+        return dataclasses.replace(
+            self, a=self.a + shift[:-1, :n_x], b=self.b + shift[:-1, n_x:],
+            m_x=self.m_x + shift[-1, :n_x], cost=cost, epsilon=epsilon,
+            barrier_outer=ratio * self.barrier_outer, barrier_weight=ratio * self.barrier_weight,
+        )  # fmt: skip
 
 
 def linearize(

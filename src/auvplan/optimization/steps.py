@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from auvplan._typing import FloatArray
+from auvplan.errors import SolverError
 from auvplan.optimization.lq import LqDirection, solve_lq_direction
 from auvplan.optimization.model import ProntoModel
 from auvplan.optimization.options import FallbackModel, ProntoOptions
@@ -30,7 +31,13 @@ from auvplan.optimization.stages import (
     second_order_weights,
 )
 
-__all__ = ["LocalModel", "compute_direction", "local_model", "steepest_weights"]
+__all__ = [
+    "LocalModel",
+    "compute_direction",
+    "local_model",
+    "predicted_decrement",
+    "steepest_weights",
+]
 
 _DEFAULT_OPTIONS = ProntoOptions()
 
@@ -152,3 +159,33 @@ def compute_direction(
         groups=coordinate_groups(model.problem.blocks, model.problem.n_states),
     )
     return local, direction
+
+
+def predicted_decrement(
+    model: ProntoModel,
+    local: LocalModel,
+    epsilon: float,
+    *,
+    options: ProntoOptions = _DEFAULT_OPTIONS,
+) -> tuple[float, float]:
+    """``−Dh·ζ`` and ``h`` at the local model's trajectory for another barrier weight ``ε'``.
+
+    One LQ solve, no new Hessian: the gradients and the cost are exact at ``ε'``
+    (:meth:`Linearization.at_barrier_weight`); the weights stay those of ``local``. They
+    differ from the exact ``ε'`` weights by ``(ε' − ε)`` times the barrier's Hessian and by
+    the dynamics' curvature weighted with the barrier's part of the costate, both small
+    where the barrier hardly pulls on the trajectory, which is when the prediction is
+    used (:func:`~auvplan.optimization.pronto.solve_pronto`'s skipping of barrier levels).
+    ``inf`` when no model of the ladder gives a descent direction.
+    """
+    lin = local.linearization.at_barrier_weight(epsilon)
+    try:
+        direction = solve_lq_direction(
+            lin,
+            local.weights,
+            eigenvalue_floor=options.eigenvalue_floor,
+            groups=coordinate_groups(model.problem.blocks, model.problem.n_states),
+        )
+    except SolverError:
+        return float("inf"), lin.cost.total
+    return -direction.slope, lin.cost.total
