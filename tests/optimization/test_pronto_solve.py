@@ -17,11 +17,11 @@ from auvplan.optimization import (
     ProntoStatus,
     TrajectoryProblem,
     build_model,
+    pronto,
     solve_fatrop,
     solve_ipopt,
     solve_pronto,
 )
-from auvplan.optimization import pronto
 from auvplan.optimization.reference import _objective_scale
 
 from ._problems import (
