@@ -296,7 +296,8 @@ def solve_pronto(
     the smallest barrier argument once the trajectory is strictly feasible, after which
     infeasible line-search candidates are rejected. A level that ends infeasible is re-solved
     with ``δ`` reduced by :func:`infeasible_restart_delta` (at most
-    ``max_infeasible_restarts`` times).
+    ``max_infeasible_restarts`` times). After a level, the levels before the last are skipped
+    when the trajectory is predicted to pass the last level's test already (:func:`_next_level`).
     """
     options = options if options is not None else ProntoOptions()
     check_guess(problem, guess)
