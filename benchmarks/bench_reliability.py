@@ -155,12 +155,10 @@ def run_scenario(
 ) -> Row:
     """Write, plan and check one scenario (its routes' ``edge_model`` and its
     ``solver.fleet`` replaced if given)."""
-    if edge_model is not None:
-        planner = {**scenario.mission.get("planner", {}), "edge_model": edge_model}
-        scenario = dataclasses.replace(scenario, mission={**scenario.mission, "planner": planner})
-    if fleet is not None:
-        solver = {**scenario.mission.get("solver", {}), "fleet": fleet}
-        scenario = dataclasses.replace(scenario, mission={**scenario.mission, "solver": solver})
+    for table, key, value in (("planner", "edge_model", edge_model), ("solver", "fleet", fleet)):
+        if value is not None:
+            entries = {**scenario.mission.get(table, {}), key: value}
+            scenario = dataclasses.replace(scenario, mission={**scenario.mission, table: entries})
     folder = scenario_folder(root, scenario.seed)
     mission = scenario.write(folder)
     row = Row(

@@ -305,11 +305,14 @@ class _Sweeps:
             if vehicle.index in done:
                 continue
             where = _fleet_positions(self.fleet.layout, self.vehicles)
-            if not (sweep == 0 or self._is_dirty(vehicle, where)):
+            related = self._related(vehicle, where)
+            if not (sweep == 0 or self._is_dirty(vehicle, related)):
                 advance(f"{self.fleet.layout.names[vehicle.index]} (no neighbour moved)")
                 continue
             pair = [vehicle]
-            partner = None if helper is None else self._independent(vehicle, where, done, sweep)
+            partner = (
+                None if helper is None else self._independent(vehicle, related, where, done, sweep)
+            )
             if helper is not None and partner is not None:
                 pair.append(partner)
                 helper.submit(partner, where, self._options(partner, sweep))
@@ -366,26 +369,30 @@ class _Sweeps:
                         self.stopped = True
         return moved
 
-    def _is_dirty(self, vehicle: _Vehicle, where: FloatArray) -> bool:
-        """Whether a neighbour of ``vehicle`` (now or at its last solve) moved since then."""
-        relevant = _near(where, vehicle.index, self.fleet.reach) | vehicle.neighbours
-        relevant |= set(vehicle.partners)
-        return any(self.vehicles[j].moved_at > vehicle.solved_at for j in relevant)
+    def _related(self, vehicle: _Vehicle, where: FloatArray) -> set[int]:
+        """The vehicles whose plans enter ``vehicle``'s problem.
+
+        Those within reach of it now, its neighbours at its last solve, its comm partners.
+        """
+        near = _near(where, vehicle.index, self.fleet.reach)
+        return near | vehicle.neighbours | set(vehicle.partners)
+
+    def _is_dirty(self, vehicle: _Vehicle, related: set[int]) -> bool:
+        """Whether a ``related`` vehicle (:meth:`_related`) moved since ``vehicle``'s last solve."""
+        return any(self.vehicles[j].moved_at > vehicle.solved_at for j in related)
 
     def _independent(
-        self, vehicle: _Vehicle, where: FloatArray, done: set[int], sweep: int
+        self, vehicle: _Vehicle, related: set[int], where: FloatArray, done: set[int], sweep: int
     ) -> _Vehicle | None:
         """The next vehicle due in this sweep that shares no term with ``vehicle`` (or None)."""
-        near = _near(where, vehicle.index, self.fleet.reach) | vehicle.neighbours
-        near |= set(vehicle.partners)
         return next(
             (
                 other
                 for other in self.vehicles[vehicle.index + 1 :]
                 if other.index not in done
-                and other.index not in near
+                and other.index not in related
                 and vehicle.index not in other.partners
-                and (sweep == 0 or self._is_dirty(other, where))
+                and (sweep == 0 or self._is_dirty(other, self._related(other, where)))
             ),
             None,
         )
