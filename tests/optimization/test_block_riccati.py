@@ -49,7 +49,7 @@ def test_lq_sweep_with_blocks_equals_the_dense_sweep(rng: np.random.Generator) -
     args = (a, b, q, s, r, l_x, l_u, p_final, m_x)
     dense = _kernels.lq_backward(*args, np.array([[0, N_X]]), np.array([[0, N_U]]), 0.0)
     blocked = _kernels.lq_backward(*args, *block_ranges(_groups(), N_X, N_U), 0.0)
-    assert dense[2] == blocked[2] == -1
+    assert dense[3] == blocked[3] == -1
     np.testing.assert_allclose(blocked[0], dense[0], rtol=1e-11, atol=1e-12)
     np.testing.assert_allclose(blocked[1], dense[1], rtol=1e-11, atol=1e-12)
 
@@ -83,9 +83,22 @@ def test_lq_sweep_by_components_equals_the_dense_sweep(rng: np.random.Generator)
     args = (a, b, q, s, r, l_x, l_u, p_final, m_x)
     dense = _kernels.lq_backward(*args, np.array([[0, N_X]]), np.array([[0, N_U]]), 0.0)
     parts = _kernels.lq_backward(*args, *block_ranges(_groups(), N_X, N_U), 0.0)
-    assert dense[2] == parts[2] == -1
+    assert dense[3] == parts[3] == -1
     np.testing.assert_allclose(parts[0], dense[0], rtol=1e-10, atol=1e-12)
     np.testing.assert_allclose(parts[1], dense[1], rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(parts[2], dense[2], rtol=1e-10, atol=1e-12)  # M⁻¹
+    # another gradient through the stored factorisation: the sweep's own feed-forward for it
+    other_x, other_u, other_m = (
+        rng.normal(size=(N, N_X)),
+        rng.normal(size=(N, N_U)),
+        rng.normal(size=N_X),
+    )
+    again = _kernels.lq_backward(
+        a, b, q, s, r, other_x, other_u, p_final, other_m, *block_ranges(_groups(), N_X, N_U), 0.0
+    )
+    reused = _kernels.lq_feedforward(a, b, parts[0], parts[2], other_x, other_u, other_m)
+    np.testing.assert_allclose(reused, again[1], rtol=1e-9, atol=1e-11)
+    assert not np.allclose(reused, parts[1])
     # subsystems 0 and 1 are coupled up to the near pass, independent after it; 2 never
     inputs_0, states_1, states_2 = slice(0, 1), slice(3, 8), slice(8, 12)
     assert np.all(np.abs(dense[0][:26, inputs_0, states_1]) > 0.0)
@@ -138,7 +151,7 @@ def test_clipped_lq_sweep_is_the_sweep_of_the_projected_weights(rng: np.random.G
         return _kernels.lq_backward(*args, *blocks, floor)
 
     clipped, plain = sweep(w, 0.5), sweep(_projected(w, 0.5), 0.0)
-    assert clipped[2] == plain[2] == -1
+    assert clipped[3] == plain[3] == -1
     np.testing.assert_allclose(clipped[0], plain[0], rtol=1e-9, atol=1e-11)
     np.testing.assert_allclose(clipped[1], plain[1], rtol=1e-9, atol=1e-11)
-    assert sweep(w, 0.0)[2] >= 0  # unclipped, the sweep fails
+    assert sweep(w, 0.0)[3] >= 0  # unclipped, the sweep fails

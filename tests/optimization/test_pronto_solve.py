@@ -205,16 +205,23 @@ def test_fatrop_objective_scale_is_ipopts_gradient_rule() -> None:
     assert _objective_scale(w[0] ** 2, w, np.array([3.0, 0.0])) == 1.0
 
 
+def _far_bound_problem() -> TrajectoryProblem:
+    """The unicycle with a turn-rate bound far from active (it moves the optimum < 1e-4)."""
+    x, u, p = ca.SX.sym("x", 4), ca.SX.sym("u", 2), ca.SX.sym("p", 0)
+    bound = ca.Function("turn", [x, u, p], [40.0 - u[0]])
+    return dataclasses.replace(
+        unicycle_problem(), constraints=(PathConstraint(bound, "plain", 40.0, "turn rate"),)
+    )
+
+
 def test_levels_the_barrier_does_not_move_are_skipped(monkeypatch: pytest.MonkeyPatch) -> None:
     """A bound far from active, which moves the optimum by less than the tolerance: after the
     first level the solve goes to the last ε (visiting the levels between would take no
-    step) and ends where the full continuation ends; a tighter tolerance visits them all."""
-    x, u, p = ca.SX.sym("x", 4), ca.SX.sym("u", 2), ca.SX.sym("p", 0)
-    bound = ca.Function("turn", [x, u, p], [40.0 - u[0]])
-    problem = dataclasses.replace(
-        unicycle_problem(), constraints=(PathConstraint(bound, "plain", 40.0, "turn rate"),)
-    )
+    step) and ends where the full continuation ends; a tighter tolerance visits them all.
+    (Probes off: they would end the solve at the first level, see the next test.)"""
+    problem = _far_bound_problem()
     options = ProntoOptions(tol=1e-4, rtol=0.0)
+    monkeypatch.setattr(pronto, "_worth_probing", lambda *_: False)  # never probe
     skipped = solve_pronto(problem, zero_guess(problem), options=options)
     monkeypatch.setattr(pronto, "SKIP_MARGIN", 1e-300)  # never predicted converged
     full = solve_pronto(problem, zero_guess(problem), options=options)
@@ -228,3 +235,48 @@ def test_levels_the_barrier_does_not_move_are_skipped(monkeypatch: pytest.Monkey
     monkeypatch.undo()
     tight = solve_pronto(problem, zero_guess(problem), options=ProntoOptions(tol=1e-6))
     assert sorted({h.epsilon for h in tight.history}) == sorted(levels)
+
+
+def test_a_probe_at_the_last_level_replaces_the_level_ends(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """After two full Newton steps at the first level whose decrements predict the last
+    level's test to pass at the new point, that point is tested at the last ε first: the
+    solve ends there, at the trajectory the skipping continuation ends at (to the bit),
+    without the first level's own test and the prediction."""
+    problem = _far_bound_problem()
+    levels = ProntoOptions().epsilon_levels()
+    options = ProntoOptions(tol=1e-4, rtol=0.0)
+    probed = solve_pronto(problem, zero_guess(problem), options=options)
+    monkeypatch.setattr(pronto, "_worth_probing", lambda *_: False)
+    plain = solve_pronto(problem, zero_guess(problem), options=options)
+    assert probed.status is plain.status is ProntoStatus.CONVERGED
+    epsilons = [h.epsilon for h in probed.history]
+    assert epsilons == [levels[0]] * (len(epsilons) - 1) + [levels[-1]]
+    assert len(probed.history) == len(plain.history) - 1
+    np.testing.assert_array_equal(probed.trajectory.states, plain.trajectory.states)
+
+
+def test_a_failed_probe_leaves_the_iterates_alone(monkeypatch: pytest.MonkeyPatch) -> None:
+    """With a tolerance the last level's decrement at the first level's end (1.5e-5) does not
+    meet, the prediction makes no probe; a probe forced there fails, and the solve goes
+    on with the iterates of a solve without probes, its record between them, and makes no
+    further probe."""
+    problem = _far_bound_problem()
+    options = ProntoOptions(tol=1.2e-5, rtol=0.0)
+    predicted = solve_pronto(problem, zero_guess(problem), options=options)
+    monkeypatch.setattr(pronto, "_worth_probing", lambda *_: True)
+    forced = solve_pronto(problem, zero_guess(problem), options=options)
+    monkeypatch.setattr(pronto, "_worth_probing", lambda *_: False)
+    plain = solve_pronto(problem, zero_guess(problem), options=options)
+    assert predicted.status is forced.status is plain.status is ProntoStatus.CONVERGED
+    assert [h.cost for h in predicted.history] == [h.cost for h in plain.history]
+    history = forced.history
+    probes = [  # failed probes: records at the last ε followed by a larger ε
+        i for i in range(len(history) - 1) if history[i].epsilon < history[i + 1].epsilon
+    ]
+    assert len(probes) == 1
+    assert history[probes[0]].decrement >= options.tol
+    kept = [h for i, h in enumerate(history) if i not in probes]
+    assert [h.cost for h in kept] == [h.cost for h in plain.history]
+    np.testing.assert_array_equal(forced.trajectory.states, plain.trajectory.states)

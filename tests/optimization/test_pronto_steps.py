@@ -33,7 +33,8 @@ from auvplan.optimization import (
     solve_pronto,
 )
 from auvplan.optimization.lq import quadratic_form
-from auvplan.optimization.steps import compute_direction, predicted_decrement
+from auvplan.optimization.model import ProntoModel
+from auvplan.optimization.steps import LocalModel, compute_direction, predicted_decrement
 
 from ._problems import (
     crossing_problem,
@@ -334,10 +335,9 @@ def test_linearization_at_another_barrier_weight_equals_linearizing_there(
     assert moved.epsilon == direct.epsilon
 
 
-def test_predicted_decrement_at_the_same_weight_is_the_directions() -> None:
-    """At its own ε the prediction is the direction's decrement; at another ε it has the exact
-    gradient (only the weights are the first ε's), so it is much closer to the exact decrement
-    there than the first ε's decrement is (a one-sided turn-rate bound, far from active)."""
+def _turn_bound_start() -> tuple[ProntoModel, Trajectory, LocalModel, LqDirection]:
+    """The unicycle with a one-sided turn-rate bound far from active, its projected zero
+    guess, and the model and direction there at ε = 1."""
     x, u, p = ca.SX.sym("x", 4), ca.SX.sym("u", 2), ca.SX.sym("p", 0)
     bound = ca.Function("turn", [x, u, p], [6.0 - u[0]])
     problem = dataclasses.replace(
@@ -346,9 +346,35 @@ def test_predicted_decrement_at_the_same_weight_is_the_directions() -> None:
     model = build_model(problem)
     xi, _ = project_guess(model, zero_guess(problem), ProntoOptions())
     local, direction = compute_direction(model, xi, 1.0, 0.5)
-    same, _ = predicted_decrement(model, local, 1.0)
+    return model, xi, local, direction
+
+
+def test_predicted_decrement_at_the_same_weight_is_the_directions() -> None:
+    """At its own ε the prediction is the direction's decrement; at another ε it has the exact
+    gradient (only the weights are the first ε's), so it is much closer to the exact decrement
+    there than the first ε's decrement is (a one-sided turn-rate bound, far from active)."""
+    model, xi, local, direction = _turn_bound_start()
+    same, _ = predicted_decrement(local, direction, 1.0)
     assert same == pytest.approx(-direction.slope, rel=1e-12)
-    predicted, cost = predicted_decrement(model, local, 1e-4)
+    predicted, cost = predicted_decrement(local, direction, 1e-4)
     exact_local, exact = compute_direction(model, xi, 1e-4, 0.5)
     assert cost == pytest.approx(exact_local.linearization.cost.total, rel=1e-12)
     assert abs(predicted + exact.slope) < 0.25 * abs(same + exact.slope)
+
+
+def test_the_barrier_shift_decrement_is_quadratic_in_the_weight_change() -> None:
+    """``shift_only`` measures ``Δg = (ε'/ε − 1) ∇b`` alone: zero at the model's own ε,
+    ``(ε'/ε − 1)²`` times one fixed quadratic form elsewhere (so it is not the whole
+    gradient's decrement), and with ``g + Δg`` the full prediction at ``ε'`` obeys
+    ``√d(ε') ≤ √d(ε) + √shift`` (the triangle inequality of the model's norm)."""
+    _, _, local, direction = _turn_bound_start()
+    assert predicted_decrement(local, direction, 1.0, shift_only=True)[0] == pytest.approx(
+        0.0, abs=1e-14
+    )
+    small, _ = predicted_decrement(local, direction, 0.5, shift_only=True)
+    large, _ = predicted_decrement(local, direction, 1e-4, shift_only=True)
+    assert small > 0.0
+    assert large == pytest.approx(small * ((1e-4 - 1.0) / (0.5 - 1.0)) ** 2, rel=1e-9)
+    full, _ = predicted_decrement(local, direction, 1e-4)
+    assert full**0.5 <= (-direction.slope) ** 0.5 + large**0.5 + 1e-12
+    assert large != pytest.approx(full, rel=1e-3)

@@ -335,7 +335,7 @@ def lq_backward(
     x_blocks: IntArray,
     u_blocks: IntArray,
     floor: float,
-) -> tuple[FloatArray, FloatArray, int]:
+) -> tuple[FloatArray, FloatArray, FloatArray, int]:
     """Discrete Riccati with cross term for the LQ direction (§6.3), component by component.
 
     ``A_k`` and ``B_k`` are block-diagonal with the state and input ranges ``x_blocks``,
@@ -354,8 +354,9 @@ def lq_backward(
     sweep reaches them: the convexified model, without a clipped copy of the weights. The
     caller clips ``P_N``.
 
-    Returns the feedback ``K^o (N, n_u, n_x)``, feed-forward ``v^o (N, n_u)`` and the stage
-    index at which ``M_k = R_k + B_kᵀ P B_k`` failed the Cholesky test (``-1`` if none).
+    Returns the feedback ``K^o (N, n_u, n_x)``, feed-forward ``v^o (N, n_u)``, ``M_k⁻¹``
+    ``(N, n_u, n_u)`` (for other gradients: :func:`lq_feedforward`) and the stage index at
+    which ``M_k = R_k + B_kᵀ P B_k`` failed the Cholesky test (``-1`` if none).
     """
     n_stages, n_x, n_u = b_mat.shape
     n_blocks = x_blocks.shape[0]
@@ -363,6 +364,7 @@ def lq_backward(
     parent = np.arange(n_blocks)
     feedback = np.zeros((n_stages, n_u, n_x))
     feedforward = np.zeros((n_stages, n_u))
+    m_inverse = np.zeros((n_stages, n_u, n_u))
     p = p_final.copy()
     r = r_final.copy()
     _join_coupled(p, x_owner, x_owner, parent)
@@ -388,12 +390,14 @@ def lq_backward(
             m = r_c + _block_diagonal_transpose_times(b, pb, xb, ub)  # R + Bᵀ P B
             lower, is_pd = _cholesky(0.5 * (m + m.T))
             if not is_pd:
-                return feedback, feedforward, k
+                return feedback, feedforward, m_inverse, k
             g_mat = (s_c + _block_diagonal_transpose_times(a, pb, xb, xb)).T  # Sᵀ + (P B)ᵀ A
             g_vec = l_u[k][us] + b.T @ r[xs]
-            rhs = np.empty((us.size, xs.size + 1))
+            rhs = np.zeros((us.size, xs.size + 1 + us.size))
             rhs[:, : xs.size] = g_mat
             rhs[:, xs.size] = g_vec
+            for i in range(us.size):
+                rhs[i, xs.size + 1 + i] = 1.0
             sol = _cholesky_solve(lower, rhs)
             gain = sol[:, : xs.size].copy()
             p_new = q_c + _block_diagonal_transpose_times(a, pa, xb, xb) - g_mat.T @ gain
@@ -402,11 +406,39 @@ def lq_backward(
                 feedforward[k, us[i]] = -sol[i, xs.size]
                 for j in range(xs.size):
                     feedback[k, us[i], xs[j]] = gain[i, j]
+                for j in range(us.size):
+                    m_inverse[k, us[i], us[j]] = sol[i, xs.size + 1 + j]
             for i in range(xs.size):
                 r[xs[i]] = r_new[i]
                 for j in range(xs.size):
                     p[xs[i], xs[j]] = 0.5 * (p_new[i, j] + p_new[j, i])
-    return feedback, feedforward, -1
+    return feedback, feedforward, m_inverse, -1
+
+
+@numba.njit(cache=True)
+def lq_feedforward(
+    a_mat: FloatArray,
+    b_mat: FloatArray,
+    feedback: FloatArray,
+    m_inverse: FloatArray,
+    l_x: FloatArray,
+    l_u: FloatArray,
+    r_final: FloatArray,
+) -> FloatArray:
+    """Feed-forward ``v^o`` of :func:`lq_backward`'s factorised model for other gradients.
+
+    The gains ``K^o`` and ``M_k⁻¹`` do not depend on the gradients: with ``r_N = r_final``,
+    ``g_k = l_{u,k} + B_kᵀ r_{k+1}``, ``v^o_k = −M_k⁻¹ g_k`` and
+    ``r_k = l_{x,k} + A_kᵀ r_{k+1} − K^{oᵀ}_k g_k``: ``O(n_x² + n_x n_u)`` per stage.
+    """
+    n_stages, _, n_u = b_mat.shape
+    feedforward = np.zeros((n_stages, n_u))
+    r = r_final.copy()
+    for k in range(n_stages - 1, -1, -1):
+        g = l_u[k] + b_mat[k].T @ r
+        feedforward[k] = -(m_inverse[k] @ g)
+        r = l_x[k] + a_mat[k].T @ r - feedback[k].T @ g
+    return feedforward
 
 
 @numba.njit(cache=True)

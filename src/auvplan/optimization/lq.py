@@ -21,6 +21,7 @@ from auvplan.optimization.stages import Linearization, StageWeights
 __all__ = [
     "DirectionType",
     "LqDirection",
+    "LqFactor",
     "convexify",
     "directional_derivative",
     "quadratic_form",
@@ -82,12 +83,50 @@ class LqDirection:
         produced it).
     direction : DirectionType
         Ladder level used.
+    factor : LqFactor, optional
+        Its model's Riccati factorisation (:meth:`LqFactor.slope` for other gradients).
     """
 
     z: FloatArray
     v: FloatArray
     slope: float
     direction: DirectionType
+    factor: LqFactor | None = None
+
+
+@dataclass(frozen=True)
+class LqFactor:
+    """The Riccati factorisation of an LQ model: its solution for any gradients.
+
+    Attributes
+    ----------
+    A, B : ndarray
+        The linearisation's ``F_x (N, n_x, n_x)``, ``F_u (N, n_x, n_u)``.
+    feedback : ndarray of shape (N, n_u, n_x)
+        ``K^o``.
+    m_inverse : ndarray of shape (N, n_u, n_u)
+        ``M_k⁻¹ = (R_k + B_kᵀ P_{k+1} B_k)⁻¹``.
+    """
+
+    A: FloatArray
+    B: FloatArray
+    feedback: FloatArray
+    m_inverse: FloatArray
+
+    def slope(self, linearization: Linearization) -> float:
+        """``Dh·ζ`` of the model's minimiser ``ζ`` for the gradients of ``linearization``.
+
+        ``−Dh·ζ = gᵀ H⁻¹ g`` in the model's metric: a backward sweep for the feed-forward
+        (:func:`~auvplan.optimization._kernels.lq_feedforward`) and a forward pass, with no
+        factorisation.
+        """
+        lin = linearization
+        feedforward = _kernels.lq_feedforward(
+            self.A, self.B, self.feedback, self.m_inverse, lin.a, lin.b,
+            np.ascontiguousarray(lin.m_x),
+        )  # fmt: skip
+        z, v = _kernels.lq_forward(self.A, self.B, self.feedback, feedforward)
+        return directional_derivative(lin, z, v)
 
 
 def quadratic_form(weights: StageWeights, z: FloatArray, v: FloatArray) -> float:
@@ -142,7 +181,7 @@ def _try_direction(
 ) -> LqDirection | None:
     """The direction of one ladder level; with ``floor > 0`` every stage weight is clipped."""
     lin = linearization
-    feedback, feedforward, failed = _kernels.lq_backward(
+    feedback, feedforward, m_inverse, failed = _kernels.lq_backward(
         lin.A,
         lin.B,
         np.ascontiguousarray(weights.Q),
@@ -165,7 +204,7 @@ def _try_direction(
     if slope > 0.0:
         logger.debug("%s direction is not a descent direction (Dh·ζ = %g)", direction.value, slope)
         return None
-    return LqDirection(z, v, slope, direction)
+    return LqDirection(z, v, slope, direction, LqFactor(lin.A, lin.B, feedback, m_inverse))
 
 
 def solve_lq_direction(

@@ -5,8 +5,10 @@ The solver loop is written as named, individually testable steps (STYLE B2)::
     ξ ← project_guess(guess)                             # regulator designed along the guess
     for ε in ε-levels:                                   # barrier continuation (§7.5)
         repeat:
-            local, ζ = compute_direction(ξ)              # linearise, regulator K, costate λ,
-                                                         # Newton weights, LQ direction (ladder)
+            linearise, regulator K (reused at a new level's first point)
+            after a small full Newton step: done if ξ passes the last ε's test (a probe)
+            local, ζ = compute_direction(ξ)              # costate λ, Newton weights,
+                                                         # LQ direction (ladder)
             if converged(−Dh·ζ): break                   # stopping criterion
             ξ = armijo_step(ξ, ζ, K)                     # try_step(γ) = h(P(ξ + γζ)), K fixed
             shrink δ once strictly feasible
@@ -35,14 +37,21 @@ from threadpoolctl import threadpool_limits
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError, SolverError
 from auvplan.interrupts import checkpoint
-from auvplan.optimization.linesearch import armijo_step, converged
+from auvplan.optimization.linesearch import ArmijoResult, armijo_step, converged
+from auvplan.optimization.lq import DirectionType, LqDirection
 from auvplan.optimization.model import ModelCache, ProntoModel
 from auvplan.optimization.options import ProntoOptions
 from auvplan.optimization.problem import Trajectory, TrajectoryProblem
 from auvplan.optimization.projection import project_guess
 from auvplan.optimization.result import ProntoIteration, ProntoResult, ProntoStatus
 from auvplan.optimization.stages import evaluate_cost, min_slack
-from auvplan.optimization.steps import LocalModel, compute_direction, predicted_decrement
+from auvplan.optimization.steps import (
+    FirstOrder,
+    LocalModel,
+    compute_direction,
+    first_order_model,
+    predicted_decrement,
+)
 
 __all__ = ["check_guess", "final_result", "solve_pronto"]
 
@@ -81,6 +90,156 @@ class _State:
     history: list[ProntoIteration] = field(default_factory=list)
     local: LocalModel | None = None
     """The model of the last direction (at ``trajectory`` when a level has converged)."""
+    direction: LqDirection | None = None
+    """The last direction (of ``local``, with its model's factorisation)."""
+    probing: bool = True
+    """Whether new points of a level are first tested at the last barrier weight (:func:`_probe`);
+    off once a probe or a level's prediction (:func:`_next_level`) has failed."""
+    finished: bool = False
+    """The last level's stopping test has passed at a probe."""
+
+
+def _record(
+    state: _State,
+    local: LocalModel,
+    direction: LqDirection,
+    start: float,
+    callback: Callable[[ProntoIteration], None] | None,
+    result: ArmijoResult | None = None,
+) -> ProntoIteration:
+    """Append the record of a direction (``result``: its line search, if a step was tried)."""
+    lin = local.linearization
+    record = ProntoIteration(
+        iteration=len(state.history),
+        cost=lin.cost.total,
+        decrement=-direction.slope,
+        step=result.step if result is not None else 0.0,
+        direction=direction.direction,
+        epsilon=lin.epsilon,
+        delta=state.delta,
+        min_slack=lin.min_slack,
+        wall_time=time.perf_counter() - start,
+        n_backtracks=result.n_backtracks if result is not None else 0,
+    )
+    state.history.append(record)
+    logger.info(
+        "PRONTO it %3d  h=%.10g  -Dh.z=%.3e  gamma=%.3g  %s  eps=%.1e  delta=%.1e  slack=%.3g",
+        record.iteration,
+        record.cost,
+        record.decrement,
+        record.step,
+        record.direction.value,
+        record.epsilon,
+        state.delta,
+        record.min_slack,
+    )
+    if callback is not None:
+        callback(record)
+    checkpoint()  # a stop request (SIGINT/SIGTERM) between iterations
+    return record
+
+
+def _first_order(
+    model: ProntoModel, state: _State, epsilon: float, options: ProntoOptions
+) -> FirstOrder:
+    """The linearisation and regulator at the current trajectory.
+
+    At a new barrier level the trajectory is where the last direction was computed: its
+    linearisation is reused, shifted to the new ``ε`` (exact), unless ``δ`` has changed since.
+    """
+    local = state.local
+    if (
+        local is not None
+        and local.trajectory is state.trajectory
+        and local.linearization.delta == state.delta
+    ):
+        return local.first_order
+    return first_order_model(model, state.trajectory, epsilon, state.delta, options=options)
+
+
+#: The predicted decrement at the last barrier level must be below this share of its tolerance
+#: for the levels between to be skipped (the prediction keeps the current level's weights).
+SKIP_MARGIN = 0.5
+
+
+#: A level ends once its decrement is below this share of the next level's barrier shift.
+LEVEL_SHARE = 0.1
+
+
+def _outweighed(local: LocalModel, direction: LqDirection, epsilon: float) -> bool:
+    """Whether the next barrier level ``epsilon`` outweighs this level's remaining error.
+
+    Going to ``epsilon`` shifts the gradient by ``Δg = (ε'/ε − 1) ∇b``, and its decrement
+    ``s = Δgᵀ H⁻¹ Δg`` (:func:`predicted_decrement`, ``shift_only``) is about
+    what the next level starts with from this level's exact minimiser. From a point whose
+    decrement here is ``d``, it starts with at most ``(√d + √s)²``: with
+    ``d < LEVEL_SHARE · s`` that is at most 1.73 ``s``, and the Newton steps that would
+    reduce ``d`` further here are not taken (IPOPT likewise solves a barrier problem only to
+    a tolerance proportional to its barrier parameter).
+    """
+    shift, _ = predicted_decrement(local, direction, epsilon, shift_only=True)
+    return -direction.slope < LEVEL_SHARE * shift
+
+
+def _worth_probing(
+    local: LocalModel,
+    direction: LqDirection,
+    decrements: tuple[float, float],
+    epsilon: float,
+    options: ProntoOptions,
+) -> bool:
+    """Whether the point after a full Newton step is predicted to pass the last level's test.
+
+    ``decrements = (d_{k−1}, d_k)``: the level's decrements at the last two points,
+    ``local`` and ``direction`` the model and direction at the second. The level's decrement
+    at the new point is estimated as
+    ``d_k² / d_{k−1}`` (the contraction going on); the last level ``epsilon`` adds the
+    barrier's shift of the gradient, whose decrement is :func:`predicted_decrement`'s
+    (``shift_only``). Their sum of square roots, squared, must be below
+    ``SKIP_MARGIN`` of the last level's tolerance.
+    """
+    before, last = decrements
+    newton = last * last / before
+    cost = local.linearization.cost.total
+    if not converged(newton / SKIP_MARGIN, cost, options.tol, options.rtol):
+        return False
+    shift, _ = predicted_decrement(local, direction, epsilon, shift_only=True)
+    return converged((newton**0.5 + shift**0.5) ** 2 / SKIP_MARGIN, cost, options.tol, options.rtol)
+
+
+def _probe(
+    model: ProntoModel,
+    state: _State,
+    first_order: FirstOrder,
+    epsilon: float,
+    options: ProntoOptions,
+    start: float,
+    callback: Callable[[ProntoIteration], None] | None,
+) -> bool:
+    """Whether the current trajectory passes the last level's stopping test (at ``epsilon``).
+
+    One direction at the last barrier weight from the level's own linearisation (shifted,
+    exact): where the barrier does not move the minimiser, a level's converged point is
+    the last level's, and this test replaces the level's own test, the prediction of
+    :func:`_next_level` and the last level's test. A probe that fails turns probing off.
+    """
+    try:
+        local, direction = compute_direction(
+            model, state.trajectory, epsilon, state.delta, options=options,
+            first_order=first_order,
+        )  # fmt: skip
+    except SolverError:
+        state.probing = False
+        return False
+    record = _record(state, local, direction, start, callback)
+    if converged(record.decrement, record.cost, options.tol, options.rtol) and (
+        not model.has_constraints or record.min_slack > 0.0
+    ):
+        state.local, state.direction, state.gains = local, direction, local.gains
+        state.finished = True
+        return True
+    state.probing = False
+    return False
 
 
 def _iterate_level(
@@ -91,23 +250,39 @@ def _iterate_level(
     options: ProntoOptions,
     start: float,
     callback: Callable[[ProntoIteration], None] | None,
+    following: tuple[float, ...] = (),
 ) -> ProntoStatus | None:
     """Run PRONTO at one barrier weight until convergence; ``None`` means converged.
 
     ``tol = (absolute, relative)`` tolerances of the stopping test (:func:`converged`).
+    ``following``: the barrier weights of the levels after this one. The level also ends
+    when the next one would move the minimiser much further than this one's remaining
+    error (:func:`_outweighed`); new points are probed at the last one (:func:`_probe`),
+    and ``state.finished`` tells when a probe has passed.
     """
+    last_epsilon = following[-1] if following else None
+    probe = False
+    previous = None  # the decrement of the last step if it was a full Newton step
     while True:
         if len(state.history) >= options.max_iter:
             return ProntoStatus.MAX_ITER
+        first_order = _first_order(model, state, epsilon, options)
+        if probe and last_epsilon is not None and state.probing:
+            if _probe(model, state, first_order, last_epsilon, options, start, callback):
+                return None
+            if len(state.history) >= options.max_iter:
+                return ProntoStatus.MAX_ITER
         local, direction = compute_direction(
-            model, state.trajectory, epsilon, state.delta, options=options
-        )
+            model, state.trajectory, epsilon, state.delta, options=options,
+            first_order=first_order,
+        )  # fmt: skip
         lin = local.linearization
-        state.gains = local.gains
-        state.local = local
+        state.local, state.direction, state.gains = local, direction, local.gains
         decrement = -direction.slope
         current = lin.cost.total
-        is_done = converged(decrement, current, *tol)
+        is_done = converged(decrement, current, *tol) or (
+            bool(following) and _outweighed(local, direction, following[0])
+        )
         result = None
         if not is_done:
             result = armijo_step(
@@ -123,33 +298,7 @@ def _iterate_level(
                 max_backtracks=options.max_backtracks,
                 require_feasible=model.has_constraints and lin.min_argument > 0.0,
             )
-        record = ProntoIteration(
-            iteration=len(state.history),
-            cost=current,
-            decrement=decrement,
-            step=result.step if result is not None else 0.0,
-            direction=direction.direction,
-            epsilon=epsilon,
-            delta=state.delta,
-            min_slack=lin.min_slack,
-            wall_time=time.perf_counter() - start,
-            n_backtracks=result.n_backtracks if result is not None else 0,
-        )
-        state.history.append(record)
-        logger.info(
-            "PRONTO it %3d  h=%.10g  -Dh.z=%.3e  gamma=%.3g  %s  eps=%.1e  delta=%.1e  slack=%.3g",
-            record.iteration,
-            record.cost,
-            record.decrement,
-            record.step,
-            record.direction.value,
-            epsilon,
-            state.delta,
-            record.min_slack,
-        )
-        if callback is not None:
-            callback(record)
-        checkpoint()  # a stop request (SIGINT/SIGTERM) between iterations
+        _record(state, local, direction, start, callback, result)
         if is_done:
             return None
         assert result is not None
@@ -166,6 +315,15 @@ def _iterate_level(
                 options.delta_feasible_factor * result.min_argument,
                 options.delta_feasible_max,
             )
+        full_newton = result.step == 1.0 and direction.direction is DirectionType.NEWTON
+        probe = (
+            full_newton
+            and previous is not None
+            and last_epsilon is not None
+            and state.probing
+            and _worth_probing(local, direction, (previous, decrement), last_epsilon, options)
+        )
+        previous = decrement if full_newton else None
 
 
 def infeasible_restart_delta(delta: float, smallest: float) -> float:
@@ -181,15 +339,9 @@ def infeasible_restart_delta(delta: float, smallest: float) -> float:
     return min(0.5 * delta, delta**2 / (violation + 2.0 * delta))
 
 
-#: The predicted decrement at the last barrier level must be below this share of its tolerance
-#: for the levels between to be skipped (the prediction keeps the current level's weights).
-SKIP_MARGIN = 0.5
-
-
 def _next_level(
-    model: ProntoModel, state: _State, levels: tuple[float, ...], index: int,
-    options: ProntoOptions,
-) -> int:  # fmt: skip
+    state: _State, levels: tuple[float, ...], index: int, options: ProntoOptions
+) -> int:
     """The level after ``levels[index]``, which ``state.trajectory`` has just solved.
 
     The last level when the trajectory is predicted to pass its stopping test already
@@ -198,13 +350,19 @@ def _next_level(
     last level's own test then decides, with an exact direction, as before.
     """
     last = len(levels) - 1
-    local = state.local
-    if index + 1 >= last or local is None or local.trajectory is not state.trajectory:
+    local, direction = state.local, state.direction
+    if (
+        index + 1 >= last
+        or local is None
+        or direction is None
+        or local.trajectory is not state.trajectory
+    ):
         return index + 1
-    decrement, cost = predicted_decrement(model, local, levels[last], options=options)
+    decrement, cost = predicted_decrement(local, direction, levels[last])
     if converged(decrement / SKIP_MARGIN, cost, options.tol, options.rtol):
         logger.info("level eps=%.1e: predicted converged at eps=%.1e", levels[index], levels[last])
         return last
+    state.probing = False
     return index + 1
 
 
@@ -225,7 +383,11 @@ def _continuation(
             tol = (options.tol, options.rtol) if last else (options.inner_tol, options.inner_rtol)
             restarts = 0
             while True:
-                status = _iterate_level(model, state, epsilon, tol, options, start, callback)
+                status = _iterate_level(
+                    model, state, epsilon, tol, options, start, callback, levels[index + 1 :]
+                )
+                if state.finished:
+                    return None, "", levels[-1]
                 if status is not None or not model.has_constraints:
                     break
                 smallest = min_slack(model, state.trajectory)
@@ -244,7 +406,7 @@ def _continuation(
                 )
             if status is not None:
                 return status, "", epsilon
-            index = _next_level(model, state, levels, index, options)
+            index = _next_level(state, levels, index, options)
     except StopIteration:
         return ProntoStatus.MAX_ITER, "stopped by the callback", epsilon
     except SolverError as error:  # no descent direction from any model of the ladder

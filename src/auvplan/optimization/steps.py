@@ -9,13 +9,13 @@ routine that does this, for :func:`~auvplan.optimization.pronto.solve_pronto` an
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from dataclasses import dataclass
 
 import numpy as np
 
 from auvplan._typing import FloatArray
-from auvplan.errors import SolverError
 from auvplan.optimization.lq import LqDirection, solve_lq_direction
 from auvplan.optimization.model import ProntoModel
 from auvplan.optimization.options import FallbackModel, ProntoOptions
@@ -32,14 +32,35 @@ from auvplan.optimization.stages import (
 )
 
 __all__ = [
+    "FirstOrder",
     "LocalModel",
     "compute_direction",
+    "first_order_model",
     "local_model",
     "predicted_decrement",
     "steepest_weights",
 ]
 
 _DEFAULT_OPTIONS = ProntoOptions()
+
+
+@dataclass(frozen=True)
+class FirstOrder:
+    """The first-order part of a :class:`LocalModel`, shared by every barrier weight.
+
+    Attributes
+    ----------
+    trajectory : Trajectory
+        The expansion point ``ξ``.
+    linearization : Linearization
+        ``A, B, a, b, m_x`` and the cost parts at ``ξ`` (at its own ``ε``).
+    gains : ndarray of shape (N, n_u, n_x)
+        Projection regulator designed along ``ξ`` (it does not depend on ``ε``).
+    """
+
+    trajectory: Trajectory
+    linearization: Linearization
+    gains: FloatArray
 
 
 @dataclass(frozen=True)
@@ -66,6 +87,24 @@ class LocalModel:
     costate: FloatArray
     weights: StageWeights
 
+    @property
+    def first_order(self) -> FirstOrder:
+        """Its linearisation and regulator (for the same trajectory at another ``ε``)."""
+        return FirstOrder(self.trajectory, self.linearization, self.gains)
+
+
+def first_order_model(
+    model: ProntoModel,
+    trajectory: Trajectory,
+    epsilon: float,
+    delta: float,
+    *,
+    options: ProntoOptions = _DEFAULT_OPTIONS,
+) -> FirstOrder:
+    """Linearisation and projection regulator at ``trajectory`` (barrier ``ε``, ``δ``)."""
+    lin = linearize(model, trajectory, epsilon, delta)
+    return FirstOrder(trajectory, lin, regulator_gains(model, trajectory, lin.A, lin.B, options))
+
 
 def local_model(
     model: ProntoModel,
@@ -74,6 +113,7 @@ def local_model(
     delta: float,
     *,
     options: ProntoOptions = _DEFAULT_OPTIONS,
+    first_order: FirstOrder | None = None,
 ) -> LocalModel:
     """Linearisation, regulator, costate and Newton weights at ``trajectory``.
 
@@ -87,17 +127,25 @@ def local_model(
         Barrier weight and switching point (ignored without constraints).
     options : ProntoOptions, optional
         ``terminal_regulator`` is used.
+    first_order : FirstOrder, optional
+        The linearisation and regulator at ``trajectory`` and ``delta`` for any barrier
+        weight (:func:`first_order_model`): shifted to ``epsilon`` exactly
+        (:meth:`~auvplan.optimization.stages.Linearization.at_barrier_weight`) instead of
+        linearising again.
 
     Returns
     -------
     LocalModel
         The quadratic model of ``g`` at ``ξ``.
     """
-    lin = linearize(model, trajectory, epsilon, delta)
-    gains = regulator_gains(model, trajectory, lin.A, lin.B, options)
-    costate = compute_costate(lin, gains)
+    if first_order is None:
+        first_order = first_order_model(model, trajectory, epsilon, delta, options=options)
+    elif first_order.trajectory is not trajectory or first_order.linearization.delta != delta:
+        raise ValueError("first_order is not at this trajectory and delta")
+    lin = first_order.linearization.at_barrier_weight(epsilon)
+    costate = compute_costate(lin, first_order.gains)
     weights = second_order_weights(model, trajectory, lin, costate)
-    return LocalModel(trajectory, lin, gains, costate, weights)
+    return LocalModel(trajectory, lin, first_order.gains, costate, weights)
 
 
 def steepest_weights(problem: TrajectoryProblem) -> StageWeights:
@@ -121,6 +169,7 @@ def compute_direction(
     delta: float,
     *,
     options: ProntoOptions = _DEFAULT_OPTIONS,
+    first_order: FirstOrder | None = None,
 ) -> tuple[LocalModel, LqDirection]:
     """The PRONTO search direction at ``trajectory`` and the model it minimises.
 
@@ -129,7 +178,7 @@ def compute_direction(
 
     Parameters
     ----------
-    model, trajectory, epsilon, delta
+    model, trajectory, epsilon, delta, first_order
         As for :func:`local_model`.
     options : ProntoOptions, optional
         ``terminal_regulator``, ``fallback_model`` and ``eigenvalue_floor`` are used.
@@ -146,7 +195,7 @@ def compute_direction(
     SolverError
         If no level of the ladder gives a descent direction.
     """
-    local = local_model(model, trajectory, epsilon, delta, options=options)
+    local = local_model(model, trajectory, epsilon, delta, options=options, first_order=first_order)
     quasi = None
     if options.fallback_model is FallbackModel.COST:
         quasi = functools.partial(quasi_newton_weights, model, trajectory, local.linearization)
@@ -162,30 +211,29 @@ def compute_direction(
 
 
 def predicted_decrement(
-    model: ProntoModel,
     local: LocalModel,
+    direction: LqDirection,
     epsilon: float,
     *,
-    options: ProntoOptions = _DEFAULT_OPTIONS,
+    shift_only: bool = False,
 ) -> tuple[float, float]:
     """``−Dh·ζ`` and ``h`` at the local model's trajectory for another barrier weight ``ε'``.
 
-    One LQ solve, no new Hessian: the gradients and the cost are exact at ``ε'``
-    (:meth:`Linearization.at_barrier_weight`); the weights stay those of ``local``. They
-    differ from the exact ``ε'`` weights by ``(ε' − ε)`` times the barrier's Hessian and by
-    the dynamics' curvature weighted with the barrier's part of the costate, both small
-    where the barrier hardly pulls on the trajectory, which is when the prediction is
-    used (:func:`~auvplan.optimization.pronto.solve_pronto`'s skipping of barrier levels).
-    ``inf`` when no model of the ladder gives a descent direction.
+    No new Hessian and no factorisation: the gradients and the cost are exact at ``ε'``
+    (:meth:`Linearization.at_barrier_weight`); the model is that of ``direction`` (the
+    ladder's model of ``local``; :meth:`LqFactor.slope`). Its weights differ from the exact
+    ``ε'`` weights by ``(ε' − ε)`` times the barrier's Hessian and by the dynamics' curvature
+    weighted with the barrier's part of the costate, both small where the barrier hardly
+    pulls on the trajectory, which is when the prediction is used
+    (:func:`~auvplan.optimization.pronto.solve_pronto`'s skipping of barrier levels).
+
+    ``shift_only``: the decrement of the gradient's change alone, ``Δg = (ε'/ε − 1) ∇b``
+    (``b`` the barrier at ``ε``), ``Δgᵀ H⁻¹ Δg`` in the model's metric: what is left at
+    ``ε'`` after a Newton step that has zeroed the gradient at ``ε``.
     """
-    lin = local.linearization.at_barrier_weight(epsilon)
-    try:
-        direction = solve_lq_direction(
-            lin,
-            local.weights,
-            eigenvalue_floor=options.eigenvalue_floor,
-            groups=coordinate_groups(model.problem.blocks, model.problem.n_states),
-        )
-    except SolverError:
-        return float("inf"), lin.cost.total
-    return -direction.slope, lin.cost.total
+    assert direction.factor is not None
+    here = local.linearization
+    lin = here.at_barrier_weight(epsilon)
+    if shift_only:
+        lin = dataclasses.replace(lin, a=lin.a - here.a, b=lin.b - here.b, m_x=lin.m_x - here.m_x)
+    return -direction.factor.slope(lin), lin.cost.total
