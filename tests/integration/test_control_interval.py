@@ -31,7 +31,8 @@ def test_demo_crossing_at_long_control_intervals(tmp_path: Path, dt: float) -> N
     assert summary["optimization"]["plan_status"] == "CONVERGED"
     assert summary["deconfliction"]["integration"]["substep_s"] <= 0.45
     energies = [v["energy_J"] for v in summary["optimization"]["vehicles"].values()]
-    reference = np.load(GOLDEN / "golden_mission.npz")["energy"]  # dt_s = 0.5
+    with np.load(GOLDEN / "golden_mission.npz") as golden:
+        reference = golden["energy"]  # dt_s = 0.5
     np.testing.assert_allclose(energies, reference, rtol=0.01)
     report = check(out, mission=mission)
     assert report.passed, report.failures

@@ -13,7 +13,8 @@ from regenerate import HERE, golden_arrays
 
 @pytest.mark.regression
 def test_short_demo_mission_matches_golden() -> None:
-    golden = np.load(HERE / "golden_mission.npz")
+    with np.load(HERE / "golden_mission.npz") as stored:
+        golden = {key: stored[key] for key in stored.files}
     arrays = golden_arrays(HERE / "golden_mission.toml")
     assert int(arrays["n_iter"]) == int(golden["n_iter"])
     for key in ("desired", "states", "inputs", "energy", "cost"):

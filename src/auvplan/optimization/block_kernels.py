@@ -154,8 +154,10 @@ class BlockKernels:
     n_u: int
     n_p: int
     n_w: int
-    _last: dict[bytes, list[_Forward]] = field(default_factory=dict, repr=False)
-    """The forward sweeps of the last :meth:`first_order` call, by a digest of its arguments:
+    _last: list[tuple[tuple[FloatArray, ...], list[_Forward]]] = field(
+        default_factory=list, repr=False
+    )
+    """The forward sweeps of the last :meth:`first_order` call, with copies of its arguments:
     a Newton step asks for the Hessians at the trajectory it just linearised."""
 
     def _sweeps(
@@ -173,19 +175,16 @@ class BlockKernels:
         ``remember=False`` leaves the remembered sweeps alone (e.g. Jacobians at other points
         between a linearisation and its Hessians).
         """
-        digest = hashlib.blake2b(np.array([h, n_substeps, CHUNK], dtype=np.float64).tobytes())
-        for array in (x, u, p, w):
-            digest.update(np.ascontiguousarray(array).tobytes())
-        key = digest.digest()
-        sweeps = self._last.get(key)
-        if sweeps is None:
-            sweeps = [
-                self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps)
-                for rows in _chunks(x.shape[0])
-            ]
-            if remember:
-                self._last.clear()
-                self._last[key] = sweeps
+        arguments = (x, u, p, w, np.array([h, n_substeps, CHUNK], dtype=np.float64))
+        for known, sweeps in self._last:
+            if all(np.array_equal(a, b) for a, b in zip(known, arguments, strict=True)):
+                return sweeps
+        sweeps = [
+            self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps)
+            for rows in _chunks(x.shape[0])
+        ]
+        if remember:
+            self._last[:] = [(tuple(np.array(a) for a in arguments), sweeps)]
         return sweeps
 
     def step(

@@ -6,13 +6,14 @@ The solver loop is written as named, individually testable steps (STYLE B2)::
     for ε in ε-levels:                                   # barrier continuation (§7.5)
         repeat:
             linearise, regulator K (reused at a new level's first point)
-            after a small full Newton step: done if ξ passes the last ε's test (a probe)
+            if predicted by the last two steps: done if ξ passes the last ε's test (probe)
             local, ζ = compute_direction(ξ)              # costate λ, Newton weights,
                                                          # LQ direction (ladder)
-            if converged(−Dh·ζ): break                   # stopping criterion
+            if converged(−Dh·ζ): break                   # stopping criterion, or the next
+                                                         # level's barrier shift outweighs it
             ξ = armijo_step(ξ, ζ, K)                     # try_step(γ) = h(P(ξ + γζ)), K fixed
             shrink δ once strictly feasible
-        skip to the last ε if ξ is predicted converged there (one LQ solve)
+        skip to the last ε if ξ is predicted converged there (the factorised LQ model)
 
 Equations and defaults follow ``reference/pronto.md`` §6 (discrete PRONTO), §7 (barrier) and
 §11. The discrete problem is stated in :mod:`auvplan.optimization.problem`.
@@ -26,13 +27,14 @@ optimization of trajectory functionals with constraints", IEEE CDC 2006.
 
 from __future__ import annotations
 
+import functools
 import logging
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from threadpoolctl import threadpool_limits
+from threadpoolctl import ThreadpoolController
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError, SolverError
@@ -170,8 +172,8 @@ def _outweighed(local: LocalModel, direction: LqDirection, epsilon: float) -> bo
     """Whether the next barrier level ``epsilon`` outweighs this level's remaining error.
 
     Going to ``epsilon`` shifts the gradient by ``Δg = (ε'/ε − 1) ∇b``, and its decrement
-    ``s = Δgᵀ H⁻¹ Δg`` (:func:`predicted_decrement`, ``shift_only``) is about
-    what the next level starts with from this level's exact minimiser. From a point whose
+    ``s = Δgᵀ H⁻¹ Δg`` (:func:`predicted_decrement`, ``shift_only``) is about what the
+    next level starts with from this level's exact minimiser. From a point whose
     decrement here is ``d``, it starts with at most ``(√d + √s)²``: with
     ``d < LEVEL_SHARE · s`` that is at most 1.73 ``s``, and the Newton steps that would
     reduce ``d`` further here are not taken (IPOPT likewise solves a barrier problem only to
@@ -192,11 +194,10 @@ def _worth_probing(
 
     ``decrements = (d_{k−1}, d_k)``: the level's decrements at the last two points,
     ``local`` and ``direction`` the model and direction at the second. The level's decrement
-    at the new point is estimated as
-    ``d_k² / d_{k−1}`` (the contraction going on); the last level ``epsilon`` adds the
-    barrier's shift of the gradient, whose decrement is :func:`predicted_decrement`'s
-    (``shift_only``). Their sum of square roots, squared, must be below
-    ``SKIP_MARGIN`` of the last level's tolerance.
+    at the new point is estimated as ``d_k² / d_{k−1}`` (the contraction going on); the last
+    level ``epsilon`` adds the barrier's shift of the gradient, whose decrement is
+    :func:`predicted_decrement`'s (``shift_only``). Their sum of square roots, squared, must
+    be below ``SKIP_MARGIN`` of the last level's tolerance.
     """
     before, last = decrements
     newton = last * last / before
@@ -414,6 +415,12 @@ def _continuation(
     return None, "", epsilon
 
 
+@functools.cache
+def _blas_pools() -> ThreadpoolController:
+    """The process's thread pools, found once (a scan of the loaded libraries takes ~1 ms)."""
+    return ThreadpoolController()
+
+
 def solve_pronto(
     problem: TrajectoryProblem,
     guess: Trajectory,
@@ -458,8 +465,12 @@ def solve_pronto(
     the smallest barrier argument once the trajectory is strictly feasible, after which
     infeasible line-search candidates are rejected. A level that ends infeasible is re-solved
     with ``δ`` reduced by :func:`infeasible_restart_delta` (at most
-    ``max_infeasible_restarts`` times). After a level, the levels before the last are skipped
-    when the trajectory is predicted to pass the last level's test already (:func:`_next_level`).
+    ``max_infeasible_restarts`` times). A level before the last also ends once the next
+    level's barrier shift outweighs its decrement (:func:`_outweighed`). After a level, the
+    levels before the last are skipped when the trajectory is predicted to pass the last
+    level's test already (:func:`_next_level`); within a level, a point that the last two
+    full Newton steps predict to pass it is tested there first (:func:`_probe`, recorded at
+    the last ``ε``; the solve ends if it passes).
     """
     options = options if options is not None else ProntoOptions()
     check_guess(problem, guess)
@@ -468,7 +479,7 @@ def solve_pronto(
     model = cache.get(problem, options.backend)
     # The solver's linear algebra is on matrices of tens of rows, stage by stage: BLAS threads
     # only add synchronisation (3x slower eigen-decompositions on two cores).
-    with threadpool_limits(limits=1, user_api="blas"):
+    with _blas_pools().limit(limits=1, user_api="blas"):
         trajectory, gains = project_guess(model, guess, options)
         state = _State(trajectory, gains, options.delta_initial)
         status, message, epsilon = _continuation(model, state, options, start, callback)

@@ -38,7 +38,8 @@ class ProntoIteration:
     direction : DirectionType
         Model that produced ζ.
     epsilon, delta : float
-        Barrier weight and switching point in force.
+        Barrier weight of the direction and switching point in force (a probe of the last
+        level's test from an earlier level records the last ``ε``, with step 0).
     min_slack : float
         Smallest scaled constraint slack ``c / scale`` on the current trajectory (``inf``
         without constraints).
