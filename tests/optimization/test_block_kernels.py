@@ -247,9 +247,10 @@ def test_closed_loop_equals_a_loop_of_substeps(
     p = rng.standard_normal((n_points, n_stages, kernels.n_p))
     w = rng.uniform(0.1, 2.0, (n_points, kernels.n_w))  # different weights per point
 
-    path, inputs = kernels.closed_loop(x0, alpha, mu, gains, p, w, h, n_substeps)
+    path, inputs, costs = kernels.closed_loop(x0, alpha, mu, gains, p, w, h, n_substeps)
 
     assert path.shape == (n_points, n_stages * n_substeps + 1, kernels.n_x)
+    assert costs.shape == (n_points, n_stages)
     for b in range(n_points):
         state = x0[b]
         expected_path, expected_inputs = [state], []
@@ -264,6 +265,14 @@ def test_closed_loop_equals_a_loop_of_substeps(
             assert_close(state, stage_end, 1e-13)
         assert_close(path[b], np.array(expected_path), 1e-12)
         assert_close(inputs[b], np.array(expected_inputs), 1e-12)
+        # a stage of the path is the step of the stage before, and its cost the step's, to
+        # the bit (the line search reads the costs of the rollout instead of a step)
+        stages = path[b, ::n_substeps]
+        stepped, stepped_cost = kernels.step(
+            stages[:-1], inputs[b], p[b], np.repeat(w[b][None], n_stages, axis=0), h, n_substeps
+        )
+        np.testing.assert_array_equal(stepped, stages[1:])
+        np.testing.assert_array_equal(stepped_cost, costs[b])
 
 
 def test_chain_rule_hessian_with_zero_rows_and_entries_equals_the_dense_product() -> None:

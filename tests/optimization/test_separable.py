@@ -144,6 +144,39 @@ def test_rollout_equals_the_casadi_rollout(
     assert np.max(np.abs(results["coupled"] - results["block-diagonal"])) > 1e-2
 
 
+def test_the_cost_of_a_rollout_is_its_steps_cost(
+    models: tuple[BlockDiscreteModel, DiscreteModel],
+    rng: np.random.Generator,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The costs the closed loop summed (remembered for a line-search trial, no step taken
+    again) are the step's costs of the rolled-out stages to the bit, and arguments that
+    differ in one entry are evaluated again."""
+    block_model, _ = models
+    x0 = 0.5 * rng.standard_normal(block_model.n_x)
+    alpha = 0.5 * rng.standard_normal((N_STAGES + 1, block_model.n_x))
+    mu = 0.5 * rng.standard_normal((N_STAGES, block_model.n_u))
+    params = rng.standard_normal((N_STAGES, block_model.n_p))
+    states, inputs = block_model.rollout(x0, alpha, mu, _block_gains(block_model, rng), params)
+    stepped, expected = block_model._step_and_cost(states[:-1], inputs, params)
+    np.testing.assert_array_equal(stepped, states[1:])
+    steps: list[int] = []
+    step_and_cost = BlockDiscreteModel._step_and_cost
+
+    def spy(self: BlockDiscreteModel, *args: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        steps.append(1)
+        return step_and_cost(self, *args)
+
+    monkeypatch.setattr(BlockDiscreteModel, "_step_and_cost", spy)
+    np.testing.assert_array_equal(block_model.cost(states[:-1], inputs, params), expected)
+    assert not steps
+    other = inputs.copy()
+    other[2, 0] += 0.1
+    fresh = block_model.cost(states[:-1], other, params)
+    np.testing.assert_array_equal(fresh, block_model._step_and_cost(states[:-1], other, params)[1])
+    assert fresh[2] != expected[2]
+
+
 def _tilings() -> dict[str, tuple[StageBlock, ...]]:
     blocks, _ = three_blocks()
     first, cart, second = blocks

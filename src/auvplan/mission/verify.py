@@ -77,7 +77,7 @@ def replay_closed_loop(
         time = dt * np.arange(n_steps, dtype=np.float64)
         drift = current_parameters(model, states[:-1], time, current)
         parameters = np.hstack([parameters, drift])
-    path, _ = kernels.closed_loop(
+    path, _, _ = kernels.closed_loop(
         states[:1],
         states[None, :-1],
         inputs[None],

@@ -56,41 +56,47 @@ CHUNK: Final = 8192
 
 #: Closed-loop RK4 simulation appended to every kernel module: it calls the ``value`` kernel
 #: in a sequential loop, and numba caches a function only together with the kernels it calls
-#: as globals of its own module.
+#: as globals of its own module. Its arithmetic is :meth:`BlockKernels.step`'s, operation by
+#: operation (``y = x + (h a_i) K``, ``x' = x + Σ_i (h b_i) K_i`` and ``L = Σ (h b_i) ℓ`` summed
+#: in node order): a stage of the path is the step of the stage before, to the bit, and its
+#: ``costs`` are the step's.
 _CLOSED_LOOP_SOURCE: Final = """
 @numba.njit(cache=True, error_model='numpy')
-def closed_loop_batch(x0, alpha, mu, gains, p, w, h, n_sub, path, inputs):
+def closed_loop_batch(x0, alpha, mu, gains, p, w, h, n_sub, path, inputs, costs):
     n_points, n_stages, n_x = alpha.shape
     n_u = mu.shape[2]
-    z = np.empty(n_x)
+    start = np.empty(n_x)
+    advanced = np.empty(n_x)
     y = np.empty(n_x)
-    rates = np.empty((4, n_x))
+    rate = np.empty(n_x)
     q = np.empty(1)
+    factors = (h * (1.0 / 6.0), h * (2.0 / 6.0), h * (2.0 / 6.0), h * (1.0 / 6.0))
+    offsets = (h * 0.5, h * 0.5, h * 1.0, 0.0)
     for b in range(n_points):
         for t in range(n_x):
-            z[t] = x0[b, t]
-            path[b, 0, t] = z[t]
+            start[t] = x0[b, t]
+            path[b, 0, t] = start[t]
         for k in range(n_stages):
             for i in range(n_u):
                 s = mu[b, k, i]
                 for j in range(n_x):
-                    s += gains[b, k, i, j] * (alpha[b, k, j] - z[j])
+                    s += gains[b, k, i, j] * (alpha[b, k, j] - start[j])
                 inputs[b, k, i] = s
+            cost = 0.0
             for j in range(n_sub):
-                value(z, inputs[b, k], p[b, k], w[b], rates[0], q)
                 for t in range(n_x):
-                    y[t] = z[t] + 0.5 * h * rates[0, t]
-                value(y, inputs[b, k], p[b, k], w[b], rates[1], q)
+                    y[t] = start[t]
+                    advanced[t] = start[t]
+                for i in range(4):
+                    value(y, inputs[b, k], p[b, k], w[b], rate, q)
+                    cost += factors[i] * q[0]
+                    for t in range(n_x):
+                        advanced[t] += factors[i] * rate[t]
+                        y[t] = start[t] + offsets[i] * rate[t]
                 for t in range(n_x):
-                    y[t] = z[t] + 0.5 * h * rates[1, t]
-                value(y, inputs[b, k], p[b, k], w[b], rates[2], q)
-                for t in range(n_x):
-                    y[t] = z[t] + h * rates[2, t]
-                value(y, inputs[b, k], p[b, k], w[b], rates[3], q)
-                for t in range(n_x):
-                    s = rates[0, t] + 2.0 * (rates[1, t] + rates[2, t]) + rates[3, t]
-                    z[t] += h / 6.0 * s
-                    path[b, k * n_sub + j + 1, t] = z[t]
+                    start[t] = advanced[t]
+                    path[b, k * n_sub + j + 1, t] = start[t]
+            costs[b, k] = cost
 """
 _BUILT: dict[tuple[str, Path | None], BlockKernels] = {}
 
@@ -329,7 +335,7 @@ class BlockKernels:
         w: FloatArray,
         h: float,
         n_substeps: int,
-    ) -> tuple[FloatArray, FloatArray]:
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Independent closed-loop simulations ``u_k = μ_k + K_k (α_k − x_k)`` (held over a step).
 
         Parameters
@@ -352,18 +358,23 @@ class BlockKernels:
         Returns
         -------
         path : ndarray of shape (B, N · n_substeps + 1, n_x)
-            The state after every substep (every ``n_substeps``-th is a stage state).
+            The state after every substep (every ``n_substeps``-th is a stage state; each the
+            :meth:`step` of the one before, to the bit).
         inputs : ndarray of shape (B, N, n_u)
             The inputs applied.
+        costs : ndarray of shape (B, N)
+            The stage costs ``L`` along the path (:meth:`step`'s, to the bit).
         """
         n_points, n_stages = reference_inputs.shape[:2]
         path = np.empty((n_points, n_stages * n_substeps + 1, self.n_x))
         inputs = np.empty((n_points, n_stages, self.n_u))
+        costs = np.empty((n_points, n_stages))
         arrays = [np.ascontiguousarray(a) for a in (x0, reference_states, reference_inputs, gains)]
         self.module.closed_loop_batch(
-            *arrays, np.ascontiguousarray(p), np.ascontiguousarray(w), h, n_substeps, path, inputs
-        )
-        return path, inputs
+            *arrays, np.ascontiguousarray(p), np.ascontiguousarray(w), h, n_substeps, path,
+            inputs, costs,
+        )  # fmt: skip
+        return path, inputs, costs
 
 
 def _warm_up(kernels: BlockKernels) -> None:

@@ -152,6 +152,11 @@ class BlockDiscreteModel:
     dt: float
     n_substeps: int
     groups: tuple[_Group, ...] = field(repr=False)
+    _rolled: list[tuple[tuple[FloatArray, FloatArray, FloatArray], FloatArray]] = field(
+        default_factory=list, repr=False
+    )
+    """The stage costs of the last closed-loop :meth:`rollout`, with copies of its stages,
+    inputs and parameters: :meth:`cost` of that trajectory (a line-search trial) reads them."""
 
     @classmethod
     def build(
@@ -220,7 +225,18 @@ class BlockDiscreteModel:
         return self._step_and_cost(states, inputs, parameters)[0]
 
     def cost(self, states: FloatArray, inputs: FloatArray, parameters: FloatArray) -> FloatArray:
-        """Stage costs ``L(x_k, u_k, p_k)``, shape ``(N,)``."""
+        """Stage costs ``L(x_k, u_k, p_k)``, shape ``(N,)``.
+
+        Those of the last :meth:`rollout` when these are its stages, inputs and parameters
+        (the closed-loop kernel sums them as :meth:`step` does, to the bit).
+        """
+        for (known_states, known_inputs, known_parameters), costs in self._rolled:
+            if (
+                np.array_equal(states, known_states)
+                and np.array_equal(inputs, known_inputs)
+                and np.array_equal(parameters, known_parameters)
+            ):
+                return costs.copy()
         return self._step_and_cost(states, inputs, parameters)[1]
 
     def _step_and_cost(
@@ -353,9 +369,10 @@ class BlockDiscreteModel:
             return self._coupled_rollout(x0, alpha, mu, gains, params)
         states = np.empty((n_stages + 1, self.n_x))
         inputs = np.empty((n_stages, self.n_u))
+        costs = np.zeros(n_stages)
         for group in self.groups:
             blocks = group.blocks
-            path, applied = group.kernels.closed_loop(
+            path, applied, increments = group.kernels.closed_loop(
                 np.stack([x0[b.states] for b in blocks]),
                 np.stack([alpha[:, b.states] for b in blocks]),
                 np.stack([mu[:, b.inputs] for b in blocks]),
@@ -368,6 +385,8 @@ class BlockDiscreteModel:
             for i, block in enumerate(blocks):
                 states[:, block.states] = path[i, :: self.n_substeps]
                 inputs[:, block.inputs] = applied[i]
+                costs += increments[i]
+        self._rolled[:] = [((states[:-1].copy(), inputs.copy(), params.copy()), costs)]
         return states, inputs
 
     def _block_diagonal(self, gains: FloatArray) -> bool:
