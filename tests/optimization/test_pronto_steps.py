@@ -34,7 +34,12 @@ from auvplan.optimization import (
 )
 from auvplan.optimization.lq import quadratic_form
 from auvplan.optimization.model import ProntoModel
-from auvplan.optimization.steps import LocalModel, compute_direction, predicted_decrement
+from auvplan.optimization.steps import (
+    LocalModel,
+    compute_direction,
+    predicted_decrement,
+    shift_decrement,
+)
 
 from ._problems import (
     crossing_problem,
@@ -363,16 +368,14 @@ def test_predicted_decrement_at_the_same_weight_is_the_directions() -> None:
 
 
 def test_the_barrier_shift_decrement_is_quadratic_in_the_weight_change() -> None:
-    """``shift_only`` measures ``Δg = (ε'/ε − 1) ∇b`` alone: zero at the model's own ε,
+    """``shift_decrement`` measures ``Δg = (ε'/ε − 1) ∇b`` alone: zero at the model's own ε,
     ``(ε'/ε − 1)²`` times one fixed quadratic form elsewhere (so it is not the whole
     gradient's decrement), and with ``g + Δg`` the full prediction at ``ε'`` obeys
     ``√d(ε') ≤ √d(ε) + √shift`` (the triangle inequality of the model's norm)."""
     _, _, local, direction = _turn_bound_start()
-    assert predicted_decrement(local, direction, 1.0, shift_only=True)[0] == pytest.approx(
-        0.0, abs=1e-14
-    )
-    small, _ = predicted_decrement(local, direction, 0.5, shift_only=True)
-    large, _ = predicted_decrement(local, direction, 1e-4, shift_only=True)
+    assert shift_decrement(local, direction, 1.0) == pytest.approx(0.0, abs=1e-14)
+    small = shift_decrement(local, direction, 0.5)
+    large = shift_decrement(local, direction, 1e-4)
     assert small > 0.0
     assert large == pytest.approx(small * ((1e-4 - 1.0) / (0.5 - 1.0)) ** 2, rel=1e-9)
     full, _ = predicted_decrement(local, direction, 1e-4)

@@ -106,6 +106,19 @@ def _block_gains(model: BlockDiscreteModel, rng: np.random.Generator) -> np.ndar
     return gains
 
 
+def _count_calls(monkeypatch: pytest.MonkeyPatch, name: str) -> list[int]:
+    """A list that grows by one at every call of ``BlockDiscreteModel.<name>`` (still made)."""
+    calls: list[int] = []
+    method = getattr(BlockDiscreteModel, name)
+
+    def spy(self: BlockDiscreteModel, *args: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        calls.append(1)
+        return method(self, *args)
+
+    monkeypatch.setattr(BlockDiscreteModel, name, spy)
+    return calls
+
+
 def test_rollout_equals_the_casadi_rollout(
     models: tuple[BlockDiscreteModel, DiscreteModel],
     rng: np.random.Generator,
@@ -120,14 +133,7 @@ def test_rollout_equals_the_casadi_rollout(
     coupling = 0.3 * rng.standard_normal(diagonal.shape)
     coupling[diagonal != 0.0] = 0.0
 
-    coupled_calls: list[int] = []
-    coupled_rollout = BlockDiscreteModel._coupled_rollout
-
-    def spy(self: BlockDiscreteModel, *args: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        coupled_calls.append(1)
-        return coupled_rollout(self, *args)
-
-    monkeypatch.setattr(BlockDiscreteModel, "_coupled_rollout", spy)
+    coupled_calls = _count_calls(monkeypatch, "_coupled_rollout")
     results = {}
     for name, gains in {
         "block-diagonal": diagonal,
@@ -160,14 +166,7 @@ def test_the_cost_of_a_rollout_is_its_steps_cost(
     states, inputs = block_model.rollout(x0, alpha, mu, _block_gains(block_model, rng), params)
     stepped, expected = block_model._step_and_cost(states[:-1], inputs, params)
     np.testing.assert_array_equal(stepped, states[1:])
-    steps: list[int] = []
-    step_and_cost = BlockDiscreteModel._step_and_cost
-
-    def spy(self: BlockDiscreteModel, *args: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        steps.append(1)
-        return step_and_cost(self, *args)
-
-    monkeypatch.setattr(BlockDiscreteModel, "_step_and_cost", spy)
+    steps = _count_calls(monkeypatch, "_step_and_cost")
     np.testing.assert_array_equal(block_model.cost(states[:-1], inputs, params), expected)
     assert not steps
     other = inputs.copy()

@@ -26,7 +26,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
-from typing import Final
+from typing import Final, Generic, TypeVar
 
 import casadi as ca
 import numpy as np
@@ -133,6 +133,35 @@ def _chunks(n_points: int) -> Iterator[slice]:
         yield slice(start, min(start + CHUNK, n_points))
 
 
+_T = TypeVar("_T")
+
+
+@dataclass(eq=False)
+class LastCall(Generic[_T]):
+    """What was computed from the last arrays given, kept with copies of them (one entry).
+
+    ``get`` returns it only for arrays equal to those, entry by entry (``None`` else): a
+    memcmp of the arguments instead of the work they stand for.
+    """
+
+    _entry: tuple[tuple[FloatArray, ...], _T] | None = None
+
+    def get(self, *arrays: FloatArray) -> _T | None:
+        """The value kept for these arrays, or ``None``."""
+        if self._entry is None:
+            return None
+        known, value = self._entry
+        if len(known) == len(arrays) and all(
+            np.array_equal(a, b) for a, b in zip(known, arrays, strict=True)
+        ):
+            return value
+        return None
+
+    def put(self, value: _T, *arrays: FloatArray) -> None:
+        """Keep ``value`` for copies of ``arrays`` (in place of the last)."""
+        self._entry = (tuple(np.array(a) for a in arrays), value)
+
+
 @dataclass(frozen=True)
 class _Forward:
     """Node data of a forward sweep: points ``Y_n``, their derivatives ``D_n``, ``J_n``, ``g_n``."""
@@ -160,11 +189,9 @@ class BlockKernels:
     n_u: int
     n_p: int
     n_w: int
-    _last: list[tuple[tuple[FloatArray, ...], list[_Forward]]] = field(
-        default_factory=list, repr=False
-    )
-    """The forward sweeps of the last :meth:`first_order` call, with copies of its arguments:
-    a Newton step asks for the Hessians at the trajectory it just linearised."""
+    _last: LastCall[list[_Forward]] = field(default_factory=LastCall, repr=False)
+    """The forward sweeps of the last :meth:`first_order` call, by its arguments: a Newton
+    step asks for the Hessians at the trajectory it just linearised."""
 
     def _sweeps(
         self,
@@ -182,15 +209,14 @@ class BlockKernels:
         between a linearisation and its Hessians).
         """
         arguments = (x, u, p, w, np.array([h, n_substeps, CHUNK], dtype=np.float64))
-        for known, sweeps in self._last:
-            if all(np.array_equal(a, b) for a, b in zip(known, arguments, strict=True)):
-                return sweeps
-        sweeps = [
-            self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps)
-            for rows in _chunks(x.shape[0])
-        ]
-        if remember:
-            self._last[:] = [(tuple(np.array(a) for a in arguments), sweeps)]
+        sweeps = self._last.get(*arguments)
+        if sweeps is None:
+            sweeps = [
+                self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps)
+                for rows in _chunks(x.shape[0])
+            ]
+            if remember:
+                self._last.put(sweeps, *arguments)
         return sweeps
 
     def step(

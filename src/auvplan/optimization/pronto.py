@@ -53,6 +53,7 @@ from auvplan.optimization.steps import (
     compute_direction,
     first_order_model,
     predicted_decrement,
+    shift_decrement,
 )
 
 __all__ = ["check_guess", "final_result", "solve_pronto"]
@@ -172,14 +173,14 @@ def _outweighed(local: LocalModel, direction: LqDirection, epsilon: float) -> bo
     """Whether the next barrier level ``epsilon`` outweighs this level's remaining error.
 
     Going to ``epsilon`` shifts the gradient by ``Δg = (ε'/ε − 1) ∇b``, and its decrement
-    ``s = Δgᵀ H⁻¹ Δg`` (:func:`predicted_decrement`, ``shift_only``) is about what the
-    next level starts with from this level's exact minimiser. From a point whose
-    decrement here is ``d``, it starts with at most ``(√d + √s)²``: with
+    ``s = Δgᵀ H⁻¹ Δg`` (:func:`shift_decrement`) is about what the next level starts with
+    from this level's exact minimiser. From a point whose decrement here is ``d``, it
+    starts with at most ``(√d + √s)²``: with
     ``d < LEVEL_SHARE · s`` that is at most 1.73 ``s``, and the Newton steps that would
     reduce ``d`` further here are not taken (IPOPT likewise solves a barrier problem only to
     a tolerance proportional to its barrier parameter).
     """
-    shift, _ = predicted_decrement(local, direction, epsilon, shift_only=True)
+    shift = shift_decrement(local, direction, epsilon)
     return -direction.slope < LEVEL_SHARE * shift
 
 
@@ -195,16 +196,16 @@ def _worth_probing(
     ``decrements = (d_{k−1}, d_k)``: the level's decrements at the last two points,
     ``local`` and ``direction`` the model and direction at the second. The level's decrement
     at the new point is estimated as ``d_k² / d_{k−1}`` (the contraction going on); the last
-    level ``epsilon`` adds the barrier's shift of the gradient, whose decrement is
-    :func:`predicted_decrement`'s (``shift_only``). Their sum of square roots, squared, must
-    be below ``SKIP_MARGIN`` of the last level's tolerance.
+    level ``epsilon`` adds the barrier's shift of the gradient (:func:`shift_decrement`).
+    Their sum of square roots, squared, must be below ``SKIP_MARGIN`` of the last level's
+    tolerance.
     """
     before, last = decrements
     newton = last * last / before
     cost = local.linearization.cost.total
     if not converged(newton / SKIP_MARGIN, cost, options.tol, options.rtol):
         return False
-    shift, _ = predicted_decrement(local, direction, epsilon, shift_only=True)
+    shift = shift_decrement(local, direction, epsilon)
     return converged((newton**0.5 + shift**0.5) ** 2 / SKIP_MARGIN, cost, options.tol, options.rtol)
 
 
@@ -268,7 +269,7 @@ def _iterate_level(
         if len(state.history) >= options.max_iter:
             return ProntoStatus.MAX_ITER
         first_order = _first_order(model, state, epsilon, options)
-        if probe and last_epsilon is not None and state.probing:
+        if probe and last_epsilon is not None:
             if _probe(model, state, first_order, last_epsilon, options, start, callback):
                 return None
             if len(state.history) >= options.max_iter:

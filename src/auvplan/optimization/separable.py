@@ -31,7 +31,7 @@ import numpy as np
 from auvplan._typing import FloatArray, IntArray
 from auvplan.errors import InputError
 from auvplan.optimization._casadi import check_rollout, check_stages
-from auvplan.optimization.block_kernels import BlockKernels, block_kernels
+from auvplan.optimization.block_kernels import BlockKernels, LastCall, block_kernels
 
 __all__ = [
     "BlockDiscreteModel",
@@ -152,11 +152,9 @@ class BlockDiscreteModel:
     dt: float
     n_substeps: int
     groups: tuple[_Group, ...] = field(repr=False)
-    _rolled: list[tuple[tuple[FloatArray, FloatArray, FloatArray], FloatArray]] = field(
-        default_factory=list, repr=False
-    )
-    """The stage costs of the last closed-loop :meth:`rollout`, with copies of its stages,
-    inputs and parameters: :meth:`cost` of that trajectory (a line-search trial) reads them."""
+    _rolled: LastCall[FloatArray] = field(default_factory=LastCall, repr=False)
+    """The stage costs of the last closed-loop :meth:`rollout`, by its stages, inputs and
+    parameters: :meth:`cost` of that trajectory (a line-search trial) reads them."""
 
     @classmethod
     def build(
@@ -230,13 +228,9 @@ class BlockDiscreteModel:
         Those of the last :meth:`rollout` when these are its stages, inputs and parameters
         (the closed-loop kernel sums them as :meth:`step` does, to the bit).
         """
-        for (known_states, known_inputs, known_parameters), costs in self._rolled:
-            if (
-                np.array_equal(states, known_states)
-                and np.array_equal(inputs, known_inputs)
-                and np.array_equal(parameters, known_parameters)
-            ):
-                return costs.copy()
+        costs = self._rolled.get(states, inputs, parameters)
+        if costs is not None:
+            return costs.copy()
         return self._step_and_cost(states, inputs, parameters)[1]
 
     def _step_and_cost(
@@ -386,7 +380,7 @@ class BlockDiscreteModel:
                 states[:, block.states] = path[i, :: self.n_substeps]
                 inputs[:, block.inputs] = applied[i]
                 costs += increments[i]
-        self._rolled[:] = [((states[:-1].copy(), inputs.copy(), params.copy()), costs)]
+        self._rolled.put(costs, states[:-1], inputs, params)
         return states, inputs
 
     def _block_diagonal(self, gains: FloatArray) -> bool:

@@ -178,23 +178,35 @@ class Linearization:
     barrier_weight: FloatArray
     constraint_jacobians: SparseJacobians | None
 
+    def barrier_shift(self, epsilon: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The change of ``a``, ``b`` and ``m_x`` from this ``ε`` to ``epsilon``.
+
+        Every barrier term is proportional to ``ε``: with ``ρ = epsilon / self.epsilon`` the
+        gradients change by ``(ρ − 1) ε dt Σ_j b'_j c_{x,j} / scale_j`` (zero without
+        constraints).
+        """
+        n_x = self.A.shape[1]
+        if self.constraint_jacobians is None or epsilon == self.epsilon:
+            return np.zeros_like(self.a), np.zeros_like(self.b), np.zeros_like(self.m_x)
+        ratio = epsilon / self.epsilon
+        shift = (ratio - 1.0) * self.constraint_jacobians.weighted_sum(self.barrier_weight)
+        return shift[:-1, :n_x], shift[:-1, n_x:], shift[-1, :n_x]
+
     def at_barrier_weight(self, epsilon: float) -> Linearization:
         """The same trajectory's linearisation at barrier weight ``epsilon`` (exact).
 
-        Every barrier term is proportional to ``ε``: with ``ρ = epsilon / self.epsilon`` the
-        gradients become ``a + (ρ − 1) ε dt Σ_j b'_j c_{x,j} / scale_j`` (likewise ``b`` and
-        ``m_x``), the barrier cost and weights ``ρ`` times theirs; ``A``, ``B`` stay.
+        The gradients move by :meth:`barrier_shift`; the barrier cost and weights scale by
+        ``ρ = epsilon / self.epsilon``; ``A``, ``B`` stay.
         """
         if self.constraint_jacobians is None or epsilon == self.epsilon:
             return dataclasses.replace(self, epsilon=epsilon)
         ratio = epsilon / self.epsilon
-        shift = (ratio - 1.0) * self.constraint_jacobians.weighted_sum(self.barrier_weight)
-        n_x = self.A.shape[1]
+        d_a, d_b, d_m = self.barrier_shift(epsilon)
         cost = CostParts(self.cost.running, self.cost.terminal, ratio * self.cost.barrier)
         return dataclasses.replace(
-            self, a=self.a + shift[:-1, :n_x], b=self.b + shift[:-1, n_x:],
-            m_x=self.m_x + shift[-1, :n_x], cost=cost, epsilon=epsilon,
-            barrier_outer=ratio * self.barrier_outer, barrier_weight=ratio * self.barrier_weight,
+            self, a=self.a + d_a, b=self.b + d_b, m_x=self.m_x + d_m, cost=cost,
+            epsilon=epsilon, barrier_outer=ratio * self.barrier_outer,
+            barrier_weight=ratio * self.barrier_weight,
         )  # fmt: skip
 
 

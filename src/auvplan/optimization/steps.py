@@ -38,6 +38,7 @@ __all__ = [
     "first_order_model",
     "local_model",
     "predicted_decrement",
+    "shift_decrement",
     "steepest_weights",
 ]
 
@@ -211,11 +212,7 @@ def compute_direction(
 
 
 def predicted_decrement(
-    local: LocalModel,
-    direction: LqDirection,
-    epsilon: float,
-    *,
-    shift_only: bool = False,
+    local: LocalModel, direction: LqDirection, epsilon: float
 ) -> tuple[float, float]:
     """``−Dh·ζ`` and ``h`` at the local model's trajectory for another barrier weight ``ε'``.
 
@@ -226,14 +223,19 @@ def predicted_decrement(
     weighted with the barrier's part of the costate, both small where the barrier hardly
     pulls on the trajectory, which is when the prediction is used
     (:func:`~auvplan.optimization.pronto.solve_pronto`'s skipping of barrier levels).
-
-    ``shift_only``: the decrement of the gradient's change alone, ``Δg = (ε'/ε − 1) ∇b``
-    (``b`` the barrier at ``ε``), ``Δgᵀ H⁻¹ Δg`` in the model's metric: what is left at
-    ``ε'`` after a Newton step that has zeroed the gradient at ``ε``.
     """
     assert direction.factor is not None
-    here = local.linearization
-    lin = here.at_barrier_weight(epsilon)
-    if shift_only:
-        lin = dataclasses.replace(lin, a=lin.a - here.a, b=lin.b - here.b, m_x=lin.m_x - here.m_x)
+    lin = local.linearization.at_barrier_weight(epsilon)
     return -direction.factor.slope(lin), lin.cost.total
+
+
+def shift_decrement(local: LocalModel, direction: LqDirection, epsilon: float) -> float:
+    """The decrement of the gradient's change alone from the model's ``ε`` to ``ε'``.
+
+    ``Δg = (ε'/ε − 1) ∇b`` (``b`` the barrier at ``ε``, :meth:`Linearization.barrier_shift`),
+    ``Δgᵀ H⁻¹ Δg`` in the model of ``direction``: what is left at ``ε'`` after a Newton step
+    that has zeroed the gradient at ``ε``.
+    """
+    assert direction.factor is not None
+    d_a, d_b, d_m = local.linearization.barrier_shift(epsilon)
+    return -direction.factor.slope(dataclasses.replace(local.linearization, a=d_a, b=d_b, m_x=d_m))
