@@ -131,6 +131,8 @@ def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, An
     ``kernels-solve``: the solve alone, like the CasADi solvers' ``solve_s`` (their NLP built
     and compiled code loaded): a second solve in the process, with the model and every
     numba kernel loaded by the first (``wall_s`` is the second solve's).
+    ``kernels-2``/``kernels-solve-2``: alike with the stage evaluations on two threads
+    (``n_threads = 2``, as ``auvplan plan`` runs a coupled fleet on two cores).
     ``max_iter`` caps the solver's iterations (for per-iteration timing).
     """
     decomposed = solver.startswith("decomposed")
@@ -167,12 +169,17 @@ def measure(case: str, solver: str, max_iter: int | None = None) -> dict[str, An
             directions=len(outcome.history), jobs=jobs,
         )  # fmt: skip
     else:
-        backend = StageBackend(stage_kernels=solver != "casadi")
-        options = ProntoOptions(**{**options.__dict__, "stage_kernels": backend.stage_kernels})
+        threads = 2 if solver.endswith("-2") else 1
+        kind = solver.removesuffix("-2")
+        backend = StageBackend(stage_kernels=kind != "casadi", n_threads=threads)
+        options = ProntoOptions(
+            **{**options.__dict__, "stage_kernels": backend.stage_kernels, "n_threads": threads}
+        )
         cache = ModelCache()
         cache.get(problem, backend)
         record["model_s"] = time.perf_counter() - started
-        if solver == "kernels-solve":
+        record["threads"] = threads
+        if kind == "kernels-solve":
             solve_pronto(problem, guess, options=options, cache=cache)
             started = time.perf_counter()
         outcome = solve_pronto(problem, guess, options=options, cache=cache)

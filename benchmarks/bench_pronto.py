@@ -120,6 +120,8 @@ def comparison(cases: tuple[str, ...]) -> str:
                 "auvplan, solve alone (model and kernels loaded)": run(
                     case, "kernels-solve", cold_cache
                 ),
+                "auvplan, warm cache, 2 threads": run(case, "kernels-2", cold_cache),
+                "auvplan, solve alone, 2 threads": run(case, "kernels-solve-2", cold_cache),
                 "PRONTO on the CasADi VM": run(case, "casadi", cold_cache),
                 "CasADi + IPOPT (MX NLP)": run(case, "ipopt-mx", cold_cache),
             }
@@ -137,7 +139,12 @@ def comparison(cases: tuple[str, ...]) -> str:
         if "error" not in warm and "error" not in ipopt:
             gap = (warm["objective"] - ipopt["cost"]) / abs(ipopt["cost"])
             lines.append(f"| {case} | objective auvplan vs IPOPT | {100 * gap:+.3f} % | | | | |")
-        for label in ("auvplan, warm cache", "auvplan, solve alone (model and kernels loaded)"):
+        for label in (
+            "auvplan, warm cache",
+            "auvplan, solve alone (model and kernels loaded)",
+            "auvplan, warm cache, 2 threads",
+            "auvplan, solve alone, 2 threads",
+        ):
             if "error" not in records[label]:
                 lines.extend(_solve_ratios(case, label, records))
         print(f"compared: {case}", flush=True)

@@ -215,3 +215,29 @@ def test_a_vehicle_whose_problem_fails_names_itself_in_the_fleet_status(
     assert result.message == "a: reached max_iter = 2"
     assert result.min_slack > 0.0  # the best plan, whole and flyable: every vehicle projected
     np.testing.assert_array_equal(result.trajectory.states[0], assembled.problem.initial_state)
+
+
+def test_jobs_run_a_coupled_solve_on_threads_and_a_decomposed_one_on_processes(
+    planned: dict[str, pipeline.MissionResult], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``jobs = 2``: the coupled solve evaluates its stages on two threads, to the same plan
+    to the bit; beside a decomposed solve's second process each solve keeps one thread."""
+    threads: list[int] = []
+    for name in ("solve_pronto", "solve_decomposed"):
+        solver = getattr(pipeline, name)
+
+        def spy(*args: Any, _solver: Any = solver, **kwargs: Any) -> Any:
+            options = kwargs["options"] if "options" in kwargs else args[2]
+            threads.append(options.n_threads)
+            return _solver(*args, **kwargs)
+
+        monkeypatch.setattr(pipeline, name, spy)
+    coupled = pipeline.run_mission(_config(CROSSING, "coupled"), jobs=2)
+    assert threads == [2]
+    assert coupled.plan is not None
+    assert planned["coupled"].plan is not None
+    for ours, theirs in zip(coupled.plan.states, planned["coupled"].plan.states, strict=True):
+        np.testing.assert_array_equal(ours, theirs)
+    decomposed = pipeline.run_mission(_config(CROSSING, "decomposed"), jobs=2)
+    assert threads == [2, 1]
+    assert decomposed.plan is not None

@@ -135,7 +135,8 @@ def run_mission(
         Called once when stage 3 is about to start (after stage 2), e.g. to wait for the
         optimiser's kernels compiled in another process (:mod:`auvplan.api.companion`).
     jobs : int
-        Processes stage 3 may use (1 or 2; a decomposed fleet solve uses a second one).
+        Processes stage 3 may use (1 or 2): a second process solves vehicles of a decomposed
+        fleet, else a second thread evaluates half the stages.
     """
     timings: dict[str, float] = {}
     progress = with_checkpoints(progress)
@@ -270,8 +271,9 @@ def run_optimization(
     MEDUSAs, one moved 30 m: scaled slack −0.05). One level up the barrier re-centres it; at
     the last level its iterates hug the constraint it crossed (``δ`` shrank to 2e-9, 12
     iterations against 8, ``benchmarks/bench_replan.py``). ``config.solver.fleet`` chooses
-    the coupled solve or the vehicle-by-vehicle one (:mod:`auvplan.mission.decomposition`,
-    with ``jobs`` processes, its sweeps told to ``progress``).
+    the coupled solve (its stage evaluations on ``jobs`` threads) or the vehicle-by-vehicle one
+    (:mod:`auvplan.mission.decomposition`, with ``jobs`` processes, its sweeps told to
+    ``progress``).
     """
     decomposed = config.solver.decomposes(layout.n_vehicles)
     assembled = assemble_problem(
@@ -281,6 +283,8 @@ def run_optimization(
         warm_start=warm_start, decomposed=decomposed,
     )  # fmt: skip
     options = config.solver.pronto_options()
+    if not decomposed:  # the companion process idles in stage 3: its core takes half the stages
+        options = dataclasses.replace(options, n_threads=jobs)
     if warm_start is not None and warm_start.guess is not None:
         delta = options.delta_initial if warm_start.delta is None else warm_start.delta
         levels = options.epsilon_levels()

@@ -32,7 +32,7 @@ import numpy as np
 from auvplan._typing import FloatArray
 
 
-@numba.njit(cache=True, fastmath=True)
+@numba.njit(cache=True, fastmath=True, nogil=True)
 def advance_node(
     jac: FloatArray,
     grad: FloatArray,
@@ -80,7 +80,7 @@ def advance_node(
                 nc[r, c] = st[r, c] + offset * rate_d[r, c]
 
 
-@numba.njit(cache=True, fastmath=True)
+@numba.njit(cache=True, fastmath=True, nogil=True)
 def add_hessian(total: FloatArray, local: FloatArray, carried: FloatArray) -> None:
     """``total += D̃ᵀ local D̃`` at every point (in place; ``total``, ``local`` ``(B, n_z, n_z)``).
 
@@ -121,7 +121,7 @@ def add_hessian(total: FloatArray, local: FloatArray, carried: FloatArray) -> No
                         t[r, c] += a * right[k, c]
 
 
-@numba.njit(cache=True, fastmath=True)
+@numba.njit(cache=True, fastmath=True, nogil=True)
 def node_adjoint(
     k_bar: FloatArray, jac: FloatArray, grad: FloatArray, cost_weight: float
 ) -> FloatArray:

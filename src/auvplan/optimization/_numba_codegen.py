@@ -22,7 +22,7 @@ import casadi as ca
 __all__ = ["UnsupportedOperation", "numba_source"]
 
 #: Version of the generated code; part of every cache key (bump on any change of the output).
-GENERATOR_VERSION: Final = 3
+GENERATOR_VERSION: Final = 4
 
 _BINARY: Final = {ca.OP_ADD: "+", ca.OP_SUB: "-", ca.OP_MUL: "*", ca.OP_DIV: "/"}
 _UNARY: Final = {
@@ -119,7 +119,8 @@ def numba_source(functions: dict[str, ca.Function], header: str, appendix: str =
     -------
     str
         Module source: ``name(i0, …, o0, …)`` on 1-D arrays and ``name_batch`` on 2-D arrays
-        (one point per row), all ``numba.njit(cache=True)``.
+        (one point per row), all ``numba.njit(cache=True, nogil=True)`` (they run on worker
+        threads side by side).
 
     Raises
     ------
@@ -139,12 +140,12 @@ def numba_source(functions: dict[str, ca.Function], header: str, appendix: str =
         rows = [f"{arg}[b]" for arg in inputs + outputs]
         lines += [
             "",
-            "@numba.njit(cache=True, error_model='numpy')",
+            "@numba.njit(cache=True, error_model='numpy', nogil=True)",
             f"def {name}({', '.join(inputs + outputs)}):",
             *_kernel_lines(function),
             "",
             "",
-            "@numba.njit(cache=True, error_model='numpy')",
+            "@numba.njit(cache=True, error_model='numpy', nogil=True)",
             f"def {name}_batch({', '.join(inputs + outputs)}):",
             "    for b in range(i0.shape[0]):",
             f"        {name}({', '.join(rows)})",

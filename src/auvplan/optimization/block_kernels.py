@@ -19,10 +19,13 @@ order through the ``4m`` model evaluations (:mod:`~auvplan.optimization._chain`)
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import logging
+import os
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
@@ -51,7 +54,7 @@ RK4_WEIGHTS: Final = (1.0 / 6.0, 2.0 / 6.0, 2.0 / 6.0, 1.0 / 6.0)
 #: Largest Hessian kernel translated (SX instructions); larger models stay in CasADi, whose
 #: virtual machine starts at once, because numba's compile time grows with the code size.
 MAX_KERNEL_INSTRUCTIONS: Final = 12_000
-#: Points evaluated per chunk (bounds the memory of the stored node derivatives).
+#: Most points evaluated in one piece (bounds the memory of the stored node derivatives).
 CHUNK: Final = 8192
 
 #: Closed-loop RK4 simulation appended to every kernel module: it calls the ``value`` kernel
@@ -61,7 +64,7 @@ CHUNK: Final = 8192
 #: in node order): a stage of the path is the step of the stage before, to the bit, and its
 #: ``costs`` are the step's.
 _CLOSED_LOOP_SOURCE: Final = """
-@numba.njit(cache=True, error_model='numpy')
+@numba.njit(cache=True, error_model='numpy', nogil=True)
 def closed_loop_batch(x0, alpha, mu, gains, p, w, h, n_sub, path, inputs, costs):
     n_points, n_stages, n_x = alpha.shape
     n_u = mu.shape[2]
@@ -128,12 +131,34 @@ def _symbolic_kernels(dynamics: ca.Function, running_cost: ca.Function) -> dict[
     }
 
 
-def _chunks(n_points: int) -> Iterator[slice]:
-    for start in range(0, n_points, CHUNK):
-        yield slice(start, min(start + CHUNK, n_points))
+def _pieces(n_points: int, threads: int) -> list[slice]:
+    """Contiguous near-equal slices of the points: one per thread, none over :data:`CHUNK`."""
+    count = max(min(threads, n_points), -(-n_points // CHUNK), 1)
+    return [slice(i * n_points // count, (i + 1) * n_points // count) for i in range(count)]
 
+
+@functools.cache
+def _pool(threads: int) -> ThreadPoolExecutor:
+    """The process's worker threads for the kernels (made on first need, one pool per count)."""
+    return ThreadPoolExecutor(threads, thread_name_prefix="auvplan-kernels")
+
+
+# A forked child has none of its parent's threads: it makes its own pools.
+os.register_at_fork(after_in_child=_pool.cache_clear)
 
 _T = TypeVar("_T")
+_R = TypeVar("_R")
+
+
+def _map(function: Callable[[_T], _R], items: Sequence[_T], threads: int) -> list[_R]:
+    """``[function(item) for item in items]``, on ``threads`` threads when more than one.
+
+    The kernels release the GIL (``nogil``), and every point is computed by the same
+    arithmetic whichever piece it falls in: the results do not depend on ``threads``.
+    """
+    if threads == 1 or len(items) == 1:
+        return [function(item) for item in items]
+    return list(_pool(threads).map(function, items))
 
 
 @dataclass(eq=False)
@@ -181,7 +206,8 @@ class BlockKernels:
 
     Every method takes points on axis 0: ``x (B, n_x)``, ``u (B, n_u)``, ``p (B, n_p)``,
     weights ``w (B, n_w)``; ``h`` is the substep length [s] and ``n_substeps`` the substeps
-    per step.
+    per step. ``threads``: the points are split into that many pieces, evaluated on as many
+    threads (:func:`_map`; the same results for any number).
     """
 
     module: ModuleType
@@ -201,20 +227,22 @@ class BlockKernels:
         w: FloatArray,
         h: float,
         n_substeps: int,
+        threads: int,
         remember: bool = True,
     ) -> list[_Forward]:
-        """The forward sweeps of every chunk (reused when the arguments repeat).
+        """The forward sweeps of every piece of :func:`_pieces` (reused when the arguments repeat).
 
         ``remember=False`` leaves the remembered sweeps alone (e.g. Jacobians at other points
         between a linearisation and its Hessians).
         """
-        arguments = (x, u, p, w, np.array([h, n_substeps, CHUNK], dtype=np.float64))
+        arguments = (x, u, p, w, np.array([h, n_substeps, CHUNK, threads], dtype=np.float64))
         sweeps = self._last.get(*arguments)
         if sweeps is None:
-            sweeps = [
-                self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps)
-                for rows in _chunks(x.shape[0])
-            ]
+            sweeps = _map(
+                lambda rows: self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps),
+                _pieces(x.shape[0], threads),
+                threads,
+            )
             if remember:
                 self._last.put(sweeps, *arguments)
         return sweeps
@@ -284,6 +312,7 @@ class BlockKernels:
         h: float,
         n_substeps: int,
         remember: bool = True,
+        threads: int = 1,
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
         """``∂F/∂(x, u) (B, n_x, n_z)``, ``L (B,)`` and ``∇_{(x,u)} L (B, n_z)``.
 
@@ -292,8 +321,8 @@ class BlockKernels:
         n_z = self.n_x + self.n_u
         step_jac = np.empty((x.shape[0], self.n_x, n_z))
         cost, cost_grad = np.empty(x.shape[0]), np.empty((x.shape[0], n_z))
-        sweeps = self._sweeps(x, u, p, w, h, n_substeps, remember)
-        for rows, forward in zip(_chunks(x.shape[0]), sweeps, strict=True):
+        sweeps = self._sweeps(x, u, p, w, h, n_substeps, threads, remember)
+        for rows, forward in zip(_pieces(x.shape[0], threads), sweeps, strict=True):
             step_jac[rows], cost[rows], cost_grad[rows] = (
                 forward.step_jac, forward.cost, forward.cost_grad,
             )  # fmt: skip
@@ -309,14 +338,19 @@ class BlockKernels:
         n_substeps: int,
         costate: FloatArray,
         cost_weight: float = 1.0,
+        threads: int = 1,
     ) -> FloatArray:
         """``∇²_{(x,u)} (ν L + λᵀ F)`` of shape ``(B, n_z, n_z)`` (``λ = costate``, ``ν``)."""
         n_z = self.n_x + self.n_u
         total = np.zeros((x.shape[0], n_z, n_z))
-        sweeps = self._sweeps(x, u, p, w, h, n_substeps)
-        for rows, forward in zip(_chunks(x.shape[0]), sweeps, strict=True):
+        sweeps = self._sweeps(x, u, p, w, h, n_substeps, threads)
+
+        def reverse(piece: tuple[slice, _Forward]) -> None:
+            rows, forward = piece
             self._reverse(forward, u[rows], p[rows], w[rows], h, costate[rows], cost_weight,
                           total[rows])  # fmt: skip
+
+        _map(reverse, list(zip(_pieces(x.shape[0], threads), sweeps, strict=True)), threads)
         return total
 
     def _reverse(
@@ -361,6 +395,7 @@ class BlockKernels:
         w: FloatArray,
         h: float,
         n_substeps: int,
+        threads: int = 1,
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Independent closed-loop simulations ``u_k = μ_k + K_k (α_k − x_k)`` (held over a step).
 
@@ -395,11 +430,16 @@ class BlockKernels:
         path = np.empty((n_points, n_stages * n_substeps + 1, self.n_x))
         inputs = np.empty((n_points, n_stages, self.n_u))
         costs = np.empty((n_points, n_stages))
-        arrays = [np.ascontiguousarray(a) for a in (x0, reference_states, reference_inputs, gains)]
-        self.module.closed_loop_batch(
-            *arrays, np.ascontiguousarray(p), np.ascontiguousarray(w), h, n_substeps, path,
-            inputs, costs,
-        )  # fmt: skip
+        arrays = [
+            np.ascontiguousarray(a) for a in (x0, reference_states, reference_inputs, gains, p, w)
+        ]
+        _map(
+            lambda rows: self.module.closed_loop_batch(
+                *(a[rows] for a in arrays), h, n_substeps, path[rows], inputs[rows], costs[rows]
+            ),
+            _pieces(n_points, threads),
+            threads,
+        )
         return path, inputs, costs
 
 

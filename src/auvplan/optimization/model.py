@@ -71,7 +71,9 @@ def _discrete_model(problem: TrajectoryProblem, backend: StageBackend) -> StepMo
     if problem.blocks and backend.stage_kernels:
         sizes = (problem.n_states, problem.n_inputs, problem.n_parameters)
         try:
-            return BlockDiscreteModel.build(problem.blocks, sizes, problem.dt, problem.n_substeps)
+            return BlockDiscreteModel.build(
+                problem.blocks, sizes, problem.dt, problem.n_substeps, threads=backend.n_threads
+            )
         except UnsupportedOperation as error:
             logger.warning("stage kernels unavailable (%s): evaluating with CasADi", error)
     return discretize_rk4(

@@ -51,7 +51,8 @@ class StageBackend:
     """How the stage model is evaluated (see :class:`~auvplan.optimization.ProntoOptions`).
 
     ``stage_kernels``: compiled per-block kernels when the problem is separable;
-    ``compile_c``: C-compiled CasADi functions otherwise; ``n_threads``: CasADi map threads.
+    ``compile_c``: C-compiled CasADi functions otherwise; ``n_threads``: threads of the stage
+    evaluations.
     """
 
     stage_kernels: bool = True
@@ -96,7 +97,9 @@ class ProntoOptions:
         Terminal matrix of the projection regulator: discrete ARE at the last stage (falls
         back to ``Q_r`` when it fails), or ``Q_r``. Strings are converted to the enum.
     n_threads : int
-        Threads for the batched stage evaluations (CasADi ``map(N, "thread", n)``); 1 = serial.
+        Threads for the batched stage evaluations; 1 = serial. The compiled kernels split
+        their points (vehicle-stages) over them, with the same results for any number; CasADi
+        evaluates with ``map(N, "thread", n)``.
     stage_kernels : bool
         Evaluate a separable problem (``TrajectoryProblem.blocks``) with compiled per-block
         kernels (numba; compiled once per vehicle model and cached on disk, 10–25x faster

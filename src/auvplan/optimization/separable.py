@@ -152,6 +152,8 @@ class BlockDiscreteModel:
     dt: float
     n_substeps: int
     groups: tuple[_Group, ...] = field(repr=False)
+    threads: int = 1
+    """Threads the kernels split their points over (the same results for any number)."""
     _rolled: LastCall[FloatArray] = field(default_factory=LastCall, repr=False)
     """The stage costs of the last closed-loop :meth:`rollout`, by its stages, inputs and
     parameters: :meth:`cost` of that trajectory (a line-search trial) reads them."""
@@ -164,6 +166,7 @@ class BlockDiscreteModel:
         dt: float,
         n_substeps: int,
         cache_dir: Path | None = None,
+        threads: int = 1,
     ) -> BlockDiscreteModel:
         """Load (or compile once) the kernels of every distinct block model.
 
@@ -181,7 +184,7 @@ class BlockDiscreteModel:
             _Group(kernels, tuple(group), np.array([b.weights for b in group]))
             for kernels, group in members.values()
         )
-        return cls(*sizes, dt=dt, n_substeps=n_substeps, groups=groups)
+        return cls(*sizes, dt=dt, n_substeps=n_substeps, groups=groups, threads=threads)
 
     @property
     def h(self) -> float:
@@ -268,7 +271,9 @@ class BlockDiscreteModel:
         l_x, l_u = np.zeros((n_stages, self.n_x)), np.zeros((n_stages, self.n_u))
         for group in self.groups:
             points = self._points(group, states, inputs, parameters)
-            jac, total, grad = group.kernels.first_order(*points, self.h, self.n_substeps, remember)
+            jac, total, grad = group.kernels.first_order(
+                *points, self.h, self.n_substeps, remember, self.threads
+            )
             n_bx = group.kernels.n_x
             for i, block in enumerate(group.blocks):
                 rows = slice(i * n_stages, (i + 1) * n_stages)
@@ -304,8 +309,9 @@ class BlockDiscreteModel:
             points = self._points(group, states, inputs, parameters)
             weights = np.concatenate([costate_next[:, b.states] for b in group.blocks])
             hessian = group.kernels.hessian(
-                *points, self.h, self.n_substeps, np.ascontiguousarray(weights), cost_weight
-            )
+                *points, self.h, self.n_substeps, np.ascontiguousarray(weights), cost_weight,
+                self.threads,
+            )  # fmt: skip
             n_bx = group.kernels.n_x
             for i, block in enumerate(group.blocks):
                 rows = slice(i * n_stages, (i + 1) * n_stages)
@@ -375,6 +381,7 @@ class BlockDiscreteModel:
                 group.weights,
                 self.h,
                 self.n_substeps,
+                self.threads,
             )
             for i, block in enumerate(blocks):
                 states[:, block.states] = path[i, :: self.n_substeps]
