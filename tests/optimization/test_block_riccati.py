@@ -67,14 +67,17 @@ def test_regulator_per_subsystem_equals_the_whole(rng: np.random.Generator, coup
         assert np.all(parts[:, 0, 3:] == 0.0)  # subsystem 0's input ignores the others
 
 
-def test_lq_sweep_by_components_equals_the_dense_sweep(rng: np.random.Generator) -> None:
-    """Weights block-diagonal but for subsystems 0 and 1 coupled at stage 25 (a near pass)."""
+@pytest.mark.parametrize("pair", [(0, 1), (0, 2)])  # adjacent, and with a subsystem between
+def test_lq_sweep_by_components_equals_the_dense_sweep(
+    rng: np.random.Generator, pair: tuple[int, int]
+) -> None:
+    """Weights block-diagonal but for two subsystems coupled at stage 25 (a near pass)."""
     a, b = _block_diagonal_dynamics(rng)
     w = np.zeros((N, N_X + N_U, N_X + N_U))
     for group in _groups():
         z = rng.normal(size=(N, group.size, group.size))
         w[:, group[:, None], group] = z @ np.swapaxes(z, 1, 2) + np.eye(group.size)
-    coupled = np.r_[_groups()[0], _groups()[1]]
+    coupled = np.r_[_groups()[pair[0]], _groups()[pair[1]]]
     z = rng.normal(size=(coupled.size, coupled.size))
     w[25, coupled[:, None], coupled] += z @ z.T
     q, s, r = w[:, :N_X, :N_X].copy(), w[:, :N_X, N_X:].copy(), w[:, N_X:, N_X:].copy()
@@ -99,11 +102,12 @@ def test_lq_sweep_by_components_equals_the_dense_sweep(rng: np.random.Generator)
     reused = _kernels.lq_feedforward(a, b, parts[0], parts[2], other_x, other_u, other_m)
     np.testing.assert_allclose(reused, again[1], rtol=1e-9, atol=1e-11)
     assert not np.allclose(reused, parts[1])
-    # subsystems 0 and 1 are coupled up to the near pass, independent after it; 2 never
-    inputs_0, states_1, states_2 = slice(0, 1), slice(3, 8), slice(8, 12)
-    assert np.all(np.abs(dense[0][:26, inputs_0, states_1]) > 0.0)
-    assert np.all(dense[0][26:, inputs_0, states_1] == 0.0)
-    assert np.all(dense[0][:, inputs_0, states_2] == 0.0)
+    # the pair is coupled up to the near pass, independent after it; the third never
+    states = (slice(0, 3), slice(3, 8), slice(8, 12))
+    inputs_0, other = slice(0, 1), ({1, 2} - {pair[1]}).pop()
+    assert np.all(np.abs(dense[0][:26, inputs_0, states[pair[1]]]) > 0.0)
+    assert np.all(dense[0][26:, inputs_0, states[pair[1]]] == 0.0)
+    assert np.all(dense[0][:, inputs_0, states[other]] == 0.0)
 
 
 def test_regulator_on_replaced_stages_equals_the_regulator_on_the_edited_linearisation(
@@ -129,15 +133,18 @@ def _projected(w: np.ndarray, floor: float) -> np.ndarray:
     return np.einsum("kij,kj,klj->kil", vectors, np.maximum(values, floor), vectors)
 
 
-def test_clipped_lq_sweep_is_the_sweep_of_the_projected_weights(rng: np.random.Generator) -> None:
-    """Indefinite stage weights (subsystems 0 and 1 coupled at some stages, a state on its
-    own): the sweep with ``floor`` equals the plain sweep on the weights projected by numpy."""
+@pytest.mark.parametrize("pair", [(0, 1), (0, 2)])
+def test_clipped_lq_sweep_is_the_sweep_of_the_projected_weights(
+    rng: np.random.Generator, pair: tuple[int, int]
+) -> None:
+    """Indefinite stage weights (two subsystems coupled at some stages, a state on its own):
+    the sweep with ``floor`` equals the plain sweep on the weights projected by numpy."""
     a, b = _block_diagonal_dynamics(rng)
     w = np.zeros((N, N_X + N_U, N_X + N_U))
     for group in _groups():
         z = rng.normal(size=(N, group.size, group.size))
         w[:, group[:, None], group] = z @ np.swapaxes(z, 1, 2) - 2.0 * np.eye(group.size)
-    coupled = np.r_[_groups()[0], _groups()[1]]
+    coupled = np.r_[_groups()[pair[0]], _groups()[pair[1]]]
     w[::4, coupled[0], coupled[-1]] = w[::4, coupled[-1], coupled[0]] = 0.7
     w[:, 9, :] = w[:, :, 9] = 0.0  # a state that nothing couples: a 1 x 1 block
     w[:, 9, 9] = rng.normal(size=N)

@@ -14,51 +14,49 @@ from auvplan._typing import FloatArray, IntArray
 
 
 @numba.njit(cache=True)
-def _cholesky(matrix: FloatArray) -> tuple[FloatArray, bool]:
-    """Lower Cholesky factor of a symmetric matrix; ``ok`` is False unless strictly PD."""
-    n = matrix.shape[0]
-    lower = np.zeros((n, n))
+def _solve_in_place(matrix: FloatArray, n: int, rhs: FloatArray, width: int) -> bool:
+    """``rhs[:n, :width] ← M⁻¹ rhs`` for ``M = ½(A + Aᵀ)``, ``A = matrix[:n, :n]``.
+
+    By Cholesky, the factor written over ``matrix``'s lower triangle. Returns False (``rhs``
+    unsolved) unless ``M`` is strictly positive definite.
+    """
     for j in range(n):
         diag = matrix[j, j]
         for k in range(j):
-            diag -= lower[j, k] * lower[j, k]
+            diag -= matrix[j, k] * matrix[j, k]
         if not diag > 0.0:  # also catches NaN
-            return lower, False
-        lower[j, j] = np.sqrt(diag)
+            return False
+        matrix[j, j] = np.sqrt(diag)
         for i in range(j + 1, n):
-            value = matrix[i, j]
+            value = 0.5 * (matrix[i, j] + matrix[j, i])
             for k in range(j):
-                value -= lower[i, k] * lower[j, k]
-            lower[i, j] = value / lower[j, j]
-    return lower, True
-
-
-@numba.njit(cache=True)
-def _cholesky_solve(lower: FloatArray, rhs: FloatArray) -> FloatArray:
-    """Solve ``(L Lᵀ) X = rhs`` for a 2-D right-hand side."""
-    n, m = rhs.shape
-    out = rhs.copy()
-    for c in range(m):
-        for i in range(n):
-            value = out[i, c]
-            for k in range(i):
-                value -= lower[i, k] * out[k, c]
-            out[i, c] = value / lower[i, i]
-        for i in range(n - 1, -1, -1):
-            value = out[i, c]
-            for k in range(i + 1, n):
-                value -= lower[k, i] * out[k, c]
-            out[i, c] = value / lower[i, i]
-    return out
+                value -= matrix[i, k] * matrix[j, k]
+            matrix[i, j] = value / matrix[j, j]
+    for i in range(n):  # L y = rhs, row by row over every column
+        for k in range(i):
+            factor = matrix[i, k]
+            for col in range(width):
+                rhs[i, col] -= factor * rhs[k, col]
+        for col in range(width):
+            rhs[i, col] /= matrix[i, i]
+    for i in range(n - 1, -1, -1):  # Lᵀ x = y
+        for k in range(i + 1, n):
+            factor = matrix[k, i]
+            for col in range(width):
+                rhs[i, col] -= factor * rhs[k, col]
+        for col in range(width):
+            rhs[i, col] /= matrix[i, i]
+    return True
 
 
 @numba.njit(cache=True)
 def _above_floor(matrix: FloatArray, floor: float) -> bool:
     """Whether ``matrix − floor·I`` passes the Cholesky test (all eigenvalues above ``floor``)."""
+    n = matrix.shape[0]
     shifted = matrix.copy()
-    for i in range(matrix.shape[0]):
+    for i in range(n):
         shifted[i, i] -= floor
-    return _cholesky(shifted)[1]
+    return _solve_in_place(shifted, n, np.empty((n, 0)), 0)
 
 
 @numba.njit(cache=True)
@@ -206,12 +204,11 @@ def regulator_riccati(
         b = b_mat[k]
         pb = p_next @ b
         m = r_r + b.T @ pb
-        lower, is_pd = _cholesky(0.5 * (m + m.T))
-        if not is_pd:
+        g = pb.T @ a
+        gain = g.copy()
+        if not _solve_in_place(m, n_u, gain, n_x):
             ok = False
             break
-        g = pb.T @ a
-        gain = _cholesky_solve(lower, g)
         gains[k] = gain
         p = q_r + a.T @ p_next @ a - g.T @ gain
         p_next = 0.5 * (p + p.T)
@@ -239,37 +236,6 @@ def closed_loop_costate(
             - gains[k].T @ (b_mat[k].T @ lam[k + 1])
         )
     return lam
-
-
-@numba.njit(cache=True)
-def _block_diagonal_transpose_times(
-    diagonal: FloatArray, matrix: FloatArray, rows: IntArray, columns: IntArray
-) -> FloatArray:
-    """``diagonalᵀ @ matrix`` for a block-diagonal ``diagonal``, without transposed copies.
-
-    Block ``b`` is ``diagonal[rows[b, 0]:rows[b, 1], columns[b, 0]:columns[b, 1]]``; entries
-    outside the blocks are taken as zero. ``matrix @ diagonal`` is the transpose of
-    ``diagonalᵀ @ matrixᵀ`` (``matrix.T``, a view).
-    """
-    out = np.zeros((diagonal.shape[1], matrix.shape[1]))
-    for b in range(rows.shape[0]):
-        for j in range(columns[b, 0], columns[b, 1]):
-            for k in range(rows[b, 0], rows[b, 1]):
-                d = diagonal[k, j]
-                if d != 0.0:
-                    for c in range(matrix.shape[1]):
-                        out[j, c] += d * matrix[k, c]
-    return out
-
-
-@numba.njit(cache=True)
-def _gather(matrix: FloatArray, rows: IntArray, columns: IntArray) -> FloatArray:
-    """``matrix[rows][:, columns]`` in one pass."""
-    out = np.empty((rows.size, columns.size))
-    for i in range(rows.size):
-        for j in range(columns.size):
-            out[i, j] = matrix[rows[i], columns[j]]
-    return out
 
 
 @numba.njit(cache=True)
@@ -322,6 +288,105 @@ def _component(
 
 
 @numba.njit(cache=True)
+def _gather_component(
+    matrix: FloatArray, rows: IntArray, columns: IntArray, out: FloatArray
+) -> None:
+    """``out[:len(rows), :len(columns)] = matrix[rows][:, columns]`` (a workspace, no copy made)."""
+    for i in range(rows.size):
+        for j in range(columns.size):
+            out[i, j] = matrix[rows[i], columns[j]]
+
+
+@numba.njit(cache=True)
+def _block_transpose_times(
+    block: FloatArray,
+    row_offset: int,
+    column_offset: int,
+    rows: tuple[int, int],
+    columns: tuple[int, int],
+    p: FloatArray,
+    n: int,
+    out: FloatArray,
+) -> None:
+    """``out[j, :n] = Σ_k block[row_offset + k, column_offset + j] p[k, :n]``.
+
+    ``k`` and ``j`` run over the local ranges ``rows`` and ``columns``; exact zeros of
+    ``block`` are skipped.
+    """
+    for j in range(columns[0], columns[1]):
+        for col in range(n):
+            out[j, col] = 0.0
+        for k in range(rows[0], rows[1]):
+            entry = block[row_offset + k, column_offset + j]
+            if entry != 0.0:
+                for col in range(n):
+                    out[j, col] += entry * p[k, col]
+
+
+@numba.njit(cache=True)
+def _transposed_products(
+    a: FloatArray,
+    b: FloatArray,
+    p: FloatArray,
+    xs: IntArray,
+    us: IntArray,
+    xb: IntArray,
+    ub: IntArray,
+    ap: FloatArray,
+    bp: FloatArray,
+) -> None:
+    """``AᵀP`` and ``BᵀP`` of a component into the workspaces ``ap``, ``bp``.
+
+    ``p`` is the component's ``P`` (local rows); ``A``, ``B`` are the stage's whole matrices,
+    block-diagonal: local block ``c`` has states ``xb[c]`` and inputs ``ub[c]`` (``(start,
+    stop)``), which are contiguous in the whole vectors from ``xs[xb[c, 0]]`` and
+    ``us[ub[c, 0]]``.
+    """
+    for c in range(xb.shape[0]):
+        x0, x1, u0, u1 = xb[c, 0], xb[c, 1], ub[c, 0], ub[c, 1]
+        gx, gu = xs[x0] - x0, (us[u0] - u0) if u1 > u0 else 0  # local -> whole index offsets
+        _block_transpose_times(a, gx, gx, (x0, x1), (x0, x1), p, xs.size, ap)
+        _block_transpose_times(b, gx, gu, (x0, x1), (u0, u1), p, xs.size, bp)
+
+
+@numba.njit(cache=True)
+def _add_right_products(
+    a: FloatArray,
+    b: FloatArray,
+    ap: FloatArray,
+    bp: FloatArray,
+    xs: IntArray,
+    us: IntArray,
+    xb: IntArray,
+    ub: IntArray,
+    apa: FloatArray,
+    bpa: FloatArray,
+    bpb: FloatArray,
+) -> None:
+    """``apa += (AᵀP) A``, ``bpa += (BᵀP) A``, ``bpb += (BᵀP) B``.
+
+    Blocks as in :func:`_transposed_products`.
+    """
+    n, m = xs.size, us.size
+    for c in range(xb.shape[0]):
+        x0, x1, u0, u1 = xb[c, 0], xb[c, 1], ub[c, 0], ub[c, 1]
+        gx, gu = xs[x0] - x0, (us[u0] - u0) if u1 > u0 else 0
+        for k in range(x0, x1):
+            for j in range(x0, x1):
+                entry = a[gx + k, gx + j]
+                if entry != 0.0:
+                    for i in range(n):
+                        apa[i, j] += ap[i, k] * entry
+                    for i in range(m):
+                        bpa[i, j] += bp[i, k] * entry
+            for j in range(u0, u1):
+                entry = b[gx + k, gu + j]
+                if entry != 0.0:
+                    for i in range(m):
+                        bpb[i, j] += bp[i, k] * entry
+
+
+@numba.njit(cache=True)
 def lq_backward(
     a_mat: FloatArray,
     b_mat: FloatArray,
@@ -346,7 +411,10 @@ def lq_backward(
     decreases) and runs on each on its own, where every matrix is block-diagonal in them:
     ``O(Σ_c n_c³)`` per stage instead of ``O(n_x³)`` (vehicles far apart, whose separation
     barriers vanish, stay apart). Products with ``A_k``, ``B_k`` inside a component use its
-    blocks (``O(n_c² n_block)``).
+    blocks and skip their exact zeros (``O(n_c² n_block)``). With ``G = Sᵀ + BᵀPA``,
+    ``M = R + BᵀPB`` and ``g = l_u + Bᵀr`` (``P``, ``r`` of stage ``k + 1``), stage ``k`` has
+    ``K = M⁻¹G``, ``v = −M⁻¹g``, ``P ← Q + AᵀPA − GᵀK`` and ``r ← l_x + Aᵀr − Kᵀg``, all
+    formed in workspaces allocated once per sweep.
 
     With ``floor > 0`` every stage's weights ``W_k = [[Q_k, S_k], [S_kᵀ, R_k]]`` are replaced
     by their projection onto ``{W ⪰ floor·I}`` (eigenvalues clipped at ``floor``, per
@@ -367,51 +435,80 @@ def lq_backward(
     m_inverse = np.zeros((n_stages, n_u, n_u))
     p = p_final.copy()
     r = r_final.copy()
+    # workspaces, a component's in their leading rows and columns
+    p_c, ap, apa = np.empty((n_x, n_x)), np.empty((n_x, n_x)), np.empty((n_x, n_x))
+    s_c, bp, bpa = np.empty((n_x, n_u)), np.empty((n_u, n_x)), np.empty((n_u, n_x))
+    bpb = np.empty((n_u, n_u))
+    r_c, r_new, g = np.empty(n_x), np.empty(n_x), np.empty(n_u)
+    solution = np.empty((n_u, n_x + 1 + n_u))  # [K | −v | M⁻¹]
     _join_coupled(p, x_owner, x_owner, parent)
     for k in range(n_stages - 1, -1, -1):
         _join_coupled(q_mat[k], x_owner, x_owner, parent)
         _join_coupled(s_mat[k], x_owner, u_owner, parent)
         _join_coupled(r_mat[k], u_owner, u_owner, parent)
+        a, b = a_mat[k], b_mat[k]
         for root in range(n_blocks):
             if _root(parent, root) != root:
                 continue
             xs, us, xb, ub = _component(parent, root, x_blocks, u_blocks)
-            a, b = _gather(a_mat[k], xs, xs), _gather(b_mat[k], xs, us)
-            p_c = _gather(p, xs, xs)
-            q_c, s_c, r_c = (
-                _gather(q_mat[k], xs, xs),
-                _gather(s_mat[k], xs, us),
-                _gather(r_mat[k], us, us),
-            )
+            n, m = xs.size, us.size
+            _gather_component(p, xs, xs, p_c)
+            _gather_component(q_mat[k], xs, xs, apa)  # AᵀPA is added to Q
+            _gather_component(s_mat[k], xs, us, s_c)
+            _gather_component(r_mat[k], us, us, bpb)  # BᵀPB is added to R
             if floor > 0.0:
-                q_c, s_c, r_c = _clipped_stage(q_c, s_c, r_c, floor)
-            pa = _block_diagonal_transpose_times(a, p_c.T, xb, xb).T  # P A
-            pb = _block_diagonal_transpose_times(b, p_c.T, xb, ub).T  # P B
-            m = r_c + _block_diagonal_transpose_times(b, pb, xb, ub)  # R + Bᵀ P B
-            lower, is_pd = _cholesky(0.5 * (m + m.T))
-            if not is_pd:
+                q_clip, s_clip, r_clip = _clipped_stage(
+                    apa[:n, :n], s_c[:n, :m], bpb[:m, :m], floor
+                )
+                apa[:n, :n], s_c[:n, :m], bpb[:m, :m] = q_clip, s_clip, r_clip
+            for i in range(m):
+                for j in range(n):
+                    bpa[i, j] = s_c[j, i]  # BᵀPA is added to Sᵀ
+            for i in range(n):
+                r_c[i] = r[xs[i]]
+            _transposed_products(a, b, p_c, xs, us, xb, ub, ap, bp)
+            _add_right_products(a, b, ap, bp, xs, us, xb, ub, apa, bpa, bpb)
+            for i in range(m):  # g = l_u + Bᵀr
+                g[i] = l_u[k, us[i]]
+            for c in range(xb.shape[0]):
+                x0, x1, u0, u1 = xb[c, 0], xb[c, 1], ub[c, 0], ub[c, 1]
+                gx, gu = xs[x0] - x0, (us[u0] - u0) if u1 > u0 else 0
+                for i in range(u0, u1):
+                    for j in range(x0, x1):
+                        g[i] += b[gx + j, gu + i] * r_c[j]
+            for i in range(m):  # [G | g | I] → [K | −v | M⁻¹]
+                for j in range(n):
+                    solution[i, j] = bpa[i, j]
+                solution[i, n] = g[i]
+                for j in range(m):
+                    solution[i, n + 1 + j] = 1.0 if i == j else 0.0
+            if not _solve_in_place(bpb, m, solution, n + 1 + m):
                 return feedback, feedforward, m_inverse, k
-            g_mat = (s_c + _block_diagonal_transpose_times(a, pb, xb, xb)).T  # Sᵀ + (P B)ᵀ A
-            g_vec = l_u[k][us] + b.T @ r[xs]
-            rhs = np.zeros((us.size, xs.size + 1 + us.size))
-            rhs[:, : xs.size] = g_mat
-            rhs[:, xs.size] = g_vec
-            for i in range(us.size):
-                rhs[i, xs.size + 1 + i] = 1.0
-            sol = _cholesky_solve(lower, rhs)
-            gain = sol[:, : xs.size].copy()
-            p_new = q_c + _block_diagonal_transpose_times(a, pa, xb, xb) - g_mat.T @ gain
-            r_new = l_x[k][xs] + a.T @ r[xs] - gain.T @ g_vec
-            for i in range(us.size):
-                feedforward[k, us[i]] = -sol[i, xs.size]
-                for j in range(xs.size):
-                    feedback[k, us[i], xs[j]] = gain[i, j]
-                for j in range(us.size):
-                    m_inverse[k, us[i], us[j]] = sol[i, xs.size + 1 + j]
-            for i in range(xs.size):
+            for i in range(n):  # r ← l_x + Aᵀr − Kᵀg
+                r_new[i] = l_x[k, xs[i]]
+            for c in range(xb.shape[0]):
+                x0, x1 = xb[c, 0], xb[c, 1]
+                gx = xs[x0] - x0
+                for j in range(x0, x1):
+                    for i in range(x0, x1):
+                        r_new[j] += a[gx + i, gx + j] * r_c[i]
+            for i in range(m):  # and P ← Q + AᵀPA − GᵀK (row i of K, G)
+                for j in range(n):
+                    r_new[j] -= solution[i, j] * g[i]
+                for row in range(n):
+                    factor = bpa[i, row]
+                    for j in range(n):
+                        apa[row, j] -= factor * solution[i, j]
+            for i in range(n):
                 r[xs[i]] = r_new[i]
-                for j in range(xs.size):
-                    p[xs[i], xs[j]] = 0.5 * (p_new[i, j] + p_new[j, i])
+                for j in range(n):
+                    p[xs[i], xs[j]] = 0.5 * (apa[i, j] + apa[j, i])
+            for i in range(m):
+                feedforward[k, us[i]] = -solution[i, n]
+                for j in range(n):
+                    feedback[k, us[i], xs[j]] = solution[i, j]
+                for j in range(m):
+                    m_inverse[k, us[i], us[j]] = solution[i, n + 1 + j]
     return feedback, feedforward, m_inverse, -1
 
 
