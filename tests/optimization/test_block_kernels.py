@@ -9,8 +9,6 @@ gradient, and a Python loop of single substeps for the closed loop.
 from __future__ import annotations
 
 import importlib
-import os
-import warnings
 from collections.abc import Callable
 from pathlib import Path
 
@@ -200,23 +198,6 @@ def test_hessian_matches_differences_of_the_kernel_gradient(
     assert_close(kernels.hessian(x, u, p, w, h, n_substeps, costate), differences, 1e-7)
 
 
-def test_pieces_tile_the_points_one_per_thread_and_none_over_a_chunk(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    monkeypatch.setattr(kernel_module, "CHUNK", 3)
-    for n_points in (1, 2, 7, 8, 20):
-        for threads in (1, 2, 3, 5):
-            pieces = kernel_module._pieces(n_points, threads)
-            covered = np.concatenate([np.arange(n_points)[rows] for rows in pieces])
-            np.testing.assert_array_equal(covered, np.arange(n_points))  # in order, once each
-            sizes = [rows.stop - rows.start for rows in pieces]
-            assert min(sizes) >= 1
-            assert max(sizes) <= 3
-            assert max(sizes) - min(sizes) <= 1
-            assert len(pieces) >= min(threads, n_points)
-    assert len(kernel_module._pieces(8, 1)) == 3  # chunks of 3, 3 and 2 points
-
-
 @pytest.mark.parametrize("threads", [1, 2, 3])
 def test_pieces_and_threads_give_the_one_piece_results_to_the_bit(
     compiled: dict[str, BlockKernels],
@@ -249,26 +230,6 @@ def test_pieces_and_threads_give_the_one_piece_results_to_the_bit(
     monkeypatch.setattr(kernel_module, "CHUNK", 3)  # pieces of 3, 3 and 2 points (or more)
     for one, many in zip(whole, evaluate(threads), strict=True):
         np.testing.assert_array_equal(many, one)
-
-
-def test_a_forked_child_makes_its_own_worker_threads() -> None:
-    """A pool made before a fork has no threads in the child: the child must not use it."""
-    parent_pool = kernel_module._pool(2)
-    reader, writer = os.pipe()
-    with warnings.catch_warnings():  # Python ≥ 3.12 warns of fork() beside threads
-        warnings.simplefilter("ignore", DeprecationWarning)
-        child = os.fork()
-    if child == 0:  # pragma: no cover (the child reports through the pipe)
-        try:
-            pool = kernel_module._pool(2)
-            answer = pool.submit(lambda: 42).result(timeout=10)
-            os.write(writer, b"new" if pool is not parent_pool and answer == 42 else b"old")
-        finally:
-            os._exit(0)
-    os.close(writer)
-    _, status = os.waitpid(child, 0)
-    assert os.read(reader, 3) == b"new"
-    assert status == 0
 
 
 def test_jacobians_elsewhere_keep_the_linearisation_s_sweeps(

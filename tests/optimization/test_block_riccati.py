@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from auvplan.optimization import _kernels, design_regulator
+from auvplan.optimization import StageWeights, _kernels, convexify, design_regulator
 from auvplan.optimization.lq import block_ranges
 
 SIZES = ((3, 1), (5, 2), (4, 2))  # (states, inputs) of three subsystems
@@ -162,3 +162,11 @@ def test_clipped_lq_sweep_is_the_sweep_of_the_projected_weights(
     np.testing.assert_allclose(clipped[0], plain[0], rtol=1e-9, atol=1e-11)
     np.testing.assert_allclose(clipped[1], plain[1], rtol=1e-9, atol=1e-11)
     assert sweep(w, 0.0)[3] >= 0  # unclipped, the sweep fails
+    # clipped before the sweep, stages split over threads (the ladder on several threads):
+    # the sweep's own clipping, to the bit
+    q, s, r = (w[:, :N_X, :N_X], w[:, :N_X, N_X:], w[:, N_X:, N_X:])
+    for threads in (1, 3):
+        weights = convexify(StageWeights(q, s, r, p_final), 0.5, threads)
+        args = (a, b, weights.Q, weights.S, weights.R, l_x, l_u, p_final, m_x)
+        for ours, theirs in zip(_kernels.lq_backward(*args, *blocks, 0.0), clipped, strict=True):
+            np.testing.assert_array_equal(ours, theirs)

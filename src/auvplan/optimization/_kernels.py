@@ -171,7 +171,7 @@ def _clipped_stage(
     return stage[:n_x, :n_x].copy(), stage[:n_x, n_x:].copy(), stage[n_x:, n_x:].copy()
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def clip_stage_weights(
     q_mat: FloatArray, s_mat: FloatArray, r_mat: FloatArray, floor: float
 ) -> tuple[FloatArray, FloatArray, FloatArray]:

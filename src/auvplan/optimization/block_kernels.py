@@ -19,13 +19,9 @@ order through the ``4m`` model evaluations (:mod:`~auvplan.optimization._chain`)
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import logging
-import os
 import time
-from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
@@ -43,6 +39,7 @@ from auvplan.optimization._numba_codegen import (
     UnsupportedOperation,
     numba_source,
 )
+from auvplan.optimization._threads import map_threads, pieces
 
 __all__ = ["BlockKernels", "block_kernels"]
 
@@ -131,34 +128,12 @@ def _symbolic_kernels(dynamics: ca.Function, running_cost: ca.Function) -> dict[
     }
 
 
-def _pieces(n_points: int, threads: int) -> list[slice]:
-    """Contiguous near-equal slices of the points: one per thread, none over :data:`CHUNK`."""
-    count = max(min(threads, n_points), -(-n_points // CHUNK), 1)
-    return [slice(i * n_points // count, (i + 1) * n_points // count) for i in range(count)]
-
-
-@functools.cache
-def _pool(threads: int) -> ThreadPoolExecutor:
-    """The process's worker threads for the kernels (made on first need, one pool per count)."""
-    return ThreadPoolExecutor(threads, thread_name_prefix="auvplan-kernels")
-
-
-# A forked child has none of its parent's threads: it makes its own pools.
-os.register_at_fork(after_in_child=_pool.cache_clear)
-
 _T = TypeVar("_T")
-_R = TypeVar("_R")
 
 
-def _map(function: Callable[[_T], _R], items: Sequence[_T], threads: int) -> list[_R]:
-    """``[function(item) for item in items]``, on ``threads`` threads when more than one.
-
-    The kernels release the GIL (``nogil``), and every point is computed by the same
-    arithmetic whichever piece it falls in: the results do not depend on ``threads``.
-    """
-    if threads == 1 or len(items) == 1:
-        return [function(item) for item in items]
-    return list(_pool(threads).map(function, items))
+def _pieces(n_points: int, threads: int) -> list[slice]:
+    """The points in one piece per thread, none over :data:`CHUNK`."""
+    return pieces(n_points, threads, CHUNK)
 
 
 @dataclass(eq=False)
@@ -207,7 +182,8 @@ class BlockKernels:
     Every method takes points on axis 0: ``x (B, n_x)``, ``u (B, n_u)``, ``p (B, n_p)``,
     weights ``w (B, n_w)``; ``h`` is the substep length [s] and ``n_substeps`` the substeps
     per step. ``threads``: the points are split into that many pieces, evaluated on as many
-    threads (:func:`_map`; the same results for any number).
+    threads (:func:`~auvplan.optimization._threads.map_threads`; the same results for any
+    number).
     """
 
     module: ModuleType
@@ -238,7 +214,7 @@ class BlockKernels:
         arguments = (x, u, p, w, np.array([h, n_substeps, CHUNK, threads], dtype=np.float64))
         sweeps = self._last.get(*arguments)
         if sweeps is None:
-            sweeps = _map(
+            sweeps = map_threads(
                 lambda rows: self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps),
                 _pieces(x.shape[0], threads),
                 threads,
@@ -350,7 +326,7 @@ class BlockKernels:
             self._reverse(forward, u[rows], p[rows], w[rows], h, costate[rows], cost_weight,
                           total[rows])  # fmt: skip
 
-        _map(reverse, list(zip(_pieces(x.shape[0], threads), sweeps, strict=True)), threads)
+        map_threads(reverse, list(zip(_pieces(x.shape[0], threads), sweeps, strict=True)), threads)
         return total
 
     def _reverse(
@@ -433,7 +409,7 @@ class BlockKernels:
         arrays = [
             np.ascontiguousarray(a) for a in (x0, reference_states, reference_inputs, gains, p, w)
         ]
-        _map(
+        map_threads(
             lambda rows: self.module.closed_loop_batch(
                 *(a[rows] for a in arrays), h, n_substeps, path[rows], inputs[rows], costs[rows]
             ),

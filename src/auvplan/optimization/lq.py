@@ -16,6 +16,7 @@ import numpy as np
 from auvplan._typing import FloatArray, IntArray
 from auvplan.errors import SolverError
 from auvplan.optimization import _kernels
+from auvplan.optimization._threads import map_threads, pieces
 from auvplan.optimization.stages import Linearization, StageWeights
 
 __all__ = [
@@ -39,25 +40,27 @@ class DirectionType(enum.Enum):
     STEEPEST = "steepest"
 
 
-def convexify(weights: StageWeights, floor: float) -> StageWeights:
+def convexify(weights: StageWeights, floor: float, threads: int = 1) -> StageWeights:
     """Clip the eigenvalues of every ``[[Q, S], [Sᵀ, R]]`` and of ``P_N`` at ``floor``.
 
-    The convexified model of the ladder as arrays (:func:`solve_lq_direction` clips inside its
-    Riccati sweep instead, without these copies). Only the blocks of coupled coordinates that
-    fail a Cholesky test above the floor change
-    (:func:`auvplan.optimization._kernels.clip_stage_weights`).
+    The convexified model of the ladder as arrays (:func:`solve_lq_direction` on one thread
+    clips inside its Riccati sweep instead, without these copies). Only the blocks of coupled
+    coordinates that fail a Cholesky test above the floor change
+    (:func:`auvplan.optimization._kernels.clip_stage_weights`); the stages are split over
+    ``threads`` threads (the same results for any number).
 
     Returns
     -------
     StageWeights
         Positive-definite weights (projection onto ``{W ⪰ floor·I}`` per stage).
     """
-    q_mat, s_mat, r_mat = _kernels.clip_stage_weights(
-        np.ascontiguousarray(weights.Q),
-        np.ascontiguousarray(weights.S),
-        np.ascontiguousarray(weights.R),
-        floor,
+    q, s, r = (np.ascontiguousarray(w) for w in (weights.Q, weights.S, weights.R))
+    parts = map_threads(
+        lambda rows: _kernels.clip_stage_weights(q[rows], s[rows], r[rows], floor),
+        pieces(q.shape[0], threads, q.shape[0]),
+        threads,
     )
+    q_mat, s_mat, r_mat = (np.concatenate(part) for part in zip(*parts, strict=True))
     return StageWeights(q_mat, s_mat, r_mat, _clipped_matrix(weights.P_N, floor))
 
 
@@ -215,6 +218,7 @@ def solve_lq_direction(
     steepest_weights: StageWeights | None = None,
     eigenvalue_floor: float = 1e-8,
     groups: tuple[IntArray, ...] = (),
+    threads: int = 1,
 ) -> LqDirection:
     """Search direction by the discrete Riccati recursion with cross term (§6.3).
 
@@ -239,6 +243,9 @@ def solve_lq_direction(
     groups : tuple of ndarray
         Independent subsystems' indices of ``(x, u)``; ``A_k`` and ``B_k`` are block-diagonal
         in them (:func:`block_ranges`), which the Riccati sweep uses.
+    threads : int
+        With more than one, the convexified model's stages are clipped on as many threads
+        before its sweep (:func:`convexify`) instead of by the sweep: the same direction.
 
     Returns
     -------
@@ -255,13 +262,17 @@ def solve_lq_direction(
     if direction is not None:
         return direction
     base = quasi_weights() if quasi_weights is not None else weights
-    direction = _try_direction(
-        linearization,
-        StageWeights(base.Q, base.S, base.R, _clipped_matrix(base.P_N, eigenvalue_floor)),
-        DirectionType.CONVEXIFIED,
-        blocks,
-        eigenvalue_floor,
-    )
+    if threads > 1:
+        convexified = convexify(base, eigenvalue_floor, threads)
+        direction = _try_direction(linearization, convexified, DirectionType.CONVEXIFIED, blocks)
+    else:
+        direction = _try_direction(
+            linearization,
+            StageWeights(base.Q, base.S, base.R, _clipped_matrix(base.P_N, eigenvalue_floor)),
+            DirectionType.CONVEXIFIED,
+            blocks,
+            eigenvalue_floor,
+        )
     if direction is not None:
         return direction
     if steepest_weights is not None:

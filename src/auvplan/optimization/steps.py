@@ -182,7 +182,8 @@ def compute_direction(
     model, trajectory, epsilon, delta, first_order
         As for :func:`local_model`.
     options : ProntoOptions, optional
-        ``terminal_regulator``, ``fallback_model`` and ``eigenvalue_floor`` are used.
+        ``terminal_regulator``, ``fallback_model``, ``eigenvalue_floor`` and ``n_threads`` are
+        used.
 
     Returns
     -------
@@ -207,6 +208,7 @@ def compute_direction(
         steepest_weights=steepest_weights(model.problem),
         eigenvalue_floor=options.eigenvalue_floor,
         groups=coordinate_groups(model.problem.blocks, model.problem.n_states),
+        threads=options.n_threads,
     )
     return local, direction
 

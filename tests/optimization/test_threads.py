@@ -1,0 +1,49 @@
+"""Worker threads of the batched kernels: pieces tile the batch; a forked child has its own pool."""
+
+from __future__ import annotations
+
+import os
+import warnings
+
+import numpy as np
+
+from auvplan.optimization import _threads
+
+
+def test_pieces_tile_the_items_one_per_thread_and_none_over_the_largest() -> None:
+    for n_items in (1, 2, 7, 8, 20):
+        for threads in (1, 2, 3, 5):
+            pieces = _threads.pieces(n_items, threads, 3)
+            covered = np.concatenate([np.arange(n_items)[rows] for rows in pieces])
+            np.testing.assert_array_equal(covered, np.arange(n_items))  # in order, once each
+            sizes = [rows.stop - rows.start for rows in pieces]
+            assert min(sizes) >= 1
+            assert max(sizes) <= 3
+            assert max(sizes) - min(sizes) <= 1
+            assert len(pieces) >= min(threads, n_items)
+    assert len(_threads.pieces(8, 1, 3)) == 3  # 3, 3 and 2 items
+
+
+def test_map_threads_keeps_the_order_of_the_items() -> None:
+    assert _threads.map_threads(lambda i: i * i, list(range(7)), 3) == [i * i for i in range(7)]
+
+
+def test_a_forked_child_makes_its_own_worker_threads() -> None:
+    """A pool made before a fork has no threads in the child: the child must not use it."""
+    parent_pool = _threads._pool(2)
+    assert parent_pool.submit(lambda: 1).result(timeout=10) == 1  # its threads are running
+    reader, writer = os.pipe()
+    with warnings.catch_warnings():  # Python ≥ 3.12 warns of fork() beside threads
+        warnings.simplefilter("ignore", DeprecationWarning)
+        child = os.fork()
+    if child == 0:  # pragma: no cover (the child reports through the pipe)
+        try:
+            pool = _threads._pool(2)
+            answer = pool.submit(lambda: 42).result(timeout=10)
+            os.write(writer, b"new" if pool is not parent_pool and answer == 42 else b"old")
+        finally:
+            os._exit(0)
+    os.close(writer)
+    _, status = os.waitpid(child, 0)
+    assert os.read(reader, 3) == b"new"
+    assert status == 0
