@@ -188,31 +188,23 @@ def clip_stage_weights(
 
 
 @numba.njit(cache=True)
-def regulator_riccati(
-    a_mat: FloatArray, b_mat: FloatArray, q_r: FloatArray, r_r: FloatArray, p_final: FloatArray
-) -> tuple[FloatArray, bool]:
-    """Time-varying discrete LQR gains ``K_k = M⁻¹ Bᵀ P_{k+1} A`` (pronto.md §6.1).
+def _add_transpose_times(matrix: FloatArray, vector: FloatArray, out: FloatArray) -> None:
+    """``out += matrixᵀ vector`` (row by row; exact zeros of ``vector`` skipped)."""
+    for i in range(matrix.shape[0]):
+        value = vector[i]
+        if value != 0.0:
+            for j in range(matrix.shape[1]):
+                out[j] += matrix[i, j] * value
 
-    Returns the gains ``(N, n_u, n_x)`` and ``ok`` (False if some ``M_k`` was not PD).
-    """
-    n_stages, n_x, n_u = b_mat.shape
-    gains = np.zeros((n_stages, n_u, n_x))
-    p_next = p_final.copy()
-    ok = True
-    for k in range(n_stages - 1, -1, -1):
-        a = a_mat[k]
-        b = b_mat[k]
-        pb = p_next @ b
-        m = r_r + b.T @ pb
-        g = pb.T @ a
-        gain = g.copy()
-        if not _solve_in_place(m, n_u, gain, n_x):
-            ok = False
-            break
-        gains[k] = gain
-        p = q_r + a.T @ p_next @ a - g.T @ gain
-        p_next = 0.5 * (p + p.T)
-    return gains, ok
+
+@numba.njit(cache=True)
+def _add_times(matrix: FloatArray, vector: FloatArray, out: FloatArray, sign: float) -> None:
+    """``out += sign · matrix vector``."""
+    for i in range(matrix.shape[0]):
+        value = 0.0
+        for j in range(matrix.shape[1]):
+            value += matrix[i, j] * vector[j]
+        out[i] += sign * value
 
 
 @numba.njit(cache=True)
@@ -224,17 +216,24 @@ def closed_loop_costate(
     l_u: FloatArray,
     lam_final: FloatArray,
 ) -> FloatArray:
-    """Costate ``λ_k = a_k − K_kᵀ b_k + (A_k − B_k K_k)ᵀ λ_{k+1}``, ``λ_N = m_x`` (§6.2)."""
-    n_stages, n_x, _ = b_mat.shape
+    """Costate ``λ_k = a_k − K_kᵀ b_k + (A_k − B_k K_k)ᵀ λ_{k+1}``, ``λ_N = m_x`` (§6.2).
+
+    As ``λ_k = a_k + A_kᵀ λ_{k+1} − K_kᵀ (b_k + B_kᵀ λ_{k+1})``: ``O(n²)`` per stage.
+    """
+    n_stages, n_x, n_u = b_mat.shape
     lam = np.zeros((n_stages + 1, n_x))
     lam[n_stages] = lam_final
-    for k in range(n_stages - 1, -1, -1):  # (A − B K)ᵀ λ = Aᵀ λ − Kᵀ (Bᵀ λ): O(n²) per stage
-        lam[k] = (
-            l_x[k]
-            - gains[k].T @ l_u[k]
-            + a_mat[k].T @ lam[k + 1]
-            - gains[k].T @ (b_mat[k].T @ lam[k + 1])
-        )
+    pulled = np.empty(n_u)
+    for k in range(n_stages - 1, -1, -1):
+        for i in range(n_u):
+            pulled[i] = l_u[k, i]
+        _add_transpose_times(b_mat[k], lam[k + 1], pulled)
+        for j in range(n_x):
+            lam[k, j] = l_x[k, j]
+        _add_transpose_times(a_mat[k], lam[k + 1], lam[k])
+        for i in range(n_u):
+            pulled[i] = -pulled[i]
+        _add_transpose_times(gains[k], pulled, lam[k])
     return lam
 
 
@@ -386,6 +385,44 @@ def _add_right_products(
                         bpb[i, j] += bp[i, k] * entry
 
 
+@numba.njit(cache=True, nogil=True)
+def regulator_riccati(
+    a_mat: FloatArray, b_mat: FloatArray, q_r: FloatArray, r_r: FloatArray, p_final: FloatArray
+) -> tuple[FloatArray, bool]:
+    """Time-varying discrete LQR gains ``K_k = M⁻¹ Bᵀ P_{k+1} A`` (pronto.md §6.1).
+
+    ``M = R_r + BᵀPB`` and ``P_k = Q_r + AᵀPA − (BᵀPA)ᵀ K_k``: :func:`lq_backward`'s products
+    on one block, in workspaces. Returns the gains ``(N, n_u, n_x)`` and ``ok`` (False if some
+    ``M_k`` was not PD).
+    """
+    n_stages, n_x, n_u = b_mat.shape
+    gains = np.zeros((n_stages, n_u, n_x))
+    xs, us = np.arange(n_x), np.arange(n_u)
+    xb, ub = np.array([[0, n_x]]), np.array([[0, n_u]])
+    p = p_final.copy()
+    ap, apa = np.empty((n_x, n_x)), np.empty((n_x, n_x))
+    bp, bpa, bpb = np.empty((n_u, n_x)), np.empty((n_u, n_x)), np.empty((n_u, n_u))
+    for k in range(n_stages - 1, -1, -1):
+        apa[:, :] = q_r
+        bpa[:, :] = 0.0
+        bpb[:, :] = r_r
+        _transposed_products(a_mat[k], b_mat[k], p, xs, us, xb, ub, ap, bp)
+        _add_right_products(a_mat[k], b_mat[k], ap, bp, xs, us, xb, ub, apa, bpa, bpb)
+        gain = gains[k]
+        gain[:, :] = bpa
+        if not _solve_in_place(bpb, n_u, gain, n_x):
+            return gains, False
+        for i in range(n_u):
+            for row in range(n_x):
+                factor = bpa[i, row]
+                for j in range(n_x):
+                    apa[row, j] -= factor * gain[i, j]
+        for i in range(n_x):
+            for j in range(n_x):
+                p[i, j] = 0.5 * (apa[i, j] + apa[j, i])
+    return gains, True
+
+
 @numba.njit(cache=True)
 def lq_backward(
     a_mat: FloatArray,
@@ -528,13 +565,22 @@ def lq_feedforward(
     ``g_k = l_{u,k} + B_kᵀ r_{k+1}``, ``v^o_k = −M_k⁻¹ g_k`` and
     ``r_k = l_{x,k} + A_kᵀ r_{k+1} − K^{oᵀ}_k g_k``: ``O(n_x² + n_x n_u)`` per stage.
     """
-    n_stages, _, n_u = b_mat.shape
+    n_stages, n_x, n_u = b_mat.shape
     feedforward = np.zeros((n_stages, n_u))
-    r = r_final.copy()
+    r, r_next = r_final.copy(), np.empty(n_x)
+    g = np.empty(n_u)
     for k in range(n_stages - 1, -1, -1):
-        g = l_u[k] + b_mat[k].T @ r
-        feedforward[k] = -(m_inverse[k] @ g)
-        r = l_x[k] + a_mat[k].T @ r - feedback[k].T @ g
+        for i in range(n_u):
+            g[i] = l_u[k, i]
+        _add_transpose_times(b_mat[k], r, g)
+        _add_times(m_inverse[k], g, feedforward[k], -1.0)
+        for j in range(n_x):
+            r_next[j] = l_x[k, j]
+        _add_transpose_times(a_mat[k], r, r_next)
+        for i in range(n_u):
+            g[i] = -g[i]
+        _add_transpose_times(feedback[k], g, r_next)
+        r, r_next = r_next, r
     return feedforward
 
 
@@ -547,6 +593,9 @@ def lq_forward(
     z = np.zeros((n_stages + 1, n_x))
     v = np.zeros((n_stages, n_u))
     for k in range(n_stages):
-        v[k] = feedforward[k] - feedback[k] @ z[k]
-        z[k + 1] = a_mat[k] @ z[k] + b_mat[k] @ v[k]
+        for i in range(n_u):
+            v[k, i] = feedforward[k, i]
+        _add_times(feedback[k], z[k], v[k], -1.0)
+        _add_times(a_mat[k], z[k], z[k + 1], 1.0)
+        _add_times(b_mat[k], v[k], z[k + 1], 1.0)
     return z, v

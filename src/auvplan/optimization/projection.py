@@ -14,6 +14,7 @@ import scipy.linalg
 from auvplan._typing import FloatArray, IntArray
 from auvplan.errors import SolverError
 from auvplan.optimization import _kernels
+from auvplan.optimization._threads import map_threads
 from auvplan.optimization.lq import block_ranges
 from auvplan.optimization.model import ProntoModel
 from auvplan.optimization.options import ProntoOptions, TerminalRegulator, named_choice
@@ -32,13 +33,15 @@ def design_regulator(
     terminal: TerminalRegulator | Literal["dare", "weight"] = TerminalRegulator.DARE,
     blocks: tuple[IntArray, IntArray] | None = None,
     replaced: tuple[IntArray, FloatArray, FloatArray] | None = None,
+    threads: int = 1,
 ) -> FloatArray:
     """Time-varying discrete LQR along a trajectory (the projection regulator, §6.1).
 
     With ``blocks`` (state and input ``(start, stop)`` ranges of independent subsystems,
     :func:`~auvplan.optimization.lq.block_ranges`) and weights without entries between them,
-    the Riccati matrices stay block-diagonal: each subsystem's regulator is designed on its
-    own, the same gains at a fraction of the cost (zero between subsystems).
+    the Riccati matrices stay block-diagonal: each subsystem's regulator (its terminal ARE
+    included) is designed on its own, on ``threads`` threads: the same gains at a fraction of
+    the cost (zero between subsystems).
 
     Parameters
     ----------
@@ -49,6 +52,8 @@ def design_regulator(
     terminal : TerminalRegulator or {"dare", "weight"}
         ``P_N`` from :func:`scipy.linalg.solve_discrete_are` at the last stage (falls back
         to ``Q_r`` when the ARE fails) or ``Q_r``.
+    threads : int
+        Threads the independent subsystems' designs run on (the same gains for any number).
     replaced : tuple, optional
         ``(stages, A_s, B_s)``: the regulator is designed on ``A_s``, ``B_s`` at these
         stages instead (``A`` and ``B`` are not modified, nor copied whole).
@@ -70,31 +75,33 @@ def design_regulator(
     )
     last = stages.size > 0 and stages[-1] == A.shape[0] - 1
     a_last, b_last = (a_replaced[-1], b_replaced[-1]) if last else (A[-1], B[-1])
-    p_final = Q_r
-    if named_choice(TerminalRegulator, terminal, "terminal") is TerminalRegulator.DARE:
-        try:
-            with np.errstate(all="ignore"):
-                candidate = scipy.linalg.solve_discrete_are(a_last, b_last, Q_r, R_r)
-            if np.all(np.isfinite(candidate)) and np.min(np.linalg.eigvalsh(candidate)) > -1e-9:
-                p_final = 0.5 * (candidate + candidate.T)
-        except (np.linalg.LinAlgError, ValueError):
-            p_final = Q_r
-    parts = _independent(blocks, Q_r, R_r, A.shape[1], B.shape[2])
-    gains = np.zeros((A.shape[0], B.shape[2], A.shape[1]))
-    ok = True
-    for states, inputs in parts:
+    dare = named_choice(TerminalRegulator, terminal, "terminal") is TerminalRegulator.DARE
+
+    def design(part: tuple[slice, slice]) -> tuple[FloatArray, bool]:
+        states, inputs = part
+        q_r, r_r = Q_r[states, states], R_r[inputs, inputs]
         a_block, b_block = A[:, states, states], B[:, states, inputs]
         if stages.size:  # copies of this subsystem's blocks only
             a_block, b_block = a_block.copy(), b_block.copy()
             a_block[stages] = a_replaced[:, states, states]
             b_block[stages] = b_replaced[:, states, inputs]
-        block, block_ok = _kernels.regulator_riccati(
+        p_final = q_r
+        if dare:
+            p_final = _terminal_are(a_last[states, states], b_last[states, inputs], q_r, r_r)
+        return _kernels.regulator_riccati(
             np.ascontiguousarray(a_block),
             np.ascontiguousarray(b_block),
-            np.ascontiguousarray(Q_r[states, states]),
-            np.ascontiguousarray(R_r[inputs, inputs]),
-            np.ascontiguousarray(p_final[states, states]),
+            np.ascontiguousarray(q_r),
+            np.ascontiguousarray(r_r),
+            np.ascontiguousarray(p_final),
         )
+
+    parts = _independent(blocks, Q_r, R_r, A.shape[1], B.shape[2])
+    gains = np.zeros((A.shape[0], B.shape[2], A.shape[1]))
+    ok = True
+    for (states, inputs), (block, block_ok) in zip(
+        parts, map_threads(design, parts, threads), strict=True
+    ):
         gains[:, inputs, states] = block
         ok = ok and block_ok
     if not ok or not np.all(np.isfinite(gains)):
@@ -102,6 +109,18 @@ def design_regulator(
             "the projection-regulator Riccati recursion broke down (non-finite A, B?)"
         )
     return gains
+
+
+def _terminal_are(a: FloatArray, b: FloatArray, q_r: FloatArray, r_r: FloatArray) -> FloatArray:
+    """``P_N`` of the discrete ARE at the last stage (``Q_r`` when it fails or is indefinite)."""
+    try:
+        with np.errstate(all="ignore"):
+            candidate: FloatArray = scipy.linalg.solve_discrete_are(a, b, q_r, r_r)
+    except (np.linalg.LinAlgError, ValueError):
+        return q_r
+    if np.all(np.isfinite(candidate)) and np.min(np.linalg.eigvalsh(candidate)) > -1e-9:
+        return 0.5 * (candidate + candidate.T)
+    return q_r
 
 
 def _independent(
@@ -167,6 +186,7 @@ def regulator_gains(
             coordinate_groups(problem.blocks, problem.n_states), problem.n_states, problem.n_inputs
         ),
         replaced=replaced,
+        threads=options.n_threads,
     )
 
 
