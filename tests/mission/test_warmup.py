@@ -63,8 +63,9 @@ def test_after_the_warm_up_the_mission_compiles_no_optimiser_kernel() -> None:
     warmed = _signatures()
     assert warmed
     assert sum(warmed.values()) > 10
-    run_mission(
-        config.model_copy(update={"solver": config.solver.model_copy(update={"max_iter": 3})})
+    run_mission(  # on two threads, as `auvplan plan` on two cores
+        config.model_copy(update={"solver": config.solver.model_copy(update={"max_iter": 3})}),
+        jobs=2,
     )
     after = _signatures()
     grown = {name: count for name, count in after.items() if count > warmed.get(name, 0)}

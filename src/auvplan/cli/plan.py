@@ -52,7 +52,8 @@ def _add_common(parser: argparse.ArgumentParser, *, default_output: Path | None)
         type=int,
         default=None,
         help="processes: 2 (the default on 2+ cores) compiles the optimiser's kernels on a "
-        "first run and draws half the figures in a second process; 1 uses this one only "
+        "first run and draws half the figures in a second process, and runs the optimiser on "
+        "two threads (or a decomposed fleet in two processes); 1 uses one core only "
         "(default also from $AUVPLAN_JOBS)",
     )
     parser.add_argument(

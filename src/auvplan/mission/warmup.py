@@ -29,6 +29,7 @@ from auvplan.mission.pipeline import fleet_layout, run_optimization
 from auvplan.mission.preplan import PreplanStage, compute_maps, load_terrain
 from auvplan.mission.tables import CurrentConfig
 from auvplan.mission.timing import run_deconfliction
+from auvplan.optimization import StageWeights, convexify
 
 __all__ = ["warm_up", "warm_up_missions"]
 
@@ -84,6 +85,10 @@ def warm_up(config: MissionConfig) -> None:
     """
     for small in warm_up_missions(config):
         _stages_2_and_3(small)
+    # the convexified model clipped on threads (a coupled solve with --jobs 2), which the
+    # small missions' few iterations need not reach: its kernel takes any sizes
+    empty = np.zeros((1, 1, 1))
+    convexify(StageWeights(empty, empty, empty, np.eye(1)), floor=1.0, threads=2)
 
 
 def _stages_2_and_3(small: MissionConfig) -> None:

@@ -128,12 +128,12 @@ def _symbolic_kernels(dynamics: ca.Function, running_cost: ca.Function) -> dict[
     }
 
 
-_T = TypeVar("_T")
-
-
 def _pieces(n_points: int, threads: int) -> list[slice]:
     """The points in one piece per thread, none over :data:`CHUNK`."""
     return pieces(n_points, threads, CHUNK)
+
+
+_T = TypeVar("_T")
 
 
 @dataclass(eq=False)

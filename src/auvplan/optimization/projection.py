@@ -52,11 +52,11 @@ def design_regulator(
     terminal : TerminalRegulator or {"dare", "weight"}
         ``P_N`` from :func:`scipy.linalg.solve_discrete_are` at the last stage (falls back
         to ``Q_r`` when the ARE fails) or ``Q_r``.
-    threads : int
-        Threads the independent subsystems' designs run on (the same gains for any number).
     replaced : tuple, optional
         ``(stages, A_s, B_s)``: the regulator is designed on ``A_s``, ``B_s`` at these
         stages instead (``A`` and ``B`` are not modified, nor copied whole).
+    threads : int
+        Threads the independent subsystems' designs run on (the same gains for any number).
 
     Returns
     -------
