@@ -253,6 +253,38 @@ def test_jacobians_elsewhere_keep_the_linearisation_s_sweeps(
     assert sweeps == []  # the Hessians reused the linearisation's forward sweep
 
 
+@pytest.mark.parametrize("threads", [1, 2])
+def test_sweeps_written_over_the_last_ones_memory_give_fresh_results(
+    compiled: dict[str, BlockKernels], rng: np.random.Generator, threads: int
+) -> None:
+    """A linearisation elsewhere writes over the sweeps before the remembered ones: the
+    remembered ones (and their Hessians) and the new ones are those of fresh kernels."""
+    kernels, weights = compiled["cart"], MODELS["cart"][1]
+    x, u, p, w = _points(kernels, weights, rng, n_points=9)
+    costate = rng.standard_normal((9, kernels.n_x))
+    points = [(x + shift, u, p, w, DT / 2, 2) for shift in (0.0, 0.1, 0.2, 0.3)]
+
+    def evaluate(arguments: tuple) -> tuple[np.ndarray, ...]:
+        first = kernels.first_order(*arguments, threads=threads)
+        return (*first, kernels.hessian(*arguments, costate, 0.7, threads=threads))
+
+    fresh = [evaluate(arguments) for arguments in points]  # each evicts the one before
+    again = [evaluate(arguments) for arguments in points]  # on the evicted sweeps' memory
+    for ours, theirs in zip(again, fresh, strict=True):
+        for one, other in zip(ours, theirs, strict=True):
+            np.testing.assert_array_equal(one, other)
+    assert kernels._spares  # the memory was there to reuse
+    kept = kernels._last.get(*points[-1][:4], np.array([DT / 2, 2, kernel_module.CHUNK, threads]))
+    assert kept is not None
+    assert not any(
+        np.shares_memory(a, b)
+        for spare in kernels._spares
+        for sweep in kept
+        for a in spare.jac + spare.carried
+        for b in sweep.jac + sweep.carried
+    )
+
+
 def test_closed_loop_equals_a_loop_of_substeps(
     compiled: dict[str, BlockKernels], rng: np.random.Generator
 ) -> None:

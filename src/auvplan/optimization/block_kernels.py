@@ -157,9 +157,11 @@ class LastCall(Generic[_T]):
             return value
         return None
 
-    def put(self, value: _T, *arrays: FloatArray) -> None:
-        """Keep ``value`` for copies of ``arrays`` (in place of the last)."""
+    def put(self, value: _T, *arrays: FloatArray) -> _T | None:
+        """Keep ``value`` for copies of ``arrays`` in place of the last; returns the last."""
+        last = None if self._entry is None else self._entry[1]
         self._entry = (tuple(np.array(a) for a in arrays), value)
+        return last
 
 
 @dataclass(frozen=True)
@@ -194,6 +196,9 @@ class BlockKernels:
     _last: LastCall[list[_Forward]] = field(default_factory=LastCall, repr=False)
     """The forward sweeps of the last :meth:`first_order` call, by its arguments: a Newton
     step asks for the Hessians at the trajectory it just linearised."""
+    _spares: list[_Forward] = field(default_factory=list, repr=False)
+    """The sweeps ``_last`` held before (one per piece), whose memory the next remembered
+    sweeps write over."""
 
     def _sweeps(
         self,
@@ -214,13 +219,19 @@ class BlockKernels:
         arguments = (x, u, p, w, np.array([h, n_substeps, CHUNK, threads], dtype=np.float64))
         sweeps = self._last.get(*arguments)
         if sweeps is None:
+            pieces = _pieces(x.shape[0], threads)
+            spares: list[_Forward | None] = [None] * len(pieces)
+            if remember:  # else the sweeps outlive this call: the caller reads them
+                spares[: len(self._spares)] = self._spares[: len(pieces)]
             sweeps = map_threads(
-                lambda rows: self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps),
-                _pieces(x.shape[0], threads),
+                lambda work: self._forward(
+                    x[work[0]], u[work[0]], p[work[0]], w[work[0]], h, n_substeps, work[1]
+                ),
+                list(zip(pieces, spares, strict=True)),
                 threads,
             )
             if remember:
-                self._last.put(sweeps, *arguments)
+                self._spares[:] = self._last.put(sweeps, *arguments) or []
         return sweeps
 
     def step(
@@ -242,10 +253,31 @@ class BlockKernels:
         return x, cost
 
     def _forward(
-        self, x: FloatArray, u: FloatArray, p: FloatArray, w: FloatArray, h: float, n_substeps: int
+        self,
+        x: FloatArray,
+        u: FloatArray,
+        p: FloatArray,
+        w: FloatArray,
+        h: float,
+        n_substeps: int,
+        spare: _Forward | None = None,
     ) -> _Forward:
-        """Forward sweep through the ``4m`` nodes with first-order derivatives."""
+        """Forward sweep through the ``4m`` nodes with first-order derivatives.
+
+        ``spare``: a sweep no longer needed, whose node Jacobians ``J_n`` and derivatives
+        ``D_n`` (the bulk of a sweep's memory) are written over when their shapes match
+        (fresh memory is first touched page by page).
+        """
         n_points, n_x, n_z = x.shape[0], self.n_x, self.n_x + self.n_u
+        shape = (n_points, n_x, n_z)
+
+        def buffer(kind: str, index: int) -> FloatArray:
+            """The spare's node array ``kind`` (``jac`` or ``carried``) ``index``, or a new one."""
+            arrays: list[FloatArray] = [] if spare is None else getattr(spare, kind)
+            if index < len(arrays) and arrays[index].shape == shape:
+                return arrays[index]
+            return np.empty(shape)
+
         nodes: tuple[list[FloatArray], list[FloatArray], list[FloatArray], list[FloatArray]] = (
             [],
             [],
@@ -254,14 +286,15 @@ class BlockKernels:
         )
         cost, cost_grad = np.zeros(n_points), np.zeros((n_points, n_z))
         y = np.ascontiguousarray(x)
-        dy = np.zeros((n_points, n_x, n_z))
+        dy = np.zeros(shape)
         dy[:, np.arange(n_x), np.arange(n_x)] = 1.0
         rate, increment = np.empty((n_points, n_x)), np.empty((n_points, 1))
         for _ in range(n_substeps):
             point, carried = y, dy
             advanced, advanced_d = y.copy(), dy.copy()
             for i in range(4):
-                jac, grad = np.empty((n_points, n_x, n_z)), np.empty((n_points, n_z))
+                n = len(nodes[0])
+                jac, grad = buffer("jac", n), np.empty((n_points, n_z))
                 self.module.first_batch(
                     point, u, p, w, rate, increment, jac.reshape(n_points, -1), grad
                 )
@@ -271,7 +304,9 @@ class BlockKernels:
                 offset = h * RK4_OFFSETS[i + 1] if i < 3 else 0.0
                 cost += factor * increment[:, 0]
                 advanced += factor * rate
-                carried = np.empty_like(dy)
+                # the next node's D (after a substep's last node: scratch, as the next
+                # substep's first node carries that substep's own D, and so is no spare's)
+                carried = buffer("carried", n + 1)
                 _chain.advance_node(
                     jac, grad, nodes[1][-1], dy, advanced_d, cost_grad, factor, offset, carried
                 )
