@@ -98,8 +98,9 @@ class ProntoOptions:
         back to ``Q_r`` when it fails), or ``Q_r``. Strings are converted to the enum.
     n_threads : int
         Threads for the batched stage evaluations; 1 = serial. The compiled kernels split
-        their points (vehicle-stages) over them, with the same results for any number; CasADi
-        evaluates with ``map(N, "thread", n)``.
+        their points (vehicle-stages) over them, the convexified model's stages are clipped
+        and independent vehicles' regulators designed on them, with the same results for any
+        number; CasADi evaluates with ``map(N, "thread", n)``.
     stage_kernels : bool
         Evaluate a separable problem (``TrajectoryProblem.blocks``) with compiled per-block
         kernels (numba; compiled once per vehicle model and cached on disk, 10–25x faster
