@@ -75,6 +75,16 @@ def test_replan_with_the_plans_own_states_is_the_rest_of_the_plan(parent: Parent
     assert result.config.mission.start_time == start
 
 
+def test_a_replan_on_two_cores_is_the_one_core_replan_to_the_bit(parent: ParentPlan) -> None:
+    states = given_states(_moved(parent, 30.0, 0.0), parent.deconfliction.layout.names)
+    one, two = (replan_mission(parent, AT, states, jobs=jobs).result.plan for jobs in (1, 2))
+    assert one is not None
+    assert two is not None
+    assert two.result.status.name == "CONVERGED"
+    for ours, theirs in zip(two.states, one.states, strict=True):
+        np.testing.assert_array_equal(ours, theirs)
+
+
 @pytest.mark.parametrize(
     ("north", "east", "schedule"),
     [(30.0, 0.0, "kept"), (0.0, -30.0, "kept"), (0.0, 30.0, "deconflicted")],

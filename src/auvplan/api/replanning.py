@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from auvplan._figures import DEFAULT_DPI
+from auvplan.api.companion import resolve_jobs
 from auvplan.api.result import MissionPlan, load, logged_warnings, progress_reporter
 from auvplan.errors import InputError
 from auvplan.mission.config import MissionConfig
@@ -54,7 +55,12 @@ class SavedReplan:
 
 
 def replan(
-    plan: MissionPlan, at: float, states: StatesSource = None, *, progress: bool = True
+    plan: MissionPlan,
+    at: float,
+    states: StatesSource = None,
+    *,
+    progress: bool = True,
+    jobs: int | None = None,
 ) -> MissionPlan:
     """Plan the rest of ``plan`` from time ``at`` [s] and the vehicles' ``states`` then.
 
@@ -70,6 +76,9 @@ def replan(
         given start where ``plan`` has them at ``at``.
     progress : bool
         Show progress on the console.
+    jobs : int, optional
+        Cores, 1 or 2 (default: :func:`~auvplan.api.companion.resolve_jobs`): a coupled
+        fleet's optimiser runs on ``jobs`` threads, a decomposed one in ``jobs`` processes.
 
     Returns
     -------
@@ -91,6 +100,7 @@ def replan(
     )
     replan_step(at, float(plan.record.plans[MAIN_PLAN][0].time[-1]), config.solver.dt)
     poses = _poses(states, plan.names)
+    cores = resolve_jobs(jobs)
     with logged_warnings() as warnings, progress_reporter(config, progress) as reporter:
         stages = no_progress if reporter is None else reporter
         parent = _parent(plan, config, folder, stages)
@@ -100,6 +110,7 @@ def replan(
             poses,
             callback=None if reporter is None else reporter.iteration,
             progress=stages,
+            jobs=cores,
         )
     return MissionPlan(replan_record(replanned, warnings=warnings), result=replanned.result)
 
@@ -114,18 +125,20 @@ def replan_to_folder(
     figures: bool = True,
     figure_format: str = "png",
     dpi: int = DEFAULT_DPI,
+    jobs: int | None = None,
 ) -> SavedReplan:
     """Replan the plan of output folder ``folder`` (:func:`replan`) into ``target``.
 
     ``figures``, ``figure_format`` and ``dpi`` (dots per inch) as for
-    :meth:`auvplan.MissionPlan.save`; the folder is written also when the plan failed.
+    :meth:`auvplan.MissionPlan.save`, ``jobs`` as for :func:`replan`; the folder is written
+    also when the plan failed.
 
     Raises
     ------
     InputError, DataFormatError
         As :func:`replan` and :func:`auvplan.load`; nothing is written.
     """
-    new_plan = replan(load(folder), at, states, progress=progress)
+    new_plan = replan(load(folder), at, states, progress=progress, jobs=jobs)
     written = new_plan.save(target, figures=figures, figure_format=figure_format, dpi=dpi)
     assert new_plan.result is not None  # planned in this session
     return SavedReplan(new_plan.result, tuple(written))

@@ -202,7 +202,12 @@ class MissionPlan:
         )  # fmt: skip
 
     def replan(
-        self, at: float, states: StatesSource = None, *, progress: bool = True
+        self,
+        at: float,
+        states: StatesSource = None,
+        *,
+        progress: bool = True,
+        jobs: int | None = None,
     ) -> MissionPlan:
         """Plan the rest of this plan from time ``at`` [s] and the vehicles' states then.
 
@@ -210,7 +215,8 @@ class MissionPlan:
         or ``lat,lon`` for ``north,east``) or vehicle -> ``{north, east, heading_deg,
         speed}``; vehicles not given start where this plan has them at ``at``. The new plan
         keeps the goals, the horizon's end (its horizon is ``T - at``) and the constraints;
-        ``summary["replan"]`` names this plan (:func:`auvplan.api.replanning.replan`).
+        ``summary["replan"]`` names this plan (:func:`auvplan.api.replanning.replan`, which
+        also says what ``jobs`` does).
 
         Raises
         ------
@@ -219,7 +225,7 @@ class MissionPlan:
         """
         from auvplan.api.replanning import replan
 
-        return replan(self, at, states, progress=progress)
+        return replan(self, at, states, progress=progress, jobs=jobs)
 
     def save(
         self,

@@ -48,6 +48,13 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--no-figures", action="store_true", help="write no figures (report.html has tables only)"
     )
+    parser.add_argument(
+        "--jobs",
+        type=int,
+        default=None,
+        help="cores: 2 (the default on 2+ cores) runs the optimiser on two threads (a "
+        "decomposed fleet in two processes); 1 uses one (default also from $AUVPLAN_JOBS)",
+    )
     add_figure_options(parser)
     parser.set_defaults(run=run_replan)
 
@@ -65,6 +72,7 @@ def run_replan(args: argparse.Namespace) -> int:
         figures=not args.no_figures,
         figure_format=args.figure_format,
         dpi=args.dpi,
+        jobs=args.jobs,
     )
     if not args.quiet:
         print_report(saved.result, saved.written)

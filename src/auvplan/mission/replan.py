@@ -231,13 +231,15 @@ def replan_mission(
     *,
     callback: Callable[[Any], None] | None = None,
     progress: ProgressReporter = no_progress,
+    jobs: int = 1,
 ) -> Replan:
     """Replan ``parent`` at ``at`` [s] from ``states`` (vehicle -> state; module notes).
 
-    ``callback`` and ``progress`` as for :func:`auvplan.mission.run_mission`. The timings [s]
-    are ``parent_preplan`` and ``parent_deconflict`` (a parent read from a folder: its mission
-    pre-planned again, its schedule read back), ``schedule`` (the shifted schedule and its
-    certificate), ``deconflict`` (when the certificate fails) and ``optimize``.
+    ``callback``, ``progress`` and ``jobs`` as for :func:`auvplan.mission.run_mission`. The
+    timings [s] are ``parent_preplan`` and ``parent_deconflict`` (a parent read from a
+    folder: its mission pre-planned again, its schedule read back), ``schedule`` (the
+    shifted schedule and its certificate), ``deconflict`` (when the certificate fails) and
+    ``optimize``.
 
     Raises
     ------
@@ -302,7 +304,7 @@ def replan_mission(
     def optimize(warm_start: WarmStart) -> OptimizedPlan:
         return run_optimization(
             child, layout, rest, timed, config.weights.terrain, callback=callback,
-            warm_start=warm_start,
+            warm_start=warm_start, jobs=jobs,
         )  # fmt: skip
 
     def solve() -> OptimizedPlan:
