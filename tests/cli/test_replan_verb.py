@@ -110,6 +110,17 @@ def test_bad_replan_inputs_exit_2_with_one_line_and_write_nothing(
     assert not (tmp_path / "child").exists()
 
 
+def test_jobs_other_than_one_or_two_exit_2_and_write_nothing(
+    parent_folder: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["replan", str(parent_folder), "--at", "60", "-o", str(tmp_path / "child")]
+    code, out, err = run_cli([*argv, "--jobs", "3"], capsys)
+    assert code == 2
+    assert "--jobs (or $AUVPLAN_JOBS) must be 1 or 2, got 3" in one_error_line(err)
+    assert out == ""
+    assert not (tmp_path / "child").exists()
+
+
 def test_a_vehicle_that_can_no_longer_make_it_exits_3_naming_it(
     parent_folder: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
