@@ -9,8 +9,10 @@ gradient, and a Python loop of single substeps for the closed loop.
 from __future__ import annotations
 
 import importlib
+import threading
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -273,12 +275,47 @@ def test_sweeps_written_over_the_last_ones_memory_give_fresh_results(
     for ours, theirs in zip(again, fresh, strict=True):
         for one, other in zip(ours, theirs, strict=True):
             np.testing.assert_array_equal(one, other)
-    assert kernels._spares  # the memory was there to reuse
-    kept = kernels._last.get(*points[-1][:4], np.array([DT / 2, 2, kernel_module.CHUNK, threads]))
+    memory = kernels._thread_memory()
+    assert memory.spares  # the memory was there to reuse
+    kept = memory.last.get(*points[-1][:4], np.array([DT / 2, 2, kernel_module.CHUNK, threads]))
     assert kept is not None
     assert not any(
         np.shares_memory(a, b)
-        for spare in kernels._spares
+        for spare in memory.spares
+        for sweep in kept
+        for a in spare.jac + spare.carried
+        for b in sweep.jac + sweep.carried
+    )
+
+
+def test_each_thread_remembers_and_writes_over_its_own_sweeps(
+    compiled: dict[str, BlockKernels], rng: np.random.Generator
+) -> None:
+    """Kernels are shared by every model of a vehicle type: a solve in another thread must
+    neither find nor write over this thread's sweeps."""
+    kernels, weights = compiled["cart"], MODELS["cart"][1]
+    x, u, p, w = _points(kernels, weights, rng)
+    arguments = (x, u, p, w, DT / 2, 2)
+    kernels.first_order(*arguments)
+    mine = kernels._thread_memory()
+    theirs: list[Any] = []
+
+    def other_solve() -> None:  # linearises elsewhere twice: evicts into its spares
+        kernels.first_order(x + 0.1, u, p, w, DT / 2, 2)
+        kernels.first_order(x + 0.2, u, p, w, DT / 2, 2)
+        theirs.append(kernels._thread_memory())
+
+    worker = threading.Thread(target=other_solve)
+    worker.start()
+    worker.join()
+    assert theirs[0] is not mine
+    assert theirs[0].spares
+    key = np.array([DT / 2, 2, kernel_module.CHUNK, 1])
+    kept = mine.last.get(x, u, p, w, key)  # still this thread's linearisation
+    assert kept is not None
+    assert not any(
+        np.shares_memory(a, b)
+        for spare in theirs[0].spares + theirs[0].last.get(x + 0.2, u, p, w, key)
         for sweep in kept
         for a in spare.jac + spare.carried
         for b in sweep.jac + sweep.carried

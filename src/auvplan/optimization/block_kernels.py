@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import hashlib
 import logging
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -177,6 +178,18 @@ class _Forward:
     cost_grad: FloatArray
 
 
+@dataclass
+class _SweepMemory:
+    """One thread's forward sweeps: the last remembered ones and the ones they evicted."""
+
+    last: LastCall[list[_Forward]] = field(default_factory=LastCall)
+    """The sweeps of the last :meth:`BlockKernels.first_order` call, by its arguments: a
+    Newton step asks for the Hessians at the trajectory it just linearised."""
+    spares: list[_Forward] = field(default_factory=list)
+    """The sweeps ``last`` held before (one per piece), whose memory the next remembered
+    sweeps write over."""
+
+
 @dataclass(frozen=True, eq=False)
 class BlockKernels:
     """The compiled kernels of one block model and its RK4 steps.
@@ -193,12 +206,16 @@ class BlockKernels:
     n_u: int
     n_p: int
     n_w: int
-    _last: LastCall[list[_Forward]] = field(default_factory=LastCall, repr=False)
-    """The forward sweeps of the last :meth:`first_order` call, by its arguments: a Newton
-    step asks for the Hessians at the trajectory it just linearised."""
-    _spares: list[_Forward] = field(default_factory=list, repr=False)
-    """The sweeps ``_last`` held before (one per piece), whose memory the next remembered
-    sweeps write over."""
+    _memory: threading.local = field(default_factory=threading.local, repr=False)
+    """Each calling thread's :class:`_SweepMemory` (kernels are shared by every model of a
+    vehicle type: solves in two threads must not write over each other's sweeps)."""
+
+    def _thread_memory(self) -> _SweepMemory:
+        """The calling thread's remembered sweeps (made on its first call)."""
+        if not hasattr(self._memory, "sweeps"):
+            self._memory.sweeps = _SweepMemory()
+        memory: _SweepMemory = self._memory.sweeps
+        return memory
 
     def _sweeps(
         self,
@@ -217,12 +234,13 @@ class BlockKernels:
         between a linearisation and its Hessians).
         """
         arguments = (x, u, p, w, np.array([h, n_substeps, CHUNK, threads], dtype=np.float64))
-        sweeps = self._last.get(*arguments)
+        memory = self._thread_memory()
+        sweeps = memory.last.get(*arguments)
         if sweeps is None:
             pieces = _pieces(x.shape[0], threads)
             spares: list[_Forward | None] = [None] * len(pieces)
             if remember:  # else the sweeps outlive this call: the caller reads them
-                spares[: len(self._spares)] = self._spares[: len(pieces)]
+                spares[: len(memory.spares)] = memory.spares[: len(pieces)]
             sweeps = map_threads(
                 lambda work: self._forward(
                     x[work[0]], u[work[0]], p[work[0]], w[work[0]], h, n_substeps, work[1]
@@ -231,7 +249,7 @@ class BlockKernels:
                 threads,
             )
             if remember:
-                self._spares[:] = self._last.put(sweeps, *arguments) or []
+                memory.spares[:] = memory.last.put(sweeps, *arguments) or []
         return sweeps
 
     def step(
