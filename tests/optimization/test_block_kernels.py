@@ -255,6 +255,17 @@ def test_jacobians_elsewhere_keep_the_linearisation_s_sweeps(
     assert sweeps == []  # the Hessians reused the linearisation's forward sweep
 
 
+def _share_memory(sweeps: list[Any], others: list[Any]) -> bool:
+    """Whether a node array of ``sweeps`` shares memory with one of ``others``."""
+    return any(
+        np.shares_memory(a, b)
+        for sweep in sweeps
+        for other in others
+        for a in sweep.jac + sweep.carried
+        for b in other.jac + other.carried
+    )
+
+
 @pytest.mark.parametrize("threads", [1, 2])
 def test_sweeps_written_over_the_last_ones_memory_give_fresh_results(
     compiled: dict[str, BlockKernels], rng: np.random.Generator, threads: int
@@ -279,13 +290,7 @@ def test_sweeps_written_over_the_last_ones_memory_give_fresh_results(
     assert memory.spares  # the memory was there to reuse
     kept = memory.last.get(*points[-1][:4], np.array([DT / 2, 2, kernel_module.CHUNK, threads]))
     assert kept is not None
-    assert not any(
-        np.shares_memory(a, b)
-        for spare in memory.spares
-        for sweep in kept
-        for a in spare.jac + spare.carried
-        for b in sweep.jac + sweep.carried
-    )
+    assert not _share_memory(memory.spares, kept)
 
 
 def test_each_thread_remembers_and_writes_over_its_own_sweeps(
@@ -313,13 +318,7 @@ def test_each_thread_remembers_and_writes_over_its_own_sweeps(
     key = np.array([DT / 2, 2, kernel_module.CHUNK, 1])
     kept = mine.last.get(x, u, p, w, key)  # still this thread's linearisation
     assert kept is not None
-    assert not any(
-        np.shares_memory(a, b)
-        for spare in theirs[0].spares + theirs[0].last.get(x + 0.2, u, p, w, key)
-        for sweep in kept
-        for a in spare.jac + spare.carried
-        for b in sweep.jac + sweep.carried
-    )
+    assert not _share_memory(theirs[0].spares + theirs[0].last.get(x + 0.2, u, p, w, key), kept)
 
 
 def test_closed_loop_equals_a_loop_of_substeps(
