@@ -327,6 +327,7 @@ def _transposed_products(
     a: FloatArray,
     b: FloatArray,
     p: FloatArray,
+    width: int,
     xs: IntArray,
     us: IntArray,
     xb: IntArray,
@@ -336,16 +337,16 @@ def _transposed_products(
 ) -> None:
     """``AᵀP`` and ``BᵀP`` of a component into the workspaces ``ap``, ``bp``.
 
-    ``p`` is the component's ``P`` (local rows); ``A``, ``B`` are the stage's whole matrices,
-    block-diagonal: local block ``c`` has states ``xb[c]`` and inputs ``ub[c]`` (``(start,
-    stop)``), which are contiguous in the whole vectors from ``xs[xb[c, 0]]`` and
-    ``us[ub[c, 0]]``.
+    ``p`` is the component's ``P`` (local rows; its first ``width`` columns are multiplied,
+    e.g. ``[P | r]``); ``A``, ``B`` are the stage's whole matrices, block-diagonal: local block
+    ``c`` has states ``xb[c]`` and inputs ``ub[c]`` (``(start, stop)``), which are contiguous
+    in the whole vectors from ``xs[xb[c, 0]]`` and ``us[ub[c, 0]]``.
     """
     for c in range(xb.shape[0]):
         x0, x1, u0, u1 = xb[c, 0], xb[c, 1], ub[c, 0], ub[c, 1]
         gx, gu = xs[x0] - x0, (us[u0] - u0) if u1 > u0 else 0  # local -> whole index offsets
-        _block_transpose_times(a, gx, gx, (x0, x1), (x0, x1), p, xs.size, ap)
-        _block_transpose_times(b, gx, gu, (x0, x1), (u0, u1), p, xs.size, bp)
+        _block_transpose_times(a, gx, gx, (x0, x1), (x0, x1), p, width, ap)
+        _block_transpose_times(b, gx, gu, (x0, x1), (u0, u1), p, width, bp)
 
 
 @numba.njit(cache=True)
@@ -385,6 +386,16 @@ def _add_right_products(
                         bpb[i, j] += bp[i, k] * entry
 
 
+@numba.njit(cache=True)
+def _subtract_gain_term(apa: FloatArray, g: FloatArray, gain: FloatArray, n: int, m: int) -> None:
+    """``apa[:n, :n] −= Gᵀ K`` for ``G = g[:m, :n]``, ``K = gain[:m, :n]`` (row by row of K)."""
+    for i in range(m):
+        for row in range(n):
+            factor = g[i, row]
+            for j in range(n):
+                apa[row, j] -= factor * gain[i, j]
+
+
 @numba.njit(cache=True, nogil=True)
 def regulator_riccati(
     a_mat: FloatArray, b_mat: FloatArray, q_r: FloatArray, r_r: FloatArray, p_final: FloatArray
@@ -406,17 +417,13 @@ def regulator_riccati(
         apa[:, :] = q_r
         bpa[:, :] = 0.0
         bpb[:, :] = r_r
-        _transposed_products(a_mat[k], b_mat[k], p, xs, us, xb, ub, ap, bp)
+        _transposed_products(a_mat[k], b_mat[k], p, n_x, xs, us, xb, ub, ap, bp)
         _add_right_products(a_mat[k], b_mat[k], ap, bp, xs, us, xb, ub, apa, bpa, bpb)
         gain = gains[k]
         gain[:, :] = bpa
         if not _solve_in_place(bpb, n_u, gain, n_x):
             return gains, False
-        for i in range(n_u):
-            for row in range(n_x):
-                factor = bpa[i, row]
-                for j in range(n_x):
-                    apa[row, j] -= factor * gain[i, j]
+        _subtract_gain_term(apa, bpa, gain, n_x, n_u)
         for i in range(n_x):
             for j in range(n_x):
                 p[i, j] = 0.5 * (apa[i, j] + apa[j, i])
@@ -472,11 +479,11 @@ def lq_backward(
     m_inverse = np.zeros((n_stages, n_u, n_u))
     p = p_final.copy()
     r = r_final.copy()
-    # workspaces, a component's in their leading rows and columns
-    p_c, ap, apa = np.empty((n_x, n_x)), np.empty((n_x, n_x)), np.empty((n_x, n_x))
-    s_c, bp, bpa = np.empty((n_x, n_u)), np.empty((n_u, n_x)), np.empty((n_u, n_x))
-    bpb = np.empty((n_u, n_u))
-    r_c, r_new, g = np.empty(n_x), np.empty(n_x), np.empty(n_u)
+    # workspaces, a component's in their leading rows and columns; [P | r] is multiplied
+    # by Aᵀ and Bᵀ at once, giving [AᵀP | Aᵀr] and [BᵀP | Bᵀr]
+    p_c, ap = np.empty((n_x, n_x + 1)), np.empty((n_x, n_x + 1))
+    s_c, bp = np.empty((n_x, n_u)), np.empty((n_u, n_x + 1))
+    apa, bpa, bpb = np.empty((n_x, n_x)), np.empty((n_u, n_x)), np.empty((n_u, n_u))
     solution = np.empty((n_u, n_x + 1 + n_u))  # [K | −v | M⁻¹]
     _join_coupled(p, x_owner, x_owner, parent)
     for k in range(n_stages - 1, -1, -1):
@@ -502,42 +509,25 @@ def lq_backward(
                 for j in range(n):
                     bpa[i, j] = s_c[j, i]  # BᵀPA is added to Sᵀ
             for i in range(n):
-                r_c[i] = r[xs[i]]
-            _transposed_products(a, b, p_c, xs, us, xb, ub, ap, bp)
+                p_c[i, n] = r[xs[i]]
+            _transposed_products(a, b, p_c, n + 1, xs, us, xb, ub, ap, bp)
             _add_right_products(a, b, ap, bp, xs, us, xb, ub, apa, bpa, bpb)
-            for i in range(m):  # g = l_u + Bᵀr
-                g[i] = l_u[k, us[i]]
-            for c in range(xb.shape[0]):
-                x0, x1, u0, u1 = xb[c, 0], xb[c, 1], ub[c, 0], ub[c, 1]
-                gx, gu = xs[x0] - x0, (us[u0] - u0) if u1 > u0 else 0
-                for i in range(u0, u1):
-                    for j in range(x0, x1):
-                        g[i] += b[gx + j, gu + i] * r_c[j]
-            for i in range(m):  # [G | g | I] → [K | −v | M⁻¹]
+            for i in range(m):  # [G | g | I] → [K | −v | M⁻¹], g = l_u + Bᵀr
                 for j in range(n):
                     solution[i, j] = bpa[i, j]
-                solution[i, n] = g[i]
+                bp[i, n] += l_u[k, us[i]]
+                solution[i, n] = bp[i, n]
                 for j in range(m):
                     solution[i, n + 1 + j] = 1.0 if i == j else 0.0
             if not _solve_in_place(bpb, m, solution, n + 1 + m):
                 return feedback, feedforward, m_inverse, k
             for i in range(n):  # r ← l_x + Aᵀr − Kᵀg
-                r_new[i] = l_x[k, xs[i]]
-            for c in range(xb.shape[0]):
-                x0, x1 = xb[c, 0], xb[c, 1]
-                gx = xs[x0] - x0
-                for j in range(x0, x1):
-                    for i in range(x0, x1):
-                        r_new[j] += a[gx + i, gx + j] * r_c[i]
-            for i in range(m):  # and P ← Q + AᵀPA − GᵀK (row i of K, G)
-                for j in range(n):
-                    r_new[j] -= solution[i, j] * g[i]
-                for row in range(n):
-                    factor = bpa[i, row]
-                    for j in range(n):
-                        apa[row, j] -= factor * solution[i, j]
+                value = l_x[k, xs[i]] + ap[i, n]
+                for j in range(m):
+                    value -= solution[j, i] * bp[j, n]
+                r[xs[i]] = value
+            _subtract_gain_term(apa, bpa, solution, n, m)  # P ← Q + AᵀPA − GᵀK
             for i in range(n):
-                r[xs[i]] = r_new[i]
                 for j in range(n):
                     p[xs[i], xs[j]] = 0.5 * (apa[i, j] + apa[j, i])
             for i in range(m):
