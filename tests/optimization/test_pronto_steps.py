@@ -18,6 +18,7 @@ from auvplan.optimization import (
     StageWeights,
     Trajectory,
     TrajectoryProblem,
+    _kernels,
     armijo_step,
     build_model,
     compute_costate,
@@ -115,6 +116,56 @@ def test_regulator_converges_to_the_infinite_horizon_lqr() -> None:
     )
     np.testing.assert_allclose(weight_terminal[0], expected, rtol=1e-8)
     assert not np.allclose(weight_terminal[-1], expected, rtol=1e-3)
+
+
+def _are_residual(a, b, q, r, p):
+    """Largest entry of the DARE's residual relative to ``P``."""
+    gain = np.linalg.solve(r + b.T @ p @ b, b.T @ p @ a)
+    return np.abs(a.T @ p @ a - p - a.T @ p @ b @ gain + q).max() / np.abs(p).max()
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_doubling_are_matches_qz_and_solves_the_equation(seed: int) -> None:
+    """Random stabilisable systems (some unstable, some with integrators like a vehicle's
+    position): the doubling's P is scipy's QZ solution and satisfies the ARE."""
+    rng = np.random.default_rng(seed)
+    n, m = 8, 2
+    a = rng.normal(size=(n, n)) * (0.4 if seed % 2 else 0.25) + np.eye(n) * (0.6 + 0.1 * seed)
+    if seed >= 4:  # positions: integrators of other states, nothing feeds back on them
+        a[:2, :] = 0.0
+        a[:2, :2] = np.eye(2)
+        a[:2, 2:4] = 0.5 * rng.normal(size=(2, 2))
+        a[2:, :2] = 0.0
+    b = rng.normal(size=(n, m))
+    q = np.diag(rng.uniform(0.1, 2.0, n))
+    r = np.diag(rng.uniform(0.1, 1.0, m))
+    p, converged_ = _kernels.discrete_are(a, b, q, r)
+    assert converged_
+    np.testing.assert_allclose(p, scipy.linalg.solve_discrete_are(a, b, q, r), rtol=1e-9, atol=0)
+    assert _are_residual(a, b, q, r, p) < 1e-11
+    np.testing.assert_array_equal(p, p.T)
+
+
+def test_doubling_are_reports_an_unstabilisable_system() -> None:
+    """An unstable mode no input reaches has no stabilising solution: the doubling diverges,
+    says so, and the regulator falls back on ``Q_r`` for its terminal matrix."""
+    a = np.diag([1.5, 0.5])
+    b = np.array([[0.0], [1.0]])
+    q, r = np.eye(2), np.eye(1)
+    _, converged_ = _kernels.discrete_are(a, b, q, r)
+    assert not converged_
+    n_steps = 50
+    gains = design_regulator(
+        np.broadcast_to(a, (n_steps, 2, 2)).copy(), np.broadcast_to(b, (n_steps, 2, 1)).copy(), q, r
+    )
+    weight_terminal = design_regulator(
+        np.broadcast_to(a, (n_steps, 2, 2)).copy(),
+        np.broadcast_to(b, (n_steps, 2, 1)).copy(),
+        q,
+        r,
+        terminal="weight",
+    )
+    np.testing.assert_array_equal(gains, weight_terminal)
 
 
 @pytest.mark.parametrize("make_problem", [unicycle_problem, pendulum_problem, crossing_problem])

@@ -9,7 +9,6 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
-import scipy.linalg
 
 from auvplan._typing import FloatArray, IntArray
 from auvplan.errors import SolverError
@@ -50,8 +49,8 @@ def design_regulator(
     Q_r, R_r : ndarray of shape (n_x, n_x), (n_u, n_u)
         Regulator weights (``R_r ≻ 0``).
     terminal : TerminalRegulator or {"dare", "weight"}
-        ``P_N`` from :func:`scipy.linalg.solve_discrete_are` at the last stage (falls back
-        to ``Q_r`` when the ARE fails) or ``Q_r``.
+        ``P_N`` the stabilising solution of the discrete ARE at the last stage (``Q_r`` when
+        it has none) or ``Q_r``.
     replaced : tuple, optional
         ``(stages, A_s, B_s)``: the regulator is designed on ``A_s``, ``B_s`` at these
         stages instead (``A`` and ``B`` are not modified, nor copied whole).
@@ -112,15 +111,18 @@ def design_regulator(
 
 
 def _terminal_are(a: FloatArray, b: FloatArray, q_r: FloatArray, r_r: FloatArray) -> FloatArray:
-    """``P_N`` of the discrete ARE at the last stage (``Q_r`` when it fails or is indefinite)."""
+    """``P_N`` of the discrete ARE at the last stage (``Q_r`` when it has no stabilising one).
+
+    By doubling (:func:`~auvplan.optimization._kernels.discrete_are`), positive semidefinite
+    by construction.
+    """
     try:
-        with np.errstate(all="ignore"):
-            candidate: FloatArray = scipy.linalg.solve_discrete_are(a, b, q_r, r_r)
-    except (np.linalg.LinAlgError, ValueError):
+        candidate, converged = _kernels.discrete_are(
+            *(np.ascontiguousarray(m) for m in (a, b, q_r, r_r))
+        )
+    except np.linalg.LinAlgError:  # W_k singular to machine precision: diverging too
         return q_r
-    if np.all(np.isfinite(candidate)) and np.min(np.linalg.eigvalsh(candidate)) > -1e-9:
-        return 0.5 * (candidate + candidate.T)
-    return q_r
+    return candidate if converged else q_r
 
 
 def _independent(
