@@ -261,8 +261,8 @@ def _share_memory(sweeps: list[Any], others: list[Any]) -> bool:
         np.shares_memory(a, b)
         for sweep in sweeps
         for other in others
-        for a in sweep.jac + sweep.carried
-        for b in other.jac + other.carried
+        for a in sweep.carried
+        for b in other.carried
     )
 
 
@@ -362,25 +362,16 @@ def test_closed_loop_equals_a_loop_of_substeps(
         np.testing.assert_array_equal(stepped_cost, costs[b])
 
 
-def test_chain_rule_hessian_with_zero_rows_and_entries_equals_the_dense_product() -> None:
-    # add_hessian skips exact zeros of the node Hessian and of D, and the zero rows of
-    # local D~: the sum must be the dense D~^T local D~ whatever the pattern
+def test_upper_triangles_add_as_the_symmetric_matrices_they_stand_for() -> None:
+    # the Hessian kernel returns the upper triangle of D~^T H D~ row by row
     from auvplan.optimization import _chain
 
     rng = np.random.default_rng(5)
-    n_points, n_x, n_z = 7, 5, 7
-    local = rng.standard_normal((n_points, n_z, n_z))
-    local = local + local.transpose(0, 2, 1)
-    local[:, :, 1] = local[:, 1, :] = 0.0  # a state that enters no rate: a zero row
-    local[rng.uniform(size=local.shape) < 0.5] = 0.0
-    local[3] = 0.0  # a point with no curvature at all
-    carried = rng.standard_normal((n_points, n_x, n_z))
-    carried[rng.uniform(size=carried.shape) < 0.4] = 0.0
+    n_points, n_z = 7, 6
+    full = rng.standard_normal((n_points, n_z, n_z))
+    full = full + full.transpose(0, 2, 1)
+    rows, cols = np.triu_indices(n_z)  # row by row: (0, 0), (0, 1), …, (1, 1), …
     total = rng.standard_normal((n_points, n_z, n_z))
-    expected = total.copy()
-    tilde = np.zeros((n_points, n_z, n_z))
-    tilde[:, :n_x] = carried
-    tilde[:, n_x:, n_x:] = np.eye(n_z - n_x)
-    expected += np.einsum("bki,bkl,blj->bij", tilde, local, tilde)
-    _chain.add_hessian(total, local, carried)
-    np.testing.assert_allclose(total, expected, rtol=1e-13, atol=1e-13)
+    expected = total + full
+    _chain.add_symmetric(total, np.ascontiguousarray(full[:, rows, cols]))
+    np.testing.assert_allclose(total, expected, rtol=1e-15, atol=1e-15)

@@ -4,9 +4,14 @@ For a block ``ẋ = f(x, u, p)`` with running-cost rate ``l(x, u, p, w)`` (``w``
 weights) three kernels are generated, with no mission quantity baked in:
 
 - ``value(y, u, p, w) -> (f, l)``;
-- ``first(y, u, p, w) -> (f, l, J, g)`` with ``J = ∂f/∂(y, u)`` (row-major) and
-  ``g = ∇_{(y,u)} l``;
-- ``hessian(y, u, p, w, λ, ν) -> ∇²_{(y,u)} (ν l + λᵀ f)`` (row-major).
+- ``first(y, u, p, w, D) -> (f, l, J D̃, D̃ᵀ g)`` with ``J = ∂f/∂(y, u)``,
+  ``g = ∇_{(y,u)} l`` and ``D̃ = [D; 0 I]`` for a node's ``D = ∂y/∂(x, u)`` (``n_x × n_z``,
+  matrices row-major);
+- ``hessian(y, u, p, w, λ, ν, D) -> (upper triangle of D̃ᵀ H D̃, ∇_y (ν l + λᵀ f))`` with
+  ``H = ∇²_{(y,u)} (ν l + λᵀ f)``.
+
+The products with ``D̃`` (the chain rule of :mod:`~auvplan.optimization._chain`) are part of
+the symbolic kernels, so the code multiplies no structural zero of ``J`` or ``H``.
 
 They are translated to numba (:mod:`~auvplan.optimization._numba_codegen`) and cached on
 disk (:mod:`~auvplan.optimization._kernel_cache`) under a key made of the serialised ``f``
@@ -105,15 +110,20 @@ _BUILT: dict[tuple[str, Path | None], BlockKernels] = {}
 def _symbolic_kernels(dynamics: ca.Function, running_cost: ca.Function) -> dict[str, ca.Function]:
     """The three kernel Functions (module docstring) on SX symbols."""
     n_x, n_u, n_p = (int(dynamics.numel_in(i)) for i in range(3))
+    n_z = n_x + n_u
     y, u, p = ca.SX.sym("y", n_x), ca.SX.sym("u", n_u), ca.SX.sym("p", n_p)
     w, lam, nu = (
         ca.SX.sym("w", int(running_cost.numel_in(3))),
         ca.SX.sym("lam", n_x),
         ca.SX.sym("nu"),
     )
+    carried = ca.SX.sym("D", n_z, n_x).T  # row-major input: D[r, c] is entry r n_z + c
+    tilde = ca.vertcat(carried, ca.horzcat(ca.SX.zeros(n_u, n_x), ca.SX.eye(n_u)))
     rate, cost = dynamics(y, u, p), running_cost(y, u, p, w)
     yu = ca.vertcat(y, u)
-    hessian, _ = ca.hessian(nu * cost + ca.dot(lam, rate), yu)
+    hessian, gradient = ca.hessian(nu * cost + ca.dot(lam, rate), yu)
+    curvature = ca.mtimes([tilde.T, hessian, tilde])
+    upper = ca.vertcat(*(curvature[i, j] for i in range(n_z) for j in range(i, n_z)))
 
     def dense(name: str, args: list[ca.SX], outputs: list[ca.SX]) -> ca.Function:
         return ca.Function(name, args, ca.cse([ca.densify(out) for out in outputs]))
@@ -122,10 +132,17 @@ def _symbolic_kernels(dynamics: ca.Function, running_cost: ca.Function) -> dict[
         "value": dense("model_value", [y, u, p, w], [rate, cost]),
         "first": dense(
             "model_first",
-            [y, u, p, w],
-            [rate, cost, row_major(ca.jacobian(rate, yu)), ca.gradient(cost, yu)],
+            [y, u, p, w, ca.vec(carried.T)],
+            [
+                rate,
+                cost,
+                row_major(ca.mtimes(ca.jacobian(rate, yu), tilde)),
+                ca.mtimes(tilde.T, ca.gradient(cost, yu)),
+            ],
         ),
-        "hessian": dense("model_hessian", [y, u, p, w, lam, nu], [row_major(hessian)]),
+        "hessian": dense(
+            "model_hessian", [y, u, p, w, lam, nu, ca.vec(carried.T)], [upper, gradient[:n_x]]
+        ),
     }
 
 
@@ -167,12 +184,10 @@ class LastCall(Generic[_T]):
 
 @dataclass(frozen=True)
 class _Forward:
-    """Node data of a forward sweep: points ``Y_n``, their derivatives ``D_n``, ``J_n``, ``g_n``."""
+    """Node data of a forward sweep: points ``Y_n`` and their derivatives ``D_n``."""
 
     points: list[FloatArray]
     carried: list[FloatArray]
-    jac: list[FloatArray]
-    grad: list[FloatArray]
     step_jac: FloatArray
     cost: FloatArray
     cost_grad: FloatArray
@@ -282,55 +297,44 @@ class BlockKernels:
     ) -> _Forward:
         """Forward sweep through the ``4m`` nodes with first-order derivatives.
 
-        ``spare``: a sweep no longer needed, whose node Jacobians ``J_n`` and derivatives
-        ``D_n`` (the bulk of a sweep's memory) are written over when their shapes match
-        (fresh memory is first touched page by page).
+        ``spare``: a sweep no longer needed, whose node derivatives ``D_n`` (the bulk of a
+        sweep's memory) are written over when their shapes match (fresh memory is first
+        touched page by page).
         """
         n_points, n_x, n_z = x.shape[0], self.n_x, self.n_x + self.n_u
         shape = (n_points, n_x, n_z)
-
-        def buffer(kind: str, index: int) -> FloatArray:
-            """The spare's node array ``kind`` (``jac`` or ``carried``) ``index``, or a new one."""
-            arrays: list[FloatArray] = [] if spare is None else getattr(spare, kind)
-            if index < len(arrays) and arrays[index].shape == shape:
-                return arrays[index]
-            return np.empty(shape)
-
-        nodes: tuple[list[FloatArray], list[FloatArray], list[FloatArray], list[FloatArray]] = (
-            [],
-            [],
-            [],
-            [],
-        )
+        spares = [] if spare is None or spare.carried[0].shape != shape else spare.carried
+        points: list[FloatArray] = []
+        nodes: list[FloatArray] = []
         cost, cost_grad = np.zeros(n_points), np.zeros((n_points, n_z))
         y = np.ascontiguousarray(x)
         dy = np.zeros(shape)
         dy[:, np.arange(n_x), np.arange(n_x)] = 1.0
         rate, increment = np.empty((n_points, n_x)), np.empty((n_points, 1))
+        rate_d, grad_d = np.empty(shape), np.empty((n_points, n_z))
         for _ in range(n_substeps):
             point, carried = y, dy
             advanced, advanced_d = y.copy(), dy.copy()
             for i in range(4):
-                n = len(nodes[0])
-                jac, grad = buffer("jac", n), np.empty((n_points, n_z))
                 self.module.first_batch(
-                    point, u, p, w, rate, increment, jac.reshape(n_points, -1), grad
-                )
-                for store, value in zip(nodes, (point, carried, jac, grad), strict=True):
-                    store.append(value)
+                    point, u, p, w, carried.reshape(n_points, -1), rate, increment,
+                    rate_d.reshape(n_points, -1), grad_d,
+                )  # fmt: skip
+                points.append(point)
+                nodes.append(carried)
                 factor = h * RK4_WEIGHTS[i]
                 offset = h * RK4_OFFSETS[i + 1] if i < 3 else 0.0
                 cost += factor * increment[:, 0]
                 advanced += factor * rate
                 # the next node's D (after a substep's last node: scratch, as the next
                 # substep's first node carries that substep's own D, and so is no spare's)
-                carried = buffer("carried", n + 1)
+                carried = spares[len(nodes)] if len(nodes) < len(spares) else np.empty(shape)
                 _chain.advance_node(
-                    jac, grad, nodes[1][-1], dy, advanced_d, cost_grad, factor, offset, carried
+                    rate_d, grad_d, dy, advanced_d, cost_grad, factor, offset, carried
                 )
                 point = y + offset * rate
             y, dy = advanced, advanced_d
-        return _Forward(*nodes, dy, cost, cost_grad)
+        return _Forward(points, nodes, dy, cost, cost_grad)
 
     def first_order(
         self,
@@ -395,22 +399,22 @@ class BlockKernels:
     ) -> None:
         """Reverse sweep: node adjoints ``K̄`` and the node Hessians added into ``total``."""
         n_points, n_z = u.shape[0], self.n_x + self.n_u
-        local = np.empty((n_points, n_z * n_z))
+        upper = np.empty((n_points, n_z * (n_z + 1) // 2))
+        point_bar = np.empty((n_points, self.n_x))
         y_bar = np.ascontiguousarray(costate)
         for j in range(len(forward.points) // 4 - 1, -1, -1):
             start_bar = y_bar.copy()
-            point_bar = None
             for i in range(3, -1, -1):
                 n = 4 * j + i
                 k_bar = h * RK4_WEIGHTS[i] * y_bar
-                if point_bar is not None:
-                    k_bar = k_bar + h * RK4_OFFSETS[i + 1] * point_bar
+                if i < 3:
+                    k_bar += h * RK4_OFFSETS[i + 1] * point_bar
                 node_weight = cost_weight * h * RK4_WEIGHTS[i]
                 self.module.hessian_batch(
-                    forward.points[n], u, p, w, k_bar, np.full((n_points, 1), node_weight), local
-                )
-                _chain.add_hessian(total, local.reshape(n_points, n_z, n_z), forward.carried[n])
-                point_bar = _chain.node_adjoint(k_bar, forward.jac[n], forward.grad[n], node_weight)
+                    forward.points[n], u, p, w, k_bar, np.full((n_points, 1), node_weight),
+                    forward.carried[n].reshape(n_points, -1), upper, point_bar,
+                )  # fmt: skip
+                _chain.add_symmetric(total, upper)
                 start_bar += point_bar
             y_bar = start_bar
 
