@@ -50,6 +50,27 @@ def cart() -> tuple[ca.Function, ca.Function]:
     return ca.Function("cart_f", [x, u, p], [rate]), ca.Function("cart_l", [x, u, p, w], [cost])
 
 
+def unicycle() -> tuple[ca.Function, ca.Function]:
+    """Unicycle ``x = (north, east, heading, speed)``, ``u = (turn, thrust)``, a current ``p``.
+
+    No rate depends on the position, as for a vehicle: the node derivatives ``D`` keep
+    structural zeros (:func:`auvplan.optimization.block_kernels._carried_pattern`).
+    """
+    x, u = ca.SX.sym("x", 4), ca.SX.sym("u", 2)
+    p, w = ca.SX.sym("p", 2), ca.SX.sym("w", 2)
+    rate = ca.vertcat(
+        x[3] * ca.cos(x[2]) + p[0],
+        x[3] * ca.sin(x[2]) + p[1],
+        u[0] * x[3] / (1.0 + x[3] ** 2),
+        u[1] - 0.3 * x[3] * ca.fabs(x[3]),
+    )
+    cost = w[0] * (u[0] ** 2 + u[1] ** 2) + w[1] * x[3] ** 3 + 0.1 * (x[0] ** 2 + x[1] ** 2)
+    return (
+        ca.Function("unicycle_f", [x, u, p], [rate]),
+        ca.Function("unicycle_l", [x, u, p, w], [cost]),
+    )
+
+
 def fixed_weights(running_cost: ca.Function, weights: np.ndarray) -> ca.Function:
     """``l(x, u, p)`` of the CasADi path: the cost rate with its weights ``w`` fixed."""
     x, u, p = (ca.SX.sym(name, running_cost.size_in(i)) for i, name in enumerate("xup"))

@@ -28,7 +28,7 @@ from auvplan.optimization._numba_codegen import (
     numba_source,
 )
 
-from ._kernel_models import assert_close, cart, fixed_weights, pendulum
+from ._kernel_models import assert_close, cart, fixed_weights, pendulum, unicycle
 
 # the package exports the function ``block_kernels`` under the module's name
 kernel_module = importlib.import_module("auvplan.optimization.block_kernels")
@@ -38,6 +38,7 @@ N_POINTS = 6
 MODELS: dict[str, tuple[Callable[[], tuple[ca.Function, ca.Function]], np.ndarray]] = {
     "pendulum": (pendulum, np.array([1.5, 0.4])),
     "cart": (cart, np.array([0.7])),
+    "unicycle": (unicycle, np.array([0.4, 0.2])),
 }
 
 
@@ -375,3 +376,42 @@ def test_upper_triangles_add_as_the_symmetric_matrices_they_stand_for() -> None:
     expected = total + full
     _chain.add_symmetric(total, np.ascontiguousarray(full[:, rows, cols]))
     np.testing.assert_allclose(total, expected, rtol=1e-15, atol=1e-15)
+
+
+def test_carried_pattern_is_the_closure_of_the_jacobian_pattern() -> None:
+    # unicycle (x, y, θ, v) with inputs (ω, a): ẋ = v cos θ, ẏ = v sin θ, θ̇ = ω, v̇ = a;
+    # nothing depends on x or y, so D's x and y columns stay the identity's at every node
+    z = ca.SX.sym("z", 6)
+    rate = ca.vertcat(z[3] * ca.cos(z[2]), z[3] * ca.sin(z[2]), z[4], z[5])
+    pattern = kernel_module._carried_pattern(ca.jacobian(rate, z).sparsity(), 4, 2)
+    expected = np.array(
+        [
+            [1, 0, 1, 1, 1, 1],  # x: through θ and v, so through ω and a one node later
+            [0, 1, 1, 1, 1, 1],
+            [0, 0, 1, 0, 1, 0],  # θ: only itself and ω
+            [0, 0, 0, 1, 0, 1],
+        ],
+        dtype=bool,
+    )
+    np.testing.assert_array_equal(pattern, expected)
+
+
+def test_node_derivatives_vanish_outside_the_carried_pattern(
+    compiled: dict[str, BlockKernels], rng: np.random.Generator
+) -> None:
+    """The kernels take ``D`` as zero outside the pattern: the sweeps' own ``D`` are zero there
+    at every node of several substeps (and the unicycle's pattern has such zeros, so the
+    tests against the CasADi discretisation above check the kernels built on it)."""
+    kernels, weights = compiled["unicycle"], MODELS["unicycle"][1]
+    dynamics, _ = unicycle()
+    z = ca.SX.sym("z", kernels.n_x + kernels.n_u)
+    rate = dynamics(z[: kernels.n_x], z[kernels.n_x :], ca.SX.sym("p", kernels.n_p))
+    pattern = kernel_module._carried_pattern(
+        ca.jacobian(rate, z).sparsity(), kernels.n_x, kernels.n_u
+    )
+    # north and east columns: their identity entries only; speed: neither heading nor turn
+    assert np.count_nonzero(~pattern) == 8
+    x, u, p, w = _points(kernels, weights, rng)
+    (sweep,) = kernels._sweeps(x, u, p, w, DT / 3, 3, threads=1, remember=False)
+    for carried in sweep.carried:
+        assert np.all(carried[:, ~pattern] == 0.0)

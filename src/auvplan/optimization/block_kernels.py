@@ -36,7 +36,7 @@ from typing import Final, Generic, TypeVar
 import casadi as ca
 import numpy as np
 
-from auvplan._typing import FloatArray
+from auvplan._typing import BoolArray, FloatArray
 from auvplan.optimization import _chain
 from auvplan.optimization._casadi import row_major
 from auvplan.optimization._kernel_cache import load_kernel_module, mark_compiled
@@ -107,8 +107,33 @@ def closed_loop_batch(x0, alpha, mu, gains, p, w, h, n_sub, path, inputs, costs)
 _BUILT: dict[tuple[str, Path | None], BlockKernels] = {}
 
 
+def _carried_pattern(jacobian: ca.Sparsity, n_x: int, n_u: int) -> BoolArray:
+    """Where a node's ``D = ∂Y/∂(x, u)`` can be nonzero, at any node of any step (``n_x × n_z``).
+
+    ``D_0 = [I 0]`` and every later ``D`` is a start's plus multiples of ``J D̃`` (:mod:`_chain`),
+    so the pattern is the least fixed point of ``S ← S ∪ S_J S̃`` from ``[I 0]``, with ``S_J``
+    the structural nonzeros of ``J = ∂f/∂(y, u)``: e.g. no rate depends on a position, so no
+    other coordinate's ``D`` depends on it.
+    """
+    n_z = n_x + n_u
+    rows, columns = jacobian.get_triplet()
+    depends = np.zeros((n_x, n_z), dtype=np.int64)
+    depends[rows, columns] = 1
+    pattern = np.eye(n_x, n_z, dtype=np.int64)
+    inputs = np.eye(n_u, n_z, n_x, dtype=np.int64)  # D̃'s rows [0 I]
+    while True:
+        grown = (pattern + depends @ np.vstack([pattern, inputs])) > 0
+        if np.array_equal(grown, pattern > 0):
+            return grown
+        pattern = grown.astype(np.int64)
+
+
 def _symbolic_kernels(dynamics: ca.Function, running_cost: ca.Function) -> dict[str, ca.Function]:
-    """The three kernel Functions (module docstring) on SX symbols."""
+    """The three kernel Functions (module docstring) on SX symbols.
+
+    ``D`` enters as ``n_x n_z`` symbols (row-major), of which those outside
+    :func:`_carried_pattern` are taken as the zeros they are.
+    """
     n_x, n_u, n_p = (int(dynamics.numel_in(i)) for i in range(3))
     n_z = n_x + n_u
     y, u, p = ca.SX.sym("y", n_x), ca.SX.sym("u", n_u), ca.SX.sym("p", n_p)
@@ -117,10 +142,15 @@ def _symbolic_kernels(dynamics: ca.Function, running_cost: ca.Function) -> dict[
         ca.SX.sym("lam", n_x),
         ca.SX.sym("nu"),
     )
-    carried = ca.SX.sym("D", n_z, n_x).T  # row-major input: D[r, c] is entry r n_z + c
-    tilde = ca.vertcat(carried, ca.horzcat(ca.SX.zeros(n_u, n_x), ca.SX.eye(n_u)))
     rate, cost = dynamics(y, u, p), running_cost(y, u, p, w)
     yu = ca.vertcat(y, u)
+    jacobian = ca.jacobian(rate, yu)
+    d_entries = ca.SX.sym("D", n_x * n_z)
+    pattern = _carried_pattern(jacobian.sparsity(), n_x, n_u)
+    carried = ca.SX.zeros(n_x, n_z)
+    for r, c in zip(*np.nonzero(pattern), strict=True):
+        carried[int(r), int(c)] = d_entries[int(r) * n_z + int(c)]
+    tilde = ca.vertcat(carried, ca.horzcat(ca.SX.zeros(n_u, n_x), ca.SX.eye(n_u)))
     hessian, gradient = ca.hessian(nu * cost + ca.dot(lam, rate), yu)
     curvature = ca.mtimes([tilde.T, hessian, tilde])
     upper = ca.vertcat(*(curvature[i, j] for i in range(n_z) for j in range(i, n_z)))
@@ -132,16 +162,16 @@ def _symbolic_kernels(dynamics: ca.Function, running_cost: ca.Function) -> dict[
         "value": dense("model_value", [y, u, p, w], [rate, cost]),
         "first": dense(
             "model_first",
-            [y, u, p, w, ca.vec(carried.T)],
+            [y, u, p, w, d_entries],
             [
                 rate,
                 cost,
-                row_major(ca.mtimes(ca.jacobian(rate, yu), tilde)),
+                row_major(ca.mtimes(jacobian, tilde)),
                 ca.mtimes(tilde.T, ca.gradient(cost, yu)),
             ],
         ),
         "hessian": dense(
-            "model_hessian", [y, u, p, w, lam, nu, ca.vec(carried.T)], [upper, gradient[:n_x]]
+            "model_hessian", [y, u, p, w, lam, nu, d_entries], [upper, gradient[:n_x]]
         ),
     }
 
