@@ -427,9 +427,12 @@ class BlockKernels:
         cost_weight: float,
         total: FloatArray,
     ) -> None:
-        """Reverse sweep: node adjoints ``K̄`` and the node Hessians added into ``total``."""
+        """Reverse sweep: node adjoints ``K̄`` and the node Hessians added into ``total``.
+
+        The node Hessians are summed as upper triangles and expanded once.
+        """
         n_points, n_z = u.shape[0], self.n_x + self.n_u
-        upper = np.empty((n_points, n_z * (n_z + 1) // 2))
+        upper, node_upper = np.zeros((2, n_points, n_z * (n_z + 1) // 2))
         point_bar = np.empty((n_points, self.n_x))
         y_bar = np.ascontiguousarray(costate)
         for j in range(len(forward.points) // 4 - 1, -1, -1):
@@ -442,11 +445,12 @@ class BlockKernels:
                 node_weight = cost_weight * h * RK4_WEIGHTS[i]
                 self.module.hessian_batch(
                     forward.points[n], u, p, w, k_bar, np.full((n_points, 1), node_weight),
-                    forward.carried[n].reshape(n_points, -1), upper, point_bar,
+                    forward.carried[n].reshape(n_points, -1), node_upper, point_bar,
                 )  # fmt: skip
-                _chain.add_symmetric(total, upper)
+                upper += node_upper
                 start_bar += point_bar
             y_bar = start_bar
+        _chain.add_symmetric(total, upper)
 
     def closed_loop(
         self,
