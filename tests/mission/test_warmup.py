@@ -10,7 +10,7 @@ import auvplan
 from auvplan.mission.config import parse_mission
 from auvplan.mission.pipeline import run_mission
 from auvplan.mission.warmup import ITERATIONS, warm_up, warm_up_missions
-from auvplan.optimization import _chain, _kernel_cache, _kernels, constraints
+from auvplan.optimization import _kernel_cache, _kernels, constraints
 
 MIXED = {
     "terrain": {"synthetic": True},
@@ -47,7 +47,7 @@ def test_one_small_mission_per_vehicle_type_with_the_mission_settings() -> None:
 
 def _signatures() -> dict[str, int]:
     """Compiled signatures of every optimiser kernel loaded in this process."""
-    modules = [_kernels, _chain, constraints, *_kernel_cache._LOADED.values()]
+    modules = [_kernels, constraints, *_kernel_cache._LOADED.values()]
     return {
         f"{module.__name__}.{name}": len(value.signatures)
         for module in modules

@@ -262,8 +262,8 @@ def _share_memory(sweeps: list[Any], others: list[Any]) -> bool:
         np.shares_memory(a, b)
         for sweep in sweeps
         for other in others
-        for a in sweep.carried
-        for b in other.carried
+        for a in (sweep.points, sweep.carried)
+        for b in (other.points, other.carried)
     )
 
 
@@ -363,21 +363,6 @@ def test_closed_loop_equals_a_loop_of_substeps(
         np.testing.assert_array_equal(stepped_cost, costs[b])
 
 
-def test_upper_triangles_add_as_the_symmetric_matrices_they_stand_for() -> None:
-    # the Hessian kernel returns the upper triangle of D~^T H D~ row by row
-    from auvplan.optimization import _chain
-
-    rng = np.random.default_rng(5)
-    n_points, n_z = 7, 6
-    full = rng.standard_normal((n_points, n_z, n_z))
-    full = full + full.transpose(0, 2, 1)
-    rows, cols = np.triu_indices(n_z)  # row by row: (0, 0), (0, 1), …, (1, 1), …
-    total = rng.standard_normal((n_points, n_z, n_z))
-    expected = total + full
-    _chain.add_symmetric(total, np.ascontiguousarray(full[:, rows, cols]))
-    np.testing.assert_allclose(total, expected, rtol=1e-15, atol=1e-15)
-
-
 def test_carried_pattern_is_the_closure_of_the_jacobian_pattern() -> None:
     # unicycle (x, y, θ, v) with inputs (ω, a): ẋ = v cos θ, ẏ = v sin θ, θ̇ = ω, v̇ = a;
     # nothing depends on x or y, so D's x and y columns stay the identity's at every node
@@ -413,5 +398,5 @@ def test_node_derivatives_vanish_outside_the_carried_pattern(
     assert np.count_nonzero(~pattern) == 8
     x, u, p, w = _points(kernels, weights, rng)
     (sweep,) = kernels._sweeps(x, u, p, w, DT / 3, 3, threads=1, remember=False)
-    for carried in sweep.carried:
-        assert np.all(carried[:, ~pattern] == 0.0)
+    carried = sweep.carried.reshape(12, N_POINTS, *pattern.shape)  # 3 substeps of 4 nodes
+    assert np.all(carried[:, :, ~pattern] == 0.0)

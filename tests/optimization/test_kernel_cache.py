@@ -55,7 +55,7 @@ def counting_load(key, make_source, cache_dir=None):
 kernel_module.load_kernel_module = counting_load
 kernels = kernel_module.block_kernels(*pendulum(float(sys.argv[2])), Path(sys.argv[1]))
 dispatchers = [getattr(kernels.module, name) for name in
-               ("value_batch", "first_batch", "hessian_batch", "closed_loop_batch")]
+               ("value_batch", "forward_batch", "reverse_batch", "closed_loop_batch")]
 report["compiled"] = sum(d.stats.cache_misses.total() for d in dispatchers)
 report["loaded"] = sum(d.stats.cache_hits.total() for d in dispatchers)
 report["file"] = kernels.module.__file__

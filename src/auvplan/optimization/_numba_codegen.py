@@ -22,7 +22,7 @@ import casadi as ca
 __all__ = ["UnsupportedOperation", "numba_source"]
 
 #: Version of the generated code; part of every cache key (bump on any change of the output).
-GENERATOR_VERSION: Final = 6
+GENERATOR_VERSION: Final = 7
 
 _BINARY: Final = {ca.OP_ADD: "+", ca.OP_SUB: "-", ca.OP_MUL: "*", ca.OP_DIV: "/"}
 _UNARY: Final = {

@@ -1,7 +1,7 @@
 r"""Compiled kernels of one block's continuous model, stepped by RK4; built once per model.
 
 For a block ``ẋ = f(x, u, p)`` with running-cost rate ``l(x, u, p, w)`` (``w``: runtime
-weights) three kernels are generated, with no mission quantity baked in:
+weights) three node kernels are generated, with no mission quantity baked in:
 
 - ``value(y, u, p, w) -> (f, l)``;
 - ``first(y, u, p, w, D) -> (f, l, J D̃, D̃ᵀ g)`` with ``J = ∂f/∂(y, u)``,
@@ -10,16 +10,34 @@ weights) three kernels are generated, with no mission quantity baked in:
 - ``hessian(y, u, p, w, λ, ν, D) -> (upper triangle of D̃ᵀ H D̃, ∇_y (ν l + λᵀ f))`` with
   ``H = ∇²_{(y,u)} (ν l + λᵀ f)``.
 
-The products with ``D̃`` (the chain rule of :mod:`~auvplan.optimization._chain`) are part of
-the symbolic kernels, so the code multiplies no structural zero of ``J`` or ``H``.
-
 They are translated to numba (:mod:`~auvplan.optimization._numba_codegen`) and cached on
 disk (:mod:`~auvplan.optimization._kernel_cache`) under a key made of the serialised ``f``
 and ``l``: the first mission with a model pays the compilation (seconds, logged), every
 later one, in any process, loads it. :class:`BlockKernels` integrates whole control
 intervals of ``m`` RK4 substeps of length ``h`` (zero-order hold, the cost as a quadrature
 state; :mod:`~auvplan.optimization.integration`) and differentiates them exactly to second
-order through the ``4m`` model evaluations (:mod:`~auvplan.optimization._chain`).
+order through the ``4m`` model evaluations, the **nodes**
+``(K_n, ℓ_n) = (f, l)(Y_n, u)``. Every node's argument is linear in the substep's start
+``y_j`` and the previous node's ``K`` (``Y_{j,0} = y_j``,
+``Y_{j,i} = y_j + h a_i K_{j,i-1}``, ``a = (0, ½, ½, 1)``), and so are the step's results
+``y_{j+1} = y_j + h Σ_i b_i K_{j,i}`` and ``L = h Σ_{j,i} b_i ℓ_{j,i}``, ``b = (1, 2, 2, 1)/6``.
+With ``D_n = ∂Y_n/∂(x, u)`` the first-order data follow forward,
+
+.. math::
+
+    ∂K_n/∂(x, u) = J_n \tilde D_n,\qquad \tilde D_n = \begin{bmatrix} D_n \\ 0\;\; I\end{bmatrix},
+    \qquad ∇_{(x,u)} L = h \sum_n b_n \tilde D_n^T g_n,
+
+and since only the nodes are nonlinear, the Hessian of ``ν L + λᵀ F`` is exactly
+
+.. math::
+
+    \sum_n \tilde D_n^T\, ∇^2_{(y,u)} \big(\bar K_n^T f + ν h b_n l\big)\big|_{Y_n}\, \tilde D_n
+
+with the node adjoints ``K̄`` of a reverse sweep. The node kernels form the products with
+``D̃`` symbolically, with ``D`` zero where it structurally is (:func:`_carried_pattern`),
+so the code multiplies no structural zero; the sweeps (``forward_batch``,
+``reverse_batch``, generated with the node kernels) run point by point through the nodes.
 """
 
 from __future__ import annotations
@@ -37,7 +55,6 @@ import casadi as ca
 import numpy as np
 
 from auvplan._typing import BoolArray, FloatArray
-from auvplan.optimization import _chain
 from auvplan.optimization._casadi import row_major
 from auvplan.optimization._kernel_cache import load_kernel_module, mark_compiled
 from auvplan.optimization._numba_codegen import (
@@ -104,13 +121,122 @@ def closed_loop_batch(x0, alpha, mu, gains, p, w, h, n_sub, path, inputs, costs)
                     path[b, k * n_sub + j + 1, t] = start[t]
             costs[b, k] = cost
 """
+#: The derivative sweeps appended to every kernel module (as the closed loop, for numba's
+#: cache), point by point through the ``4m`` nodes so that a node's products stay in
+#: registers (the chain rule of the module notes). ``forward_batch`` stores
+#: every node's point ``Y_n (n_nodes, B, n_x)`` and ``D_n (n_nodes, B, n_x n_z)`` (row-major)
+#: for ``reverse_batch``, and returns the step's ``∂F/∂(x, u)``, ``L`` and ``∇L``;
+#: ``reverse_batch`` adds ``Σ_n D̃_nᵀ ∇²(K̄_nᵀ f + ν h b_n l) D̃_n`` into ``total (B, n_z, n_z)``.
+_SWEEP_SOURCE: Final = """
+@numba.njit(cache=True, error_model='numpy', nogil=True)
+def forward_batch(x, u, p, w, h, n_sub, points, carried, step_jac, cost, cost_grad):
+    n_points, n_x = x.shape
+    n_d = carried.shape[2]
+    n_z = n_d // n_x
+    rate = np.empty(n_x)
+    q = np.empty(1)
+    rate_d = np.empty(n_d)
+    grad_d = np.empty(n_z)
+    y = np.empty(n_x)
+    dy = np.empty(n_d)
+    advanced = np.empty(n_x)
+    advanced_d = np.empty(n_d)
+    factors = (h * (1.0 / 6.0), h * (2.0 / 6.0), h * (2.0 / 6.0), h * (1.0 / 6.0))
+    offsets = (h * 0.5, h * 0.5, h * 1.0, 0.0)
+    for b in range(n_points):
+        for t in range(n_x):
+            y[t] = x[b, t]
+        for t in range(n_d):
+            dy[t] = 0.0
+        for t in range(n_x):
+            dy[t * n_z + t] = 1.0
+        total = 0.0
+        for c in range(n_z):
+            cost_grad[b, c] = 0.0
+        for j in range(n_sub):
+            n = 4 * j
+            for t in range(n_x):
+                advanced[t] = y[t]
+                points[n, b, t] = y[t]
+            for t in range(n_d):
+                advanced_d[t] = dy[t]
+                carried[n, b, t] = dy[t]
+            for i in range(4):
+                first(points[n + i, b], u[b], p[b], w[b], carried[n + i, b], rate, q, rate_d,
+                      grad_d)
+                total += factors[i] * q[0]
+                for c in range(n_z):
+                    cost_grad[b, c] += factors[i] * grad_d[c]
+                for t in range(n_x):
+                    advanced[t] += factors[i] * rate[t]
+                for t in range(n_d):
+                    advanced_d[t] += factors[i] * rate_d[t]
+                if i < 3:
+                    for t in range(n_x):
+                        points[n + i + 1, b, t] = y[t] + offsets[i] * rate[t]
+                    for t in range(n_d):
+                        carried[n + i + 1, b, t] = dy[t] + offsets[i] * rate_d[t]
+            for t in range(n_x):
+                y[t] = advanced[t]
+            for t in range(n_d):
+                dy[t] = advanced_d[t]
+        cost[b] = total
+        for t in range(n_d):
+            step_jac[b, t // n_z, t % n_z] = dy[t]
+
+
+@numba.njit(cache=True, error_model='numpy', nogil=True)
+def reverse_batch(points, carried, u, p, w, h, costate, cost_weight, total):
+    n_nodes, n_points, n_x = points.shape
+    n_z = total.shape[1]
+    n_upper = n_z * (n_z + 1) // 2
+    factors = (h * (1.0 / 6.0), h * (2.0 / 6.0), h * (2.0 / 6.0), h * (1.0 / 6.0))
+    offsets = (h * 0.5, h * 0.5, h * 1.0, 0.0)
+    y_bar = np.empty(n_x)
+    start_bar = np.empty(n_x)
+    point_bar = np.empty(n_x)
+    k_bar = np.empty(n_x)
+    weight = np.empty(1)
+    node_upper = np.empty(n_upper)
+    upper = np.empty(n_upper)
+    for b in range(n_points):
+        for t in range(n_x):
+            y_bar[t] = costate[b, t]
+        for t in range(n_upper):
+            upper[t] = 0.0
+        for j in range(n_nodes // 4 - 1, -1, -1):
+            for t in range(n_x):
+                start_bar[t] = y_bar[t]
+            for i in range(3, -1, -1):
+                for t in range(n_x):
+                    k_bar[t] = factors[i] * y_bar[t]
+                    if i < 3:
+                        k_bar[t] += offsets[i] * point_bar[t]
+                weight[0] = cost_weight * factors[i]
+                hessian(points[4 * j + i, b], u[b], p[b], w[b], k_bar, weight,
+                        carried[4 * j + i, b], node_upper, point_bar)
+                for t in range(n_upper):
+                    upper[t] += node_upper[t]
+                for t in range(n_x):
+                    start_bar[t] += point_bar[t]
+            for t in range(n_x):
+                y_bar[t] = start_bar[t]
+        k = 0
+        for r in range(n_z):
+            total[b, r, r] += upper[k]
+            k += 1
+            for c in range(r + 1, n_z):
+                total[b, r, c] += upper[k]
+                total[b, c, r] += upper[k]
+                k += 1
+"""
 _BUILT: dict[tuple[str, Path | None], BlockKernels] = {}
 
 
 def _carried_pattern(jacobian: ca.Sparsity, n_x: int, n_u: int) -> BoolArray:
     """Where a node's ``D = ∂Y/∂(x, u)`` can be nonzero, at any node of any step (``n_x × n_z``).
 
-    ``D_0 = [I 0]`` and every later ``D`` is a start's plus multiples of ``J D̃`` (:mod:`_chain`),
+    ``D_0 = [I 0]`` and every later ``D`` is a start's plus multiples of ``J D̃`` (module notes),
     so the pattern is the least fixed point of ``S ← S ∪ S_J S̃`` from ``[I 0]``, with ``S_J``
     the structural nonzeros of ``J = ∂f/∂(y, u)``: e.g. no rate depends on a position, so no
     other coordinate's ``D`` depends on it.
@@ -214,10 +340,14 @@ class LastCall(Generic[_T]):
 
 @dataclass(frozen=True)
 class _Forward:
-    """Node data of a forward sweep: points ``Y_n`` and their derivatives ``D_n``."""
+    """A forward sweep: the nodes' points and derivatives, the step's first-order data.
 
-    points: list[FloatArray]
-    carried: list[FloatArray]
+    ``points`` ``Y_n (n_nodes, B, n_x)``, ``carried`` ``D_n (n_nodes, B, n_x n_z)``
+    (row-major), ``step_jac`` ``∂F/∂(x, u)``, ``cost`` ``L``, ``cost_grad`` ``∇L``.
+    """
+
+    points: FloatArray
+    carried: FloatArray
     step_jac: FloatArray
     cost: FloatArray
     cost_grad: FloatArray
@@ -327,44 +457,22 @@ class BlockKernels:
     ) -> _Forward:
         """Forward sweep through the ``4m`` nodes with first-order derivatives.
 
-        ``spare``: a sweep no longer needed, whose node derivatives ``D_n`` (the bulk of a
-        sweep's memory) are written over when their shapes match (fresh memory is first
-        touched page by page).
+        ``spare``: a sweep no longer needed, whose node arrays are written over when their
+        shapes match (fresh memory is first touched page by page).
         """
         n_points, n_x, n_z = x.shape[0], self.n_x, self.n_x + self.n_u
-        shape = (n_points, n_x, n_z)
-        spares = [] if spare is None or spare.carried[0].shape != shape else spare.carried
-        points: list[FloatArray] = []
-        nodes: list[FloatArray] = []
-        cost, cost_grad = np.zeros(n_points), np.zeros((n_points, n_z))
-        y = np.ascontiguousarray(x)
-        dy = np.zeros(shape)
-        dy[:, np.arange(n_x), np.arange(n_x)] = 1.0
-        rate, increment = np.empty((n_points, n_x)), np.empty((n_points, 1))
-        rate_d, grad_d = np.empty(shape), np.empty((n_points, n_z))
-        for _ in range(n_substeps):
-            point, carried = y, dy
-            advanced, advanced_d = y.copy(), dy.copy()
-            for i in range(4):
-                self.module.first_batch(
-                    point, u, p, w, carried.reshape(n_points, -1), rate, increment,
-                    rate_d.reshape(n_points, -1), grad_d,
-                )  # fmt: skip
-                points.append(point)
-                nodes.append(carried)
-                factor = h * RK4_WEIGHTS[i]
-                offset = h * RK4_OFFSETS[i + 1] if i < 3 else 0.0
-                cost += factor * increment[:, 0]
-                advanced += factor * rate
-                # the next node's D (after a substep's last node: scratch, as the next
-                # substep's first node carries that substep's own D, and so is no spare's)
-                carried = spares[len(nodes)] if len(nodes) < len(spares) else np.empty(shape)
-                _chain.advance_node(
-                    rate_d, grad_d, dy, advanced_d, cost_grad, factor, offset, carried
-                )
-                point = y + offset * rate
-            y, dy = advanced, advanced_d
-        return _Forward(points, nodes, dy, cost, cost_grad)
+        shape = (4 * n_substeps, n_points, n_x)
+        if spare is not None and spare.points.shape == shape:
+            points, carried = spare.points, spare.carried
+        else:
+            points, carried = np.empty(shape), np.empty((*shape[:2], n_x * n_z))
+        step_jac, cost = np.empty((n_points, n_x, n_z)), np.empty(n_points)
+        cost_grad = np.empty((n_points, n_z))
+        self.module.forward_batch(
+            np.ascontiguousarray(x), u, p, w, h, n_substeps, points, carried, step_jac, cost,
+            cost_grad,
+        )  # fmt: skip
+        return _Forward(points, carried, step_jac, cost, cost_grad)
 
     def first_order(
         self,
@@ -427,30 +535,11 @@ class BlockKernels:
         cost_weight: float,
         total: FloatArray,
     ) -> None:
-        """Reverse sweep: node adjoints ``K̄`` and the node Hessians added into ``total``.
-
-        The node Hessians are summed as upper triangles and expanded once.
-        """
-        n_points, n_z = u.shape[0], self.n_x + self.n_u
-        upper, node_upper = np.zeros((2, n_points, n_z * (n_z + 1) // 2))
-        point_bar = np.empty((n_points, self.n_x))
-        y_bar = np.ascontiguousarray(costate)
-        for j in range(len(forward.points) // 4 - 1, -1, -1):
-            start_bar = y_bar.copy()
-            for i in range(3, -1, -1):
-                n = 4 * j + i
-                k_bar = h * RK4_WEIGHTS[i] * y_bar
-                if i < 3:
-                    k_bar += h * RK4_OFFSETS[i + 1] * point_bar
-                node_weight = cost_weight * h * RK4_WEIGHTS[i]
-                self.module.hessian_batch(
-                    forward.points[n], u, p, w, k_bar, np.full((n_points, 1), node_weight),
-                    forward.carried[n].reshape(n_points, -1), node_upper, point_bar,
-                )  # fmt: skip
-                upper += node_upper
-                start_bar += point_bar
-            y_bar = start_bar
-        _chain.add_symmetric(total, upper)
+        """Reverse sweep: node adjoints ``K̄`` and the node Hessians added into ``total``."""
+        self.module.reverse_batch(
+            forward.points, forward.carried, u, p, w, h, np.ascontiguousarray(costate),
+            cost_weight, total,
+        )  # fmt: skip
 
     def closed_loop(
         self,
@@ -535,6 +624,7 @@ def block_kernels(
         [
             str(GENERATOR_VERSION),
             _CLOSED_LOOP_SOURCE,
+            _SWEEP_SOURCE,
             dynamics.serialize(),
             running_cost.serialize(),
         ]
@@ -551,7 +641,9 @@ def block_kernels(
             raise UnsupportedOperation(
                 f"the model's Hessian has {size} instructions (> {MAX_KERNEL_INSTRUCTIONS})"
             )
-        return numba_source(functions, f"model kernels {memo[0][:24]}", _CLOSED_LOOP_SOURCE)
+        return numba_source(
+            functions, f"model kernels {memo[0][:24]}", _CLOSED_LOOP_SOURCE + _SWEEP_SOURCE
+        )
 
     module, is_new = load_kernel_module(key, source, cache_dir)
     n_x, n_u, n_p = (int(dynamics.numel_in(i)) for i in range(3))
