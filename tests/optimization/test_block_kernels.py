@@ -110,6 +110,23 @@ def test_infinite_and_nan_constants_evaluate_like_casadi(kernel_cache: Path) -> 
     np.testing.assert_array_equal(evaluate(rows), _casadi_rows(function, rows))
 
 
+def test_only_the_batched_kernels_get_a_batch_loop(kernel_cache: Path) -> None:
+    x = ca.SX.sym("x", 2)
+    functions = {
+        "twice": ca.Function("twice", [x], [2.0 * x]),
+        "square": ca.Function("square", [x], [x * x]),
+    }
+    source = numba_source(functions, "batched kernels", batched=("twice",))
+    module, _ = load_kernel_module(source, lambda: source, kernel_cache)
+    rows, out = np.array([[1.0, -2.0], [0.5, 3.0]]), np.empty((2, 2))
+    module.twice_batch(rows, out)
+    np.testing.assert_array_equal(out, 2.0 * rows)
+    single = np.empty(2)
+    module.square(rows[1], single)  # the unbatched kernel is there, without a loop
+    np.testing.assert_array_equal(single, rows[1] ** 2)
+    assert not hasattr(module, "square_batch")
+
+
 def test_untranslatable_functions_raise_unsupported_operation() -> None:
     x = ca.SX.sym("x", 2)
     with pytest.raises(UnsupportedOperation, match="operation"):

@@ -22,7 +22,7 @@ import casadi as ca
 __all__ = ["UnsupportedOperation", "numba_source"]
 
 #: Version of the generated code; part of every cache key (bump on any change of the output).
-GENERATOR_VERSION: Final = 7
+GENERATOR_VERSION: Final = 8
 
 _BINARY: Final = {ca.OP_ADD: "+", ca.OP_SUB: "-", ca.OP_MUL: "*", ca.OP_DIV: "/"}
 _UNARY: Final = {
@@ -102,7 +102,12 @@ def _kernel_lines(function: ca.Function) -> list[str]:
     return lines
 
 
-def numba_source(functions: dict[str, ca.Function], header: str, appendix: str = "") -> str:
+def numba_source(
+    functions: dict[str, ca.Function],
+    header: str,
+    appendix: str = "",
+    batched: tuple[str, ...] | None = None,
+) -> str:
     """Python source of a module with one numba kernel (and its batch loop) per Function.
 
     Parameters
@@ -114,13 +119,16 @@ def numba_source(functions: dict[str, ca.Function], header: str, appendix: str =
     appendix : str, optional
         Source appended verbatim (functions calling the kernels; ``numpy`` is imported as
         ``np``).
+    batched : tuple of str, optional
+        The kernels that get a ``name_batch`` loop (all when not given; the others are
+        called from ``appendix`` only).
 
     Returns
     -------
     str
-        Module source: ``name(i0, …, o0, …)`` on 1-D arrays and ``name_batch`` on 2-D arrays
-        (one point per row), all ``numba.njit(cache=True, nogil=True)`` (they run on worker
-        threads side by side).
+        Module source: ``name(i0, …, o0, …)`` on 1-D arrays and, for the ``batched`` ones,
+        ``name_batch`` on 2-D arrays (one point per row), all
+        ``numba.njit(cache=True, nogil=True)`` (they run on worker threads side by side).
 
     Raises
     ------
@@ -144,11 +152,14 @@ def numba_source(functions: dict[str, ca.Function], header: str, appendix: str =
             f"def {name}({', '.join(inputs + outputs)}):",
             *_kernel_lines(function),
             "",
-            "",
-            "@numba.njit(cache=True, error_model='numpy', nogil=True)",
-            f"def {name}_batch({', '.join(inputs + outputs)}):",
-            "    for b in range(i0.shape[0]):",
-            f"        {name}({', '.join(rows)})",
-            "",
         ]
+        if batched is None or name in batched:
+            lines += [
+                "",
+                "@numba.njit(cache=True, error_model='numpy', nogil=True)",
+                f"def {name}_batch({', '.join(inputs + outputs)}):",
+                "    for b in range(i0.shape[0]):",
+                f"        {name}({', '.join(rows)})",
+                "",
+            ]
     return "\n".join([*lines, appendix])

@@ -642,7 +642,10 @@ def block_kernels(
                 f"the model's Hessian has {size} instructions (> {MAX_KERNEL_INSTRUCTIONS})"
             )
         return numba_source(
-            functions, f"model kernels {memo[0][:24]}", _CLOSED_LOOP_SOURCE + _SWEEP_SOURCE
+            functions,
+            f"model kernels {memo[0][:24]}",
+            _CLOSED_LOOP_SOURCE + _SWEEP_SOURCE,
+            batched=("value",),  # `first` and `hessian` run inside the sweeps only
         )
 
     module, is_new = load_kernel_module(key, source, cache_dir)
