@@ -77,6 +77,16 @@ MAX_KERNEL_INSTRUCTIONS: Final = 12_000
 #: Most points evaluated in one piece (bounds the memory of the stored node derivatives).
 CHUNK: Final = 8192
 
+#: The RK4 coefficients of a substep of length ``h``, for the functions appended below:
+#: ``h b_i`` and the next node's offset ``h a_{i+1}`` (0 after the last node), the values of
+#: :data:`RK4_WEIGHTS` and :data:`RK4_OFFSETS` times ``h`` as :meth:`BlockKernels.step` forms them.
+_RK4_SOURCE: Final = """
+@numba.njit(cache=True, error_model='numpy', nogil=True)
+def rk4_coefficients(h):
+    factors = (h * (1.0 / 6.0), h * (2.0 / 6.0), h * (2.0 / 6.0), h * (1.0 / 6.0))
+    offsets = (h * 0.5, h * 0.5, h * 1.0, 0.0)
+    return factors, offsets
+"""
 #: Closed-loop RK4 simulation appended to every kernel module: it calls the ``value`` kernel
 #: in a sequential loop, and numba caches a function only together with the kernels it calls
 #: as globals of its own module. Its arithmetic is :meth:`BlockKernels.step`'s, operation by
@@ -93,8 +103,7 @@ def closed_loop_batch(x0, alpha, mu, gains, p, w, h, n_sub, path, inputs, costs)
     y = np.empty(n_x)
     rate = np.empty(n_x)
     q = np.empty(1)
-    factors = (h * (1.0 / 6.0), h * (2.0 / 6.0), h * (2.0 / 6.0), h * (1.0 / 6.0))
-    offsets = (h * 0.5, h * 0.5, h * 1.0, 0.0)
+    factors, offsets = rk4_coefficients(h)
     for b in range(n_points):
         for t in range(n_x):
             start[t] = x0[b, t]
@@ -141,8 +150,7 @@ def forward_batch(x, u, p, w, h, n_sub, points, carried, step_jac, cost, cost_gr
     dy = np.empty(n_d)
     advanced = np.empty(n_x)
     advanced_d = np.empty(n_d)
-    factors = (h * (1.0 / 6.0), h * (2.0 / 6.0), h * (2.0 / 6.0), h * (1.0 / 6.0))
-    offsets = (h * 0.5, h * 0.5, h * 1.0, 0.0)
+    factors, offsets = rk4_coefficients(h)
     for b in range(n_points):
         for t in range(n_x):
             y[t] = x[b, t]
@@ -190,8 +198,7 @@ def reverse_batch(points, carried, u, p, w, h, costate, cost_weight, total):
     n_nodes, n_points, n_x = points.shape
     n_z = total.shape[1]
     n_upper = n_z * (n_z + 1) // 2
-    factors = (h * (1.0 / 6.0), h * (2.0 / 6.0), h * (2.0 / 6.0), h * (1.0 / 6.0))
-    offsets = (h * 0.5, h * 0.5, h * 1.0, 0.0)
+    factors, offsets = rk4_coefficients(h)
     y_bar = np.empty(n_x)
     start_bar = np.empty(n_x)
     point_bar = np.empty(n_x)
@@ -230,6 +237,8 @@ def reverse_batch(points, carried, u, p, w, h, costate, cost_weight, total):
                 total[b, c, r] += upper[k]
                 k += 1
 """
+#: Everything appended to the generated node kernels (part of the cache key).
+_APPENDIX: Final = _RK4_SOURCE + _CLOSED_LOOP_SOURCE + _SWEEP_SOURCE
 _BUILT: dict[tuple[str, Path | None], BlockKernels] = {}
 
 
@@ -623,8 +632,7 @@ def block_kernels(
     key = "\n".join(
         [
             str(GENERATOR_VERSION),
-            _CLOSED_LOOP_SOURCE,
-            _SWEEP_SOURCE,
+            _APPENDIX,
             dynamics.serialize(),
             running_cost.serialize(),
         ]
@@ -644,7 +652,7 @@ def block_kernels(
         return numba_source(
             functions,
             f"model kernels {memo[0][:24]}",
-            _CLOSED_LOOP_SOURCE + _SWEEP_SOURCE,
+            _APPENDIX,
             batched=("value",),  # `first` and `hessian` run inside the sweeps only
         )
 
