@@ -82,3 +82,32 @@ def test_stages_above_the_floor_are_kept_bit_for_bit() -> None:
     assert not kept.all()
     clipped = _stacked(convexify(weights, 1e-2))
     assert np.array_equal(clipped[kept], stacked[kept])
+
+
+def test_blocks_wholly_below_the_floor_become_the_floor() -> None:
+    """Blocks whose Gershgorin discs lie below the floor (vehicles' positions far apart, which
+    only vanishing barriers curve, some slightly negative) are ``floor·I`` exactly, and equal
+    the projection; stages whose discs straddle the floor take the eigendecomposition."""
+    rng = np.random.default_rng(4)
+    weights = _weights(rng)
+    stacked = _stacked(weights)
+    tiny = rng.normal(scale=1e-13, size=(stacked.shape[0], 10, 10))
+    below = stacked.copy()
+    below[np.ix_(np.arange(stacked.shape[0]), GROUPS[1], GROUPS[1])] = tiny + np.swapaxes(
+        tiny, 1, 2
+    )
+    below[np.ix_(np.arange(stacked.shape[0]), GROUPS[0], GROUPS[1])] = 0.0  # on its own
+    below[np.ix_(np.arange(stacked.shape[0]), GROUPS[1], GROUPS[0])] = 0.0
+    below[::3, GROUPS[1][0], GROUPS[1][0]] = 5e-3  # discs reaching up to the floor
+    below[1::3, GROUPS[1][1], GROUPS[1][1]] = 2e-2  # one eigenvalue above it: no shortcut
+    weights = StageWeights(
+        below[:, :N_X, :N_X].copy(), below[:, :N_X, N_X:].copy(), below[:, N_X:, N_X:].copy(),
+        np.eye(N_X),
+    )  # fmt: skip
+    clipped = _stacked(convexify(weights, 1e-2))
+    np.testing.assert_allclose(clipped, _projection(below, 1e-2), atol=1e-12)
+    second = clipped[np.ix_(np.arange(below.shape[0]), GROUPS[1], GROUPS[1])]
+    shortcut = np.r_[0 : below.shape[0] : 3, 2 : below.shape[0] : 3]
+    floor = np.broadcast_to(1e-2 * np.eye(10), (shortcut.size, 10, 10))
+    assert np.array_equal(second[shortcut], floor)
+    assert not np.any(np.all(second[1::3] == 1e-2 * np.eye(10), axis=(1, 2)))

@@ -60,9 +60,36 @@ def _above_floor(matrix: FloatArray, floor: float) -> bool:
 
 
 @numba.njit(cache=True)
+def _at_most_floor(matrix: FloatArray, floor: float) -> bool:
+    """Whether every Gershgorin disc of ``matrix`` lies at or below ``floor``.
+
+    Then so does every eigenvalue: ``λ ≤ max_i (m_ii + Σ_{j≠i} |m_ij|) ≤ floor``.
+    """
+    n = matrix.shape[0]
+    for i in range(n):
+        bound = matrix[i, i]
+        for j in range(n):
+            if j != i:
+                bound += abs(matrix[i, j])
+        if not bound <= floor:  # also catches NaN
+            return False
+    return True
+
+
+@numba.njit(cache=True)
 def _clip_in_place(matrix: FloatArray, floor: float) -> None:
-    """``V max(Λ, floor) Vᵀ`` of a symmetric matrix, written over it (kept when already above)."""
+    """``V max(Λ, floor) Vᵀ`` of a symmetric matrix, written over it.
+
+    Kept when every eigenvalue is above ``floor`` (:func:`_above_floor`); ``floor·I``, with no
+    eigendecomposition, when none is (:func:`_at_most_floor`: ``V floor·I Vᵀ = floor·I``),
+    e.g. the positions of vehicles far apart, which only vanishing barriers curve.
+    """
     if _above_floor(matrix, floor):
+        return
+    if _at_most_floor(matrix, floor):
+        matrix[:, :] = 0.0
+        for i in range(matrix.shape[0]):
+            matrix[i, i] = floor
         return
     values, vectors = np.linalg.eigh(matrix)
     matrix[:, :] = (vectors * np.maximum(values, floor)) @ vectors.T

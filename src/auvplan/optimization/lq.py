@@ -125,8 +125,8 @@ class LqFactor:
         """
         lin = linearization
         feedforward = _kernels.lq_feedforward(
-            self.A, self.B, self.feedback, self.m_inverse, lin.a, lin.b,
-            np.ascontiguousarray(lin.m_x),
+            self.A, self.B, self.feedback, self.m_inverse,
+            *(np.ascontiguousarray(g) for g in (lin.a, lin.b, lin.m_x)),
         )  # fmt: skip
         z, v = _kernels.lq_forward(self.A, self.B, self.feedback, feedforward)
         return directional_derivative(lin, z, v)
