@@ -13,6 +13,7 @@ import pytest
 from _cli import one_error_line, run_cli
 
 import auvplan
+from auvplan.api.companion import Companion
 from auvplan.api.result import MissionPlan
 
 HEADER = "vehicle,north,east,heading_deg,speed\n"
@@ -135,3 +136,33 @@ def test_a_vehicle_that_can_no_longer_make_it_exits_3_naming_it(
     summary = json.loads((child / "summary.json").read_text())
     assert summary["optimization"]["plan_status"] == "FAILED"
     assert summary["replan"]["at_s"] == 140.0
+
+
+def test_figures_of_a_replan_on_two_cores_are_those_drawn_on_one(
+    parent_folder: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """With ``--jobs 2`` the second process draws half the figures (as ``plan`` does): the
+    same files, byte for byte, as one process draws."""
+    shared: list[int] = []
+    render = Companion.render_figures
+
+    def spied(self: Companion, *args: Any, **kwargs: Any) -> Any:
+        shared.append(1)
+        return render(self, *args, **kwargs)
+
+    monkeypatch.setattr(Companion, "render_figures", spied)
+    folders = {}
+    for jobs in ("1", "2"):
+        folders[jobs] = tmp_path / f"jobs{jobs}"
+        argv = [str(parent_folder), "--at", "60", "-o", str(folders[jobs]), "--dpi", "30"]
+        code, _, err = run_cli(["-q", "replan", *argv, "--jobs", jobs], capsys)
+        assert code == 0, err
+        assert len(shared) == int(jobs) - 1  # the second process drew with --jobs 2 only
+    figures = sorted(path.name for path in folders["1"].glob("*.png"))
+    assert len(figures) >= 5
+    assert sorted(path.name for path in folders["2"].glob("*.png")) == figures
+    for name in figures:
+        assert (folders["2"] / name).read_bytes() == (folders["1"] / name).read_bytes(), name

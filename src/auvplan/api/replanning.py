@@ -17,12 +17,13 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
+from contextlib import nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from auvplan._figures import DEFAULT_DPI
-from auvplan.api.companion import resolve_jobs
+from auvplan.api.companion import Companion, resolve_jobs
 from auvplan.api.result import MissionPlan, load, logged_warnings, progress_reporter
 from auvplan.errors import InputError
 from auvplan.mission.config import MissionConfig
@@ -131,15 +132,23 @@ def replan_to_folder(
 
     ``figures``, ``figure_format`` and ``dpi`` (dots per inch) as for
     :meth:`auvplan.MissionPlan.save`, ``jobs`` as for :func:`replan`; the folder is written
-    also when the plan failed.
+    also when the plan failed. With two cores the figures are drawn by two processes, as
+    :func:`~auvplan.api.planning.plan_to_folder` draws them: the second
+    (:class:`~auvplan.api.companion.Companion`) is started first, so that its imports overlap
+    the replanning.
 
     Raises
     ------
     InputError, DataFormatError
         As :func:`replan` and :func:`auvplan.load`; nothing is written.
     """
-    new_plan = replan(load(folder), at, states, progress=progress, jobs=jobs)
-    written = new_plan.save(target, figures=figures, figure_format=figure_format, dpi=dpi)
+    with Companion() if figures and resolve_jobs(jobs) == 2 else nullcontext() as companion:
+        if companion is not None:
+            companion.start()
+        new_plan = replan(load(folder), at, states, progress=progress, jobs=jobs)
+        written = new_plan.save(
+            target, figures=figures, figure_format=figure_format, dpi=dpi, companion=companion
+        )
     assert new_plan.result is not None  # planned in this session
     return SavedReplan(new_plan.result, tuple(written))
 
