@@ -26,13 +26,32 @@ def test_public_namespace_is_curated_and_lazy() -> None:
     with pytest.raises(AttributeError, match="no attribute 'nope'"):
         _ = auvplan.nope  # type: ignore[attr-defined]
     # `import auvplan` alone loads none of the heavy packages (the CLI starts fast): the
-    # version and the error types only
+    # version, the error types and the lazy-import hook only
     heavy = ("auvplan.", "casadi", "matplotlib", "xarray")
     code = f"import sys, auvplan; print(sorted(m for m in sys.modules if m.startswith({heavy})))"
     loaded = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, check=True
     )
-    assert loaded.stdout.strip() == "['auvplan._version', 'auvplan.errors']"
+    assert loaded.stdout.strip() == "['auvplan._lazy', 'auvplan._version', 'auvplan.errors']"
+
+
+def test_planning_and_writing_without_figures_loads_no_matplotlib() -> None:
+    """What ``plan``/``replan --no-figures`` and ``save(figures=False)`` import (the writer
+    of the output folder and ``report.html``, the verbs, ``auvplan.viz`` itself): no
+    matplotlib, which only drawing a figure imports."""
+    modules = (
+        "auvplan.api.folder", "auvplan.api.planning", "auvplan.api.replanning",
+        "auvplan.cli.plan", "auvplan.cli.replan", "auvplan.viz", "auvplan.viz.html",
+    )  # fmt: skip
+    code = (
+        f"import importlib, sys; [importlib.import_module(m) for m in {modules}]; "
+        "import auvplan.viz as viz; print(viz.render_report.__module__, "
+        "'matplotlib' in sys.modules); viz.plot_terrain_maps; print('matplotlib' in sys.modules)"
+    )
+    loaded = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    )
+    assert loaded.stdout.split() == ["auvplan.viz.html", "False", "True"]
 
 
 def test_to_xarray_is_trajectories_nc(

@@ -14,8 +14,9 @@ does not load the planning pipeline.
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from auvplan._lazy import lazy_attributes
 
 #: Public name -> the module that defines it (imported on first access).
 _LAZY = {
@@ -67,10 +68,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> Any:
-    """Import a public name of :data:`__all__` on first use (PEP 562)."""
-    if name not in _LAZY:
-        raise AttributeError(f"module 'auvplan.api' has no attribute {name!r}")
-    value = getattr(importlib.import_module(_LAZY[name]), name)
-    globals()[name] = value
-    return value
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY, __all__)

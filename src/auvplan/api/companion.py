@@ -53,8 +53,8 @@ from auvplan.mission.warmup import warm_up, warm_up_missions
 from auvplan.optimization._kernel_cache import cache_root
 
 if TYPE_CHECKING:
+    from auvplan._figures import RenderedFigure
     from auvplan.mission.pipeline import MissionResult
-    from auvplan.viz.report import RenderedFigure
 
 logger = logging.getLogger(__name__)
 T = TypeVar("T")

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from auvplan._figures import DEFAULT_DPI
+from auvplan._figures import DEFAULT_DPI, RenderedFigure
 from auvplan.export import DEFAULT_TOLERANCE_M, MoosFrame, write_exports
 from auvplan.io.output import staged_output_dir
 from auvplan.io.writing import writing
@@ -23,7 +23,6 @@ from auvplan.mission.pipeline import MissionResult
 from auvplan.record import PlanRecord, export_plan, write_record
 from auvplan.record.files import EXPORT_FOLDER, REPORT_FILE
 from auvplan.viz.html import render_report
-from auvplan.viz.report import RenderedFigure, render_mission_figures
 
 if TYPE_CHECKING:
     from auvplan.api.companion import Companion
@@ -76,6 +75,8 @@ def write_output_folder(
     """
     rendered: dict[str, RenderedFigure] = {}
     if figures:  # rendered before anything is written: a bad format or dpi writes nothing
+        from auvplan.viz.report import render_mission_figures  # matplotlib: only now
+
         draw = render_mission_figures if companion is None else companion.render_figures
         rendered = draw(result, figure_format=figure_format, dpi=dpi)
     with staged_output_dir(target) as staging:

@@ -16,7 +16,7 @@ import html
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any, Final
 
-from auvplan.viz.report import FIGURE_CAPTIONS, RenderedFigure
+from auvplan._figures import FIGURE_CAPTIONS, RenderedFigure
 
 _STYLE: Final = """
 body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 72em; color: #222; }

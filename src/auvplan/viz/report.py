@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import io
 from collections.abc import Callable, Collection, Sequence
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Final
+from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
 
-from auvplan._figures import DEFAULT_DPI, FIGURE_FORMATS
+from auvplan._figures import DEFAULT_DPI, FIGURE_FORMATS, RenderedFigure
 from auvplan.errors import InputError
 from auvplan.interrupts import checkpoint
 from auvplan.io.writing import writing
@@ -26,40 +25,6 @@ from auvplan.viz.current import add_current_arrows
 from auvplan.viz.maps import plot_terrain_maps
 from auvplan.viz.mission import plot_mission_paths, plot_separation, plot_time_series
 from auvplan.viz.navigation import plot_predicted_error
-
-#: What each figure of :func:`mission_figures` shows, by file stem.
-FIGURE_CAPTIONS: Final = {
-    "maps": "Terrain maps (paper Fig. 5): bathymetry, information, excitation and cost.",
-    "paths": "Pre-planned paths (dashed) and optimised trajectories over the bathymetry "
-    "(paper Fig. 6); circles: safety radius at start and goal.",
-    "paths_cost": "Pre-planned paths over the shifted cost map that A* searched.",
-    "paths_energy_only": "Energy-only optimum (terrain weight 0) against the pre-planned paths.",
-    "paths_paper": "The paper's plan beside: its information-map routes (dashed) and their "
-    "optimum.",
-    "coordination": "Coordination space of the first two vehicles: collision region and the "
-    "deconflicted schedule.",
-    "time_series": "Surge and sway speed, yaw rate, propeller speeds (and control-surface "
-    "deflections) and electrical power.",
-    "separation": "Distance between every pair of vehicles and to every obstacle, on the "
-    "closed-loop replay.",
-    "navigation_predicted": "Predicted TAN position error (1-σ radial) along each flown plan, "
-    "with the navigation budget.",
-}
-
-
-@dataclass(frozen=True)
-class RenderedFigure:
-    """A figure rendered to bytes: the file, and a preview that a web page can show.
-
-    ``data`` is the file in ``figure_format`` (a key of :data:`FIGURE_FORMATS`); ``preview``
-    is the same picture as PNG or SVG (``data`` itself unless the format is PDF) of MIME type
-    ``preview_type``.
-    """
-
-    figure_format: str
-    data: bytes
-    preview: bytes
-    preview_type: str
 
 
 def render_figure(
