@@ -14,7 +14,7 @@ import pytest
 from pyproj import Geod, Proj
 
 from auvplan.errors import InputError
-from auvplan.export import FORMATS, parse_formats, render_exports
+from auvplan.export import FORMATS, parse_formats, qgc, render_exports
 from auvplan.export.moos import moos_xy
 from auvplan.export.plan import CircleZone, ExportPlan, PolygonZone, file_stems
 from auvplan.export.waypoints import Waypoints, thin_track
@@ -116,8 +116,6 @@ def test_qgc_numbers_are_mavlinks() -> None:
     """Every MAVLink number of the QGC export, checked against pymavlink's enums."""
     from pymavlink.dialects.v20 import ardupilotmega as mavlink
 
-    from auvplan.export import qgc
-
     assert qgc.NAV_WAYPOINT == mavlink.MAV_CMD_NAV_WAYPOINT
     assert qgc.DO_CHANGE_SPEED == mavlink.MAV_CMD_DO_CHANGE_SPEED
     assert qgc.FRAME_GLOBAL_RELATIVE_ALT == mavlink.MAV_FRAME_GLOBAL_RELATIVE_ALT
@@ -148,8 +146,10 @@ def test_qgc_plans_for_ardusub(export_plan: ExportPlan) -> None:
         nav = [item for item in items if item["command"] == 16]
         lat, lon = (np.array([item["params"][k] for item in nav]) for k in (4, 5))
         assert np.max(_distance_m(lat, lon, waypoints.lat, waypoints.lon)) < 1e-6
-        assert all(item["frame"] == 3 and item["params"][6] == -export_plan.depth for item in nav)
-        assert all(item["Altitude"] == -export_plan.depth for item in nav)  # QGC 4.x keys
+        # a surface plan (the Monterey example) 1 cm down: ArduSub reads 0 as "keep depth"
+        altitude = -max(export_plan.depth, qgc.SURFACE_DEPTH)
+        assert all(item["frame"] == 3 and item["params"][6] == altitude for item in nav)
+        assert all(item["Altitude"] == altitude for item in nav)  # QGC 4.x keys
         assert all((item["AltitudeMode"], item["AMSLAltAboveTerrain"]) == (1, None) for item in nav)
         assert mission["globalPlanAltitudeMode"] == 1
         # fly the items: hold, then each leg at the last commanded speed: the plan's times
@@ -243,9 +243,13 @@ def test_moos_flies_the_plans_path_and_timing(export_plan: ExportPlan, frame: st
         settings, blocks = parse_moos(files[f"{stem}.bhv"])
         assert settings["initialize DEPLOY"] == "false"
         assert settings["initialize RETURN"] == "false"
-        (depth,) = [block for block in blocks if block["Behavior"] == "BHV_ConstantDepth"]
-        assert float(depth["depth"]) == export_plan.depth
-        assert depth["condition"] == "DEPLOY = true"
+        depths = [block for block in blocks if block["Behavior"] == "BHV_ConstantDepth"]
+        if export_plan.depth > 0.0:
+            (depth,) = depths
+            assert float(depth["depth"]) == export_plan.depth
+            assert depth["condition"] == "DEPLOY = true"
+        else:  # a surface plan (the Monterey example): a surface helm has no depth variable
+            assert depths == []
         legs = [block for block in blocks if block["Behavior"] == "BHV_Waypoint"]
         assert all(float(leg["capture_radius"]) == export_plan.capture_radius for leg in legs)
         assert all(float(leg["slip_radius"]) > export_plan.capture_radius for leg in legs)
