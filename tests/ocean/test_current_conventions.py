@@ -201,6 +201,27 @@ def test_undecodable_time_is_one_line(
 
 
 @pytest.mark.parametrize(
+    "shift_days",
+    [-1e6, 1e30],  # dates before year 1 (CF has no year 0 in the standard calendar); no int64
+)
+def test_times_no_calendar_holds_are_one_line(tmp_path: Path, shift_days: float) -> None:
+    """Time values far outside any ocean model's (a damaged RTOFS file, found by the fuzz
+    test: the first case was a CFWarning from cftime, the second an OverflowError)."""
+    import xarray as xr
+
+    source = write_rtofs(tmp_path / "source.nc", three_d=False)
+    with xr.open_dataset(source, decode_times=False) as opened:
+        dataset = opened.load()
+    dataset["MT"] = dataset["MT"] + shift_days
+    dataset.to_netcdf(tmp_path / "rtofs.nc")
+    with pytest.raises(
+        DataFormatError, match=r"rtofs.nc: time axis MT .* cannot be decoded"
+    ) as raised:
+        _read(tmp_path / "rtofs.nc", depth=0.0)
+    assert "\n" not in str(raised.value)
+
+
+@pytest.mark.parametrize(
     ("variable", "value", "message"),
     [
         ("water_u", 1e30, r"water_u holds 1e\+27 m/s at \d+ of its \d+ values, faster than any"),

@@ -159,6 +159,10 @@ def test_obstacle_outside_grid_blocks_nothing() -> None:
         (lambda: CircleObstacle(np.nan, 0.0, 1.0), "centre"),
         (lambda: PolygonObstacle(np.array([[0.0, 0.0], [1.0, 1.0]])), "shape"),
         (lambda: PolygonObstacle(np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]])), "zero area"),
+        (  # a vertex 1e300 m out (found by the fuzz test: an OverflowError before)
+            lambda: PolygonObstacle(np.array([[1e300, 200.0], [98.5, 202.6], [98.5, 197.4]])),
+            "zero area",
+        ),
         (lambda: PolygonObstacle(np.array([[0.0, 0.0], [1.0, np.inf], [2.0, 0.0]])), "finite"),
         (
             lambda: obstacle_mask(GridGeometry(2, 2, 1.0, 1.0), [], clearance=-1.0),

@@ -164,9 +164,12 @@ def _ring(vertices: FloatArray, what: str) -> FloatArray:
         raise InputError(f"{what} vertices must have shape (n >= 3, 2), got {np.shape(vertices)}")
     if not np.all(np.isfinite(ring)):
         raise InputError(f"{what} vertices must be finite")
-    north, east = ring[:, 0], ring[:, 1]
+    # the shoelace area relative to the square of the ring's extent (at least 1 m), on
+    # coordinates scaled by that extent: no overflow for vertices as far out as 1e300 m
+    scaled = (ring - ring.min(axis=0)) / max(1.0, float(np.ptp(ring)))
+    north, east = scaled[:, 0], scaled[:, 1]
     area = 0.5 * (np.dot(north, np.roll(east, -1)) - np.dot(east, np.roll(north, -1)))
-    if abs(area) <= 1e-12 * max(1.0, float(np.ptp(ring)) ** 2):
+    if abs(area) <= 1e-12:
         raise InputError(f"{what} has zero area (vertices {ring.tolist()})")
     return ring
 

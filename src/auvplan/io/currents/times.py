@@ -12,6 +12,7 @@ GriddedCurrent`) weighs the slices ``i-1 … i+2`` between slices ``i`` and ``i+
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import TYPE_CHECKING, Final
@@ -71,11 +72,15 @@ def mission_seconds(variable: xr.Variable, name: str, start_time: datetime | Non
     calendar = str(variable.attrs.get("calendar", "standard")).lower()
     values = np.asarray(variable.values, dtype=np.float64)
     try:
-        dates = cftime.num2date(values, units, calendar=calendar, only_use_cftime_datetimes=True)
-        seconds: FloatArray = np.asarray(
-            cftime.date2num(dates, _SECONDS_UNITS, calendar=calendar), dtype=np.float64
-        )
-    except (ValueError, TypeError) as error:
+        with warnings.catch_warnings():  # dates before year 1, which no model has: refused
+            warnings.simplefilter("error", cftime.CFWarning)
+            dates = cftime.num2date(
+                values, units, calendar=calendar, only_use_cftime_datetimes=True
+            )
+            seconds: FloatArray = np.asarray(
+                cftime.date2num(dates, _SECONDS_UNITS, calendar=calendar), dtype=np.float64
+            )
+    except (ValueError, TypeError, OverflowError, cftime.CFWarning) as error:
         raise DataFormatError(
             f"time axis {name} ({units!r}, calendar {calendar!r}) cannot be decoded "
             f"({first_line(error)})"
