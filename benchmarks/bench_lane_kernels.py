@@ -198,12 +198,12 @@ def by_point({", ".join(names)}):
     return scope["by_lanes"], scope["by_point"]
 
 
-def node_arguments(repeat_to: int = 8) -> tuple[dict[str, ca.Function], Any, list[np.ndarray]]:
+def node_arguments(multiple: int = 8) -> tuple[dict[str, ca.Function], Any, list[np.ndarray]]:
     """The demo model's kernel Functions, its numba module and real node arguments.
 
     Rows: every node of a forward sweep along the demo's optimal trajectory (both vehicles), in
-    the sweep's own arrays (``y``, ``D``) with the point's ``u``, ``p``, ``w``; ``λ`` of the
-    rates' scale; ``ν = 1``. The row count is rounded down to a multiple of ``repeat_to``.
+    the sweep's own arrays (``y``, ``D``) with the point's ``u``, ``p``, ``w``; ``λ`` random on the
+    states' scale; ``ν = 1``. The row count is rounded down to a multiple of ``multiple``.
     """
     with tempfile.TemporaryDirectory() as scratch:
         assembled, options, _ = build_case("demo", Path(scratch))
@@ -218,11 +218,11 @@ def node_arguments(repeat_to: int = 8) -> tuple[dict[str, ca.Function], Any, lis
     x, u, p, w = discrete._points(group, optimum.states[:-1], optimum.inputs, problem.parameters)
     forward = group.kernels._forward(x, u, p, w, discrete.h, discrete.n_substeps)
     n_nodes = forward.points.shape[0]
-    rows = (n_nodes * x.shape[0]) // repeat_to * repeat_to
+    rows = (n_nodes * x.shape[0]) // multiple * multiple
     y = forward.points.reshape(-1, forward.points.shape[2])[:rows]
     d = forward.carried.reshape(-1, forward.carried.shape[2])[:rows]
-    tile = np.tile  # the point's u, p, w at each of its nodes (node-major like the sweep)
-    u, p, w = (tile(a, (n_nodes, 1))[:rows] for a in (u, p, w))
+    # the point's u, p, w at each of its nodes (node-major, as the sweep stores them)
+    u, p, w = (np.tile(a, (n_nodes, 1))[:rows] for a in (u, p, w))
     rng = np.random.default_rng(27)
     lam = rng.normal(scale=float(np.std(y)), size=y.shape)
     nu = np.ones((rows, 1))
