@@ -178,24 +178,39 @@ def compile_lanes(function: ca.Function, lanes: int) -> tuple[Callable[..., None
     return kernel, time.perf_counter() - started, engine
 
 
-def _loops(kernel: Any, scalar: Any, n_args: int, lanes: int) -> tuple[Any, Any]:
-    """numba loops over rows of 2-D arrays: ``lanes`` rows per call / one row per call."""
+def _row_loop(kernel: Any, n_args: int, rows: int) -> Any:
+    """A numba loop over the rows of 2-D arrays calling ``kernel`` on ``rows`` rows at a time.
+
+    ``rows == 0``: a numba kernel called on each row as 1-D arrays; otherwise a lane kernel
+    (:func:`compile_lanes`) called with each argument's address and row stride.
+    """
     names = [f"a{k}" for k in range(n_args)]
+    if rows == 0:
+        step, call = 1, f"kernel({', '.join(f'{a}[b]' for a in names)})"
+    else:
+        pointers = ", ".join(f"{a}[b:].ctypes.data" for a in names)
+        strides = ", ".join(f"{a}.shape[1]" for a in names)
+        step, call = rows, f"kernel({pointers}, {strides})"
     source = f"""
 @numba.njit
-def by_lanes({", ".join(names)}):
-    for b in range(0, a0.shape[0], {lanes}):
-        kernel({", ".join(f"{a}[b:].ctypes.data" for a in names)},
-               {", ".join(f"{a}.shape[1]" for a in names)})
-
-@numba.njit
-def by_point({", ".join(names)}):
-    for b in range(a0.shape[0]):
-        scalar({", ".join(f"{a}[b]" for a in names)})
+def loop({", ".join(names)}):
+    for b in range(0, a0.shape[0], {step}):
+        {call}
 """
-    scope = {"numba": numba, "kernel": kernel, "scalar": scalar}
-    exec(compile(source, "bench_lane_kernels", "exec"), scope)  # noqa: S102 - generated loops
-    return scope["by_lanes"], scope["by_point"]
+    scope = {"numba": numba, "kernel": kernel}
+    exec(compile(source, "bench_lane_kernels", "exec"), scope)  # noqa: S102 - generated loop
+    return scope["loop"]
+
+
+def _best_us(loop: Callable[..., None], arrays: list[np.ndarray], repeat: int) -> float:
+    """Best of ``repeat`` runs of ``loop(*arrays)`` (after one untimed), in µs per row."""
+    loop(*arrays)
+    times = []
+    for _ in range(repeat):
+        started = time.perf_counter()
+        loop(*arrays)
+        times.append(time.perf_counter() - started)
+    return min(times) / arrays[0].shape[0] * 1e6
 
 
 def node_arguments(multiple: int = 8) -> tuple[dict[str, ca.Function], Any, list[np.ndarray]]:
@@ -249,29 +264,16 @@ def main(argv: list[str]) -> int:
         outputs = [np.empty((y.shape[0], function.numel_out(i))) for i in range(function.n_out())]
         arguments = [np.ascontiguousarray(a) for a in inputs[name]] + outputs
         reference = [o.copy() for o in outputs]
-
-        def best(loop: Callable[..., None], arrays: list[np.ndarray]) -> float:
-            loop(*arrays)
-            times = []
-            for _ in range(args.repeat):
-                started = time.perf_counter()
-                loop(*arrays)
-                times.append(time.perf_counter() - started)
-            return min(times) / y.shape[0] * 1e6
-
-        scalar_us = None
+        shipped = _row_loop(getattr(module, name), len(arguments), 0)
+        scalar_us = _best_us(shipped, arguments[: function.n_in()] + reference, args.repeat)
         for lanes in (4, 8):
-            kernel, compile_s, _engine = compile_lanes(function, lanes)
-            by_lanes, by_point = _loops(kernel, getattr(module, name), len(arguments), lanes)
-            if scalar_us is None:
-                by_point(*arguments[: function.n_in()], *reference)
-                scalar_us = best(by_point, arguments[: function.n_in()] + reference)
-            by_lanes(*arguments)
+            kernel, compile_s, _engine = compile_lanes(function, lanes)  # engine kept alive
+            by_lanes = _row_loop(kernel, len(arguments), lanes)
+            lanes_us = _best_us(by_lanes, arguments, args.repeat)
             equal = all(
                 np.array_equal(a, b, equal_nan=True)
                 for a, b in zip(outputs, reference, strict=True)
             )
-            lanes_us = best(by_lanes, arguments)
             print(
                 f"| {name} | {function.n_instructions()} | {scalar_us:.3f} | {lanes} | "
                 f"{lanes_us:.3f} | {scalar_us / lanes_us:.2f}× | {'yes' if equal else 'NO'} "
