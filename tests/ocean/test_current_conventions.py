@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import xarray as xr
 
 from auvplan.errors import DataFormatError, InputError
 from auvplan.io.currents import read_current
@@ -207,8 +208,6 @@ def test_undecodable_time_is_one_line(
 def test_times_no_calendar_holds_are_one_line(tmp_path: Path, shift_days: float) -> None:
     """Time values far outside any ocean model's (a damaged RTOFS file, found by the fuzz
     test: the first case was a CFWarning from cftime, the second an OverflowError)."""
-    import xarray as xr
-
     source = write_rtofs(tmp_path / "source.nc", three_d=False)
     with xr.open_dataset(source, decode_times=False) as opened:
         dataset = opened.load()
