@@ -20,6 +20,7 @@ import pytest
 
 from auvplan.optimization import BlockKernels, block_kernels, discretize_rk4
 from auvplan.optimization._kernel_cache import load_kernel_module
+from auvplan.optimization._lane_codegen import LANES
 from auvplan.optimization._numba_codegen import (
     _BINARY,
     _TEMPLATES,
@@ -59,9 +60,8 @@ def _casadi_rows(function: ca.Function, rows: np.ndarray) -> np.ndarray:
     return np.asarray(function.map(rows.shape[0])(rows.T)).T
 
 
-def test_every_translated_operation_evaluates_like_casadi(
-    kernel_cache: Path, rng: np.random.Generator
-) -> None:
+def _every_operation(rng: np.random.Generator) -> tuple[ca.Function, np.ndarray]:
+    """A Function using every translated operation, and 200 rows of arguments for it."""
     a = ca.SX.sym("a", 8)
     # x, y in (-0.9, 0.9); s, t in (0.5, 2); big in (1.5, 3); q, r in (-3, 3); z in {-1, 0, 1}
     x, y, s, t, big, q, r, z = (a[i] for i in range(8))
@@ -92,9 +92,44 @@ def test_every_translated_operation_evaluates_like_casadi(
     rows[:20, 5] = rows[:20, 7]  # q == z: equality true, floor/ceil and sign at integers
     rows[20:25, 6] = rows[20:25, 5]  # q == r: the ties of <, <=, fmin, fmax
     rows[25:27, 5] = (1e30, -1e30)  # floor and ceil beyond the int64 range
+    return function, rows
+
+
+def test_every_translated_operation_evaluates_like_casadi(
+    kernel_cache: Path, rng: np.random.Generator
+) -> None:
+    function, rows = _every_operation(rng)
     expected = _casadi_rows(function, rows)
     actual = _compiled(function, kernel_cache)(rows)
     np.testing.assert_allclose(actual, expected, rtol=1e-12, atol=0.0)
+
+
+#: A loop over groups of ``LANES`` rows calling a one-input, one-output lane kernel.
+_LANE_LOOP = """
+@numba.njit(cache=True)
+def kernel_groups(rows, out):
+    arguments, results = np.empty((rows.shape[1], LANES)), np.empty((out.shape[1], LANES))
+    for first in range(0, rows.shape[0], LANES):
+        for lane in range(LANES):
+            arguments[:, lane] = rows[first + lane]
+        kernel_lanes(arguments, results)
+        for lane in range(LANES):
+            out[first + lane] = results[:, lane]
+"""
+
+
+def test_lane_kernels_equal_the_scalar_kernels_to_the_bit(
+    kernel_cache: Path, rng: np.random.Generator
+) -> None:
+    """Every operation on ``LANES`` points at once gives the scalar kernel's bits, lane by lane."""
+    function, rows = _every_operation(rng)
+    assert rows.shape[0] % LANES == 0
+    source = numba_source({"kernel": function}, "lane kernel", _LANE_LOOP, lanes=("kernel",))
+    module, _ = load_kernel_module(source, lambda: source, kernel_cache)
+    assert not hasattr(module, "kernel")  # written on lanes only
+    actual = np.empty((rows.shape[0], function.numel_out(0)))
+    module.kernel_groups(rows, actual)
+    np.testing.assert_array_equal(actual, _compiled(function, kernel_cache)(rows))
 
 
 def test_infinite_and_nan_constants_evaluate_like_casadi(kernel_cache: Path) -> None:
@@ -415,5 +450,6 @@ def test_node_derivatives_vanish_outside_the_carried_pattern(
     assert np.count_nonzero(~pattern) == 8
     x, u, p, w = _points(kernels, weights, rng)
     (sweep,) = kernels._sweeps(x, u, p, w, DT / 3, 3, threads=1, remember=False)
-    carried = sweep.carried.reshape(12, N_POINTS, *pattern.shape)  # 3 substeps of 4 nodes
+    # 3 substeps of 4 nodes; (node, group, entry, lane) -> (node, point, entry)
+    carried = np.moveaxis(sweep.carried, 3, 2).reshape(12, -1, *pattern.shape)[:, :N_POINTS]
     assert np.all(carried[:, :, ~pattern] == 0.0)

@@ -19,10 +19,10 @@ from typing import Final
 
 import casadi as ca
 
-__all__ = ["UnsupportedOperation", "numba_source"]
+__all__ = ["UnsupportedOperation", "lane_program", "numba_source", "scalar_expression"]
 
 #: Version of the generated code; part of every cache key (bump on any change of the output).
-GENERATOR_VERSION: Final = 8
+GENERATOR_VERSION: Final = 9
 
 _BINARY: Final = {ca.OP_ADD: "+", ca.OP_SUB: "-", ca.OP_MUL: "*", ca.OP_DIV: "/"}
 _UNARY: Final = {
@@ -63,16 +63,29 @@ class UnsupportedOperation(ValueError):
     """An SX instruction that :func:`numba_source` cannot translate."""
 
 
-def _expression(function: ca.Function, k: int) -> str:
-    op = function.instruction_id(k)
-    args = [f"w{j}" for j in function.instruction_input(k)]
+def scalar_expression(op: int, args: list[str]) -> str:
+    """Python source of CasADi operation ``op`` on the operands named ``args``.
+
+    Raises
+    ------
+    UnsupportedOperation
+        If ``op`` is not translated.
+    """
     if op in _BINARY:
         return f"{args[0]} {_BINARY[op]} {args[1]}"
     if op in _UNARY:
         return f"{_UNARY[op]}({args[0]})"
     if op in _TEMPLATES:
         return _TEMPLATES[op].format(*args)
-    raise UnsupportedOperation(f"{function.name()}: CasADi operation {op} is not translated")
+    raise UnsupportedOperation(f"CasADi operation {op} is not translated")
+
+
+def _expression(function: ca.Function, k: int) -> str:
+    args = [f"w{j}" for j in function.instruction_input(k)]
+    try:
+        return scalar_expression(function.instruction_id(k), args)
+    except UnsupportedOperation as error:
+        raise UnsupportedOperation(f"{function.name()}: {error}") from None
 
 
 def _literal(value: float) -> str:
@@ -102,11 +115,41 @@ def _kernel_lines(function: ca.Function) -> list[str]:
     return lines
 
 
+def lane_program(function: ca.Function) -> list[str]:
+    """The instructions of ``function`` as tuple literals (lines of the generated source).
+
+    The program of :func:`~auvplan.optimization._lane_codegen.lane_typing`.
+
+    Raises
+    ------
+    UnsupportedOperation
+        If an instruction's operation is not translated.
+    """
+    lines = []
+    for k in range(function.n_instructions()):
+        op = function.instruction_id(k)
+        out = function.instruction_output(k)
+        fields: list[object]
+        if op == ca.OP_INPUT:
+            fields = [out[0], *function.instruction_input(k)]
+        elif op == ca.OP_OUTPUT:
+            fields = [*out, function.instruction_input(k)[0]]
+        elif op == ca.OP_CONST:
+            fields = [out[0], _literal(float(function.instruction_constant(k)))]
+        else:
+            operands = function.instruction_input(k)
+            scalar_expression(op, ["x"] * len(operands))  # refuses what is not translated
+            fields = [out[0], *operands]
+        lines.append(f"    ({op}, {', '.join(str(f) for f in fields)}),")
+    return lines
+
+
 def numba_source(
     functions: dict[str, ca.Function],
     header: str,
     appendix: str = "",
     batched: tuple[str, ...] | None = None,
+    lanes: tuple[str, ...] = (),
 ) -> str:
     """Python source of a module with one numba kernel (and its batch loop) per Function.
 
@@ -122,13 +165,19 @@ def numba_source(
     batched : tuple of str, optional
         The kernels that get a ``name_batch`` loop (all when not given; the others are
         called from ``appendix`` only).
+    lanes : tuple of str, optional
+        The kernels written as ``name_lanes`` instead, evaluating
+        :data:`~auvplan.optimization._lane_codegen.LANES` points at once on arrays of shape
+        ``(n_entries, LANES)`` (:func:`~auvplan.optimization._lane_codegen.lane_typing`;
+        from numba code only, never batched).
 
     Returns
     -------
     str
         Module source: ``name(i0, …, o0, …)`` on 1-D arrays and, for the ``batched`` ones,
         ``name_batch`` on 2-D arrays (one point per row), all
-        ``numba.njit(cache=True, nogil=True)`` (they run on worker threads side by side).
+        ``numba.njit(cache=True, nogil=True)`` (they run on worker threads side by side), and
+        the ``name_lanes`` kernels.
 
     Raises
     ------
@@ -137,6 +186,8 @@ def numba_source(
     """
     lines = [f"# {header}", f"# auvplan numba generator version {GENERATOR_VERSION}", ""]
     lines += ["import math", "", "import numba", "import numpy as np", ""]
+    lines += ["from numba.extending import intrinsic", ""]
+    lines += ["from auvplan.optimization._lane_codegen import LANES, lane_typing", ""]
     for name, function in functions.items():
         if not function.is_a("SXFunction"):
             raise UnsupportedOperation(f"{function.name()} is not an SX Function")
@@ -145,6 +196,23 @@ def numba_source(
                 raise UnsupportedOperation(f"{function.name()} output {i} is not dense")
         inputs = [f"i{i}" for i in range(function.n_in())]
         outputs = [f"o{i}" for i in range(function.n_out())]
+        if name in lanes:
+            lines += [
+                "",
+                f"_{name}_program = (",
+                *lane_program(function),
+                ")",
+                "",
+                "",
+                "@intrinsic",
+                f"def {name}_lanes(typingctx, {', '.join(inputs + outputs)}):",
+                (
+                    f"    return lane_typing({function.name()!r}, {function.n_in()}, "
+                    f"_{name}_program, ({', '.join(inputs + outputs)},))"
+                ),
+                "",
+            ]
+            continue
         rows = [f"{arg}[b]" for arg in inputs + outputs]
         lines += [
             "",

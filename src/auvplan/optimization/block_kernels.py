@@ -57,6 +57,7 @@ import numpy as np
 from auvplan._typing import BoolArray, FloatArray
 from auvplan.optimization._casadi import row_major
 from auvplan.optimization._kernel_cache import load_kernel_module, mark_compiled
+from auvplan.optimization._lane_codegen import LANES
 from auvplan.optimization._numba_codegen import (
     GENERATOR_VERSION,
     UnsupportedOperation,
@@ -131,111 +132,145 @@ def closed_loop_batch(x0, alpha, mu, gains, p, w, h, n_sub, path, inputs, costs)
             costs[b, k] = cost
 """
 #: The derivative sweeps appended to every kernel module (as the closed loop, for numba's
-#: cache), point by point through the ``4m`` nodes so that a node's products stay in
-#: registers (the chain rule of the module notes). ``forward_batch`` stores
-#: every node's point ``Y_n (n_nodes, B, n_x)`` and ``D_n (n_nodes, B, n_x n_z)`` (row-major)
-#: for ``reverse_batch``, and returns the step's ``∂F/∂(x, u)``, ``L`` and ``∇L``;
-#: ``reverse_batch`` adds ``Σ_n D̃_nᵀ ∇²(K̄_nᵀ f + ν h b_n l) D̃_n`` into ``total (B, n_z, n_z)``.
+#: cache), through the ``4m`` nodes of :data:`LANES` points at once (the lane kernels
+#: ``first_lanes`` and ``hessian_lanes``; a last group short of points repeats its last point),
+#: with the arithmetic of the chain rule (module notes) in the same order for every lane.
+#: ``forward_batch`` stores every node's point ``Y_n`` and ``D_n`` (row-major) lane-major,
+#: ``points (n_nodes, G, n_x, LANES)`` and ``carried (n_nodes, G, n_x n_z, LANES)`` for
+#: ``G = ⌈B / LANES⌉`` groups, for ``reverse_batch``, and returns the step's ``∂F/∂(x, u)``,
+#: ``L`` and ``∇L``; ``reverse_batch`` adds ``Σ_n D̃_nᵀ ∇²(K̄_nᵀ f + ν h b_n l) D̃_n`` into
+#: ``total (B, n_z, n_z)``.
 _SWEEP_SOURCE: Final = """
+@numba.njit(cache=True, error_model='numpy', nogil=True)
+def lanes_of(rows, first, out):
+    n_points = rows.shape[0]
+    for lane in range(LANES):
+        b = min(first + lane, n_points - 1)
+        for t in range(rows.shape[1]):
+            out[t, lane] = rows[b, t]
+
+
 @numba.njit(cache=True, error_model='numpy', nogil=True)
 def forward_batch(x, u, p, w, h, n_sub, points, carried, step_jac, cost, cost_grad):
     n_points, n_x = x.shape
     n_d = carried.shape[2]
     n_z = n_d // n_x
-    rate = np.empty(n_x)
-    q = np.empty(1)
-    rate_d = np.empty(n_d)
-    grad_d = np.empty(n_z)
-    y = np.empty(n_x)
-    dy = np.empty(n_d)
-    advanced = np.empty(n_x)
-    advanced_d = np.empty(n_d)
+    rate = np.empty((n_x, LANES))
+    q = np.empty((1, LANES))
+    rate_d = np.empty((n_d, LANES))
+    grad_d = np.empty((n_z, LANES))
+    y = np.empty((n_x, LANES))
+    dy = np.empty((n_d, LANES))
+    advanced = np.empty((n_x, LANES))
+    advanced_d = np.empty((n_d, LANES))
+    u_lanes = np.empty((u.shape[1], LANES))
+    p_lanes = np.empty((p.shape[1], LANES))
+    w_lanes = np.empty((w.shape[1], LANES))
+    total = np.empty(LANES)
+    total_grad = np.empty((n_z, LANES))
     factors, offsets = rk4_coefficients(h)
-    for b in range(n_points):
+    for g in range(points.shape[1]):
+        first_point = g * LANES
+        lanes_of(x, first_point, y)
+        lanes_of(u, first_point, u_lanes)
+        lanes_of(p, first_point, p_lanes)
+        lanes_of(w, first_point, w_lanes)
+        dy[:, :] = 0.0
         for t in range(n_x):
-            y[t] = x[b, t]
-        for t in range(n_d):
-            dy[t] = 0.0
-        for t in range(n_x):
-            dy[t * n_z + t] = 1.0
-        total = 0.0
-        for c in range(n_z):
-            cost_grad[b, c] = 0.0
+            dy[t * n_z + t, :] = 1.0
+        total[:] = 0.0
+        total_grad[:, :] = 0.0
         for j in range(n_sub):
             n = 4 * j
-            for t in range(n_x):
-                advanced[t] = y[t]
-                points[n, b, t] = y[t]
-            for t in range(n_d):
-                advanced_d[t] = dy[t]
-                carried[n, b, t] = dy[t]
+            advanced[:, :] = y
+            points[n, g] = y
+            advanced_d[:, :] = dy
+            carried[n, g] = dy
             for i in range(4):
-                first(points[n + i, b], u[b], p[b], w[b], carried[n + i, b], rate, q, rate_d,
-                      grad_d)
-                total += factors[i] * q[0]
+                first_lanes(points[n + i, g], u_lanes, p_lanes, w_lanes, carried[n + i, g], rate,
+                            q, rate_d, grad_d)
+                for lane in range(LANES):
+                    total[lane] += factors[i] * q[0, lane]
                 for c in range(n_z):
-                    cost_grad[b, c] += factors[i] * grad_d[c]
+                    for lane in range(LANES):
+                        total_grad[c, lane] += factors[i] * grad_d[c, lane]
                 for t in range(n_x):
-                    advanced[t] += factors[i] * rate[t]
+                    for lane in range(LANES):
+                        advanced[t, lane] += factors[i] * rate[t, lane]
                 for t in range(n_d):
-                    advanced_d[t] += factors[i] * rate_d[t]
+                    for lane in range(LANES):
+                        advanced_d[t, lane] += factors[i] * rate_d[t, lane]
                 if i < 3:
                     for t in range(n_x):
-                        points[n + i + 1, b, t] = y[t] + offsets[i] * rate[t]
+                        for lane in range(LANES):
+                            points[n + i + 1, g, t, lane] = y[t, lane] + offsets[i] * rate[t, lane]
                     for t in range(n_d):
-                        carried[n + i + 1, b, t] = dy[t] + offsets[i] * rate_d[t]
-            for t in range(n_x):
-                y[t] = advanced[t]
+                        for lane in range(LANES):
+                            carried[n + i + 1, g, t, lane] = (
+                                dy[t, lane] + offsets[i] * rate_d[t, lane]
+                            )
+            y[:, :] = advanced
+            dy[:, :] = advanced_d
+        for lane in range(min(LANES, n_points - first_point)):
+            b = first_point + lane
+            cost[b] = total[lane]
+            for c in range(n_z):
+                cost_grad[b, c] = total_grad[c, lane]
             for t in range(n_d):
-                dy[t] = advanced_d[t]
-        cost[b] = total
-        for t in range(n_d):
-            step_jac[b, t // n_z, t % n_z] = dy[t]
+                step_jac[b, t // n_z, t % n_z] = dy[t, lane]
 
 
 @numba.njit(cache=True, error_model='numpy', nogil=True)
 def reverse_batch(points, carried, u, p, w, h, costate, cost_weight, total):
-    n_nodes, n_points, n_x = points.shape
-    n_z = total.shape[1]
+    n_nodes, n_groups, n_x = points.shape[:3]
+    n_points, n_z = total.shape[:2]
     n_upper = n_z * (n_z + 1) // 2
     factors, offsets = rk4_coefficients(h)
-    y_bar = np.empty(n_x)
-    start_bar = np.empty(n_x)
-    point_bar = np.empty(n_x)
-    k_bar = np.empty(n_x)
-    weight = np.empty(1)
-    node_upper = np.empty(n_upper)
-    upper = np.empty(n_upper)
-    for b in range(n_points):
-        for t in range(n_x):
-            y_bar[t] = costate[b, t]
-        for t in range(n_upper):
-            upper[t] = 0.0
+    y_bar = np.empty((n_x, LANES))
+    start_bar = np.empty((n_x, LANES))
+    point_bar = np.empty((n_x, LANES))
+    k_bar = np.empty((n_x, LANES))
+    weight = np.empty((1, LANES))
+    node_upper = np.empty((n_upper, LANES))
+    upper = np.empty((n_upper, LANES))
+    u_lanes = np.empty((u.shape[1], LANES))
+    p_lanes = np.empty((p.shape[1], LANES))
+    w_lanes = np.empty((w.shape[1], LANES))
+    for g in range(n_groups):
+        first_point = g * LANES
+        lanes_of(costate, first_point, y_bar)
+        lanes_of(u, first_point, u_lanes)
+        lanes_of(p, first_point, p_lanes)
+        lanes_of(w, first_point, w_lanes)
+        upper[:, :] = 0.0
         for j in range(n_nodes // 4 - 1, -1, -1):
-            for t in range(n_x):
-                start_bar[t] = y_bar[t]
+            start_bar[:, :] = y_bar
             for i in range(3, -1, -1):
                 for t in range(n_x):
-                    k_bar[t] = factors[i] * y_bar[t]
-                    if i < 3:
-                        k_bar[t] += offsets[i] * point_bar[t]
-                weight[0] = cost_weight * factors[i]
-                hessian(points[4 * j + i, b], u[b], p[b], w[b], k_bar, weight,
-                        carried[4 * j + i, b], node_upper, point_bar)
+                    for lane in range(LANES):
+                        k_bar[t, lane] = factors[i] * y_bar[t, lane]
+                        if i < 3:
+                            k_bar[t, lane] += offsets[i] * point_bar[t, lane]
+                weight[:, :] = cost_weight * factors[i]
+                hessian_lanes(points[4 * j + i, g], u_lanes, p_lanes, w_lanes, k_bar, weight,
+                              carried[4 * j + i, g], node_upper, point_bar)
                 for t in range(n_upper):
-                    upper[t] += node_upper[t]
+                    for lane in range(LANES):
+                        upper[t, lane] += node_upper[t, lane]
                 for t in range(n_x):
-                    start_bar[t] += point_bar[t]
-            for t in range(n_x):
-                y_bar[t] = start_bar[t]
-        k = 0
-        for r in range(n_z):
-            total[b, r, r] += upper[k]
-            k += 1
-            for c in range(r + 1, n_z):
-                total[b, r, c] += upper[k]
-                total[b, c, r] += upper[k]
+                    for lane in range(LANES):
+                        start_bar[t, lane] += point_bar[t, lane]
+            y_bar[:, :] = start_bar
+        for lane in range(min(LANES, n_points - first_point)):
+            b = first_point + lane
+            k = 0
+            for r in range(n_z):
+                total[b, r, r] += upper[k, lane]
                 k += 1
+                for c in range(r + 1, n_z):
+                    total[b, r, c] += upper[k, lane]
+                    total[b, c, r] += upper[k, lane]
+                    k += 1
 """
 #: Everything appended to the generated node kernels (part of the cache key).
 _APPENDIX: Final = _RK4_SOURCE + _CLOSED_LOOP_SOURCE + _SWEEP_SOURCE
@@ -351,8 +386,9 @@ class LastCall(Generic[_T]):
 class _Forward:
     """A forward sweep: the nodes' points and derivatives, the step's first-order data.
 
-    ``points`` ``Y_n (n_nodes, B, n_x)``, ``carried`` ``D_n (n_nodes, B, n_x n_z)``
-    (row-major), ``step_jac`` ``∂F/∂(x, u)``, ``cost`` ``L``, ``cost_grad`` ``∇L``.
+    ``points`` ``Y_n (n_nodes, G, n_x, LANES)``, ``carried`` ``D_n (n_nodes, G, n_x n_z,
+    LANES)`` (row-major ``D``; point ``b`` in group ``b // LANES``, lane ``b % LANES``),
+    ``step_jac`` ``∂F/∂(x, u)``, ``cost`` ``L``, ``cost_grad`` ``∇L``.
     """
 
     points: FloatArray
@@ -470,11 +506,12 @@ class BlockKernels:
         shapes match (fresh memory is first touched page by page).
         """
         n_points, n_x, n_z = x.shape[0], self.n_x, self.n_x + self.n_u
-        shape = (4 * n_substeps, n_points, n_x)
-        if spare is not None and spare.points.shape == shape:
+        nodes = (4 * n_substeps, -(-n_points // LANES))
+        if spare is not None and spare.points.shape == (*nodes, n_x, LANES):
             points, carried = spare.points, spare.carried
         else:
-            points, carried = np.empty(shape), np.empty((*shape[:2], n_x * n_z))
+            points = np.empty((*nodes, n_x, LANES))
+            carried = np.empty((*nodes, n_x * n_z, LANES))
         step_jac, cost = np.empty((n_points, n_x, n_z)), np.empty(n_points)
         cost_grad = np.empty((n_points, n_z))
         self.module.forward_batch(
@@ -653,7 +690,8 @@ def block_kernels(
             functions,
             f"model kernels {memo[0][:24]}",
             _APPENDIX,
-            batched=("value",),  # `first` and `hessian` run inside the sweeps only
+            batched=("value",),
+            lanes=("first", "hessian"),  # they run inside the sweeps only
         )
 
     module, is_new = load_kernel_module(key, source, cache_dir)

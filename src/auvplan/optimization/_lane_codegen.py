@@ -1,0 +1,139 @@
+"""CasADi SX instruction lists as numba intrinsics that evaluate :data:`LANES` points at once.
+
+numba compiles the straight-line kernels of :mod:`~auvplan.optimization._numba_codegen` to
+scalar code: LLVM does not vectorise a loop over points around a body of thousands of
+instructions. The kernels of :func:`lane_typing` instead write every SX instruction as one LLVM
+instruction on ``<LANES x double>`` — one value per point — inside the numba function that
+calls it (a numba *intrinsic*, so numba's cache keeps its machine code like any other).
+Arithmetic (``+ − × ÷``, negation, square, doubling, inverse) is a vector instruction; every
+other operation is numba's own lowering of the scalar kernel's expression
+(:func:`~auvplan.optimization._numba_codegen.scalar_expression`), lane by lane. Each lane
+therefore runs the IEEE operations of the scalar kernel in the same order: the results are
+those of the scalar kernel, to the bit.
+
+The kernel's arguments are 2-D C-contiguous float64 arrays of ``LANES`` columns, one per
+point: entry ``e`` of an input or output is row ``e`` (``(n_entries, LANES)``).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Callable
+from typing import Any, Final
+
+import casadi as ca
+import numpy as np
+from llvmlite import ir
+from numba.core import compiler, types
+
+from auvplan.optimization._numba_codegen import scalar_expression
+
+__all__ = ["LANES", "lane_typing"]
+
+#: Points per evaluation (four doubles: one AVX2 register).
+LANES: Final = 4
+
+_VECTOR: Final = ir.VectorType(ir.DoubleType(), LANES)
+_ARITHMETIC: Final[dict[int, Callable[..., Any]]] = {
+    ca.OP_ADD: lambda b, x, y: b.fadd(x, y),
+    ca.OP_SUB: lambda b, x, y: b.fsub(x, y),
+    ca.OP_MUL: lambda b, x, y: b.fmul(x, y),
+    ca.OP_DIV: lambda b, x, y: b.fdiv(x, y),
+    ca.OP_NEG: lambda b, x: b.fneg(x),
+    ca.OP_SQ: lambda b, x: b.fmul(x, x),
+    ca.OP_TWICE: lambda b, x: b.fmul(_splat(2.0), x),
+    ca.OP_INV: lambda b, x: b.fdiv(_splat(1.0), x),
+}
+
+
+def _splat(value: float) -> ir.Constant:
+    return ir.Constant(_VECTOR, [value] * LANES)
+
+
+@functools.cache
+def _scalar_function(op: int, arity: int) -> Callable[..., float]:
+    """The scalar kernel's expression of ``op`` as a Python function (numba compiles it)."""
+    names = ["a", "b"][:arity]
+    source = f"lambda {', '.join(names)}: {scalar_expression(op, names)}"
+    function: Callable[..., float] = eval(source, {"math": math, "np": np})
+    return function
+
+
+def _per_lane(context: Any, builder: ir.IRBuilder, op: int, operands: list[Any]) -> Any:
+    """``op`` on each lane through numba's lowering of the scalar expression (numpy errors)."""
+    signature = types.float64(*([types.float64] * len(operands)))
+    flags = compiler.Flags()  # type: ignore[no-untyped-call]
+    flags.error_model = "numpy"  # type: ignore[misc,assignment]
+    compiled = context.compile_subroutine(
+        builder, _scalar_function(op, len(operands)), signature, flags=flags
+    )
+    vector = ir.Constant(_VECTOR, None)
+    for lane in range(LANES):
+        scalars = [builder.extract_element(x, ir.Constant(ir.IntType(32), lane)) for x in operands]
+        value = context.call_internal(builder, compiled.fndesc, signature, scalars)
+        vector = builder.insert_element(vector, value, ir.Constant(ir.IntType(32), lane))
+    return vector
+
+
+def lane_typing(
+    name: str, n_in: int, program: tuple[tuple[float, ...], ...], arrays: tuple[Any, ...]
+) -> tuple[Any, Callable[..., Any]]:
+    """Signature and code of a numba intrinsic ``kernel(i0, …, o0, …)`` that runs ``program``.
+
+    The generated modules define each lane kernel as ``@intrinsic def name_lanes(typingctx,
+    i0, …, o0, …): return lane_typing(…)``.
+
+    Parameters
+    ----------
+    name : str
+        The Function's name (for error messages).
+    n_in : int
+        Its number of inputs (the arguments after them are its outputs).
+    program : tuple of tuple
+        Its instructions in order: ``(OP_INPUT, slot, input, entry)``,
+        ``(OP_OUTPUT, output, entry, slot)``, ``(OP_CONST, slot, value)`` and
+        ``(op, slot, operand_slot, …)`` (:func:`~auvplan.optimization._numba_codegen.lane_program`).
+    arrays : tuple of numba types
+        The argument types: C-contiguous float64 arrays of shape ``(n_entries, LANES)``.
+
+    Raises
+    ------
+    TypeError
+        If an argument is not such an array (when a caller is compiled).
+    """
+    if not all(
+        isinstance(a, types.Array) and a.dtype == types.float64 and a.layout == "C" for a in arrays
+    ):
+        raise TypeError(f"{name}: lane kernels take C-contiguous float64 arrays")
+
+    def codegen(context: Any, builder: ir.IRBuilder, signature: Any, args: Any) -> Any:
+        pointers = [
+            builder.bitcast(
+                context.make_array(kind)(context, builder, value).data, _VECTOR.as_pointer()
+            )
+            for kind, value in zip(signature.args, args, strict=True)
+        ]
+        slots: dict[int, Any] = {}
+        for instruction in program:
+            op, slot = int(instruction[0]), int(instruction[1])
+            if op == ca.OP_INPUT:
+                row = ir.Constant(ir.IntType(64), int(instruction[3]))
+                slots[slot] = builder.load(
+                    builder.gep(pointers[int(instruction[2])], [row]), align=8
+                )
+            elif op == ca.OP_OUTPUT:
+                row = ir.Constant(ir.IntType(64), int(instruction[2]))
+                address = builder.gep(pointers[n_in + slot], [row])
+                builder.store(slots[int(instruction[3])], address, align=8)
+            elif op == ca.OP_CONST:
+                slots[slot] = _splat(float(instruction[2]))
+            else:
+                operands = [slots[int(j)] for j in instruction[2:]]
+                if op in _ARITHMETIC:
+                    slots[slot] = _ARITHMETIC[op](builder, *operands)
+                else:
+                    slots[slot] = _per_lane(context, builder, op, operands)
+        return context.get_dummy_value()
+
+    return types.void(*arrays), codegen
