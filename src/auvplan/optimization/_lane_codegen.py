@@ -5,7 +5,8 @@ scalar code: LLVM does not vectorise a loop over points around a body of thousan
 instructions. The kernels of :func:`lane_typing` instead write every SX instruction as one LLVM
 instruction on ``<LANES x double>`` — one value per point — inside the numba function that
 calls it (a numba *intrinsic*, so numba's cache keeps its machine code like any other).
-Arithmetic (``+ − × ÷``, negation, square, doubling, inverse) is a vector instruction; every
+Arithmetic (``+ − × ÷``, negation, square, doubling, inverse, square root, absolute value) is a
+vector instruction; every
 other operation is numba's own lowering of the scalar kernel's expression
 (:func:`~auvplan.optimization._numba_codegen.scalar_expression`), lane by lane. Each lane
 therefore runs the IEEE operations of the scalar kernel in the same order: the results are
@@ -25,7 +26,7 @@ from typing import Any, Final
 import casadi as ca
 import numpy as np
 from llvmlite import ir
-from numba.core import compiler, types
+from numba.core import cgutils, compiler, types
 
 from auvplan.optimization._numba_codegen import scalar_expression
 
@@ -44,6 +45,13 @@ _ARITHMETIC: Final[dict[int, Callable[..., Any]]] = {
     ca.OP_SQ: lambda b, x: b.fmul(x, x),
     ca.OP_TWICE: lambda b, x: b.fmul(_splat(2.0), x),
     ca.OP_INV: lambda b, x: b.fdiv(_splat(1.0), x),
+}
+#: Operations that are one LLVM vector intrinsic with the scalar code's exact result: IEEE 754
+#: rounds a square root correctly (the scalar ``math.sqrt`` is the C library's), ``abs`` is
+#: ``llvm.fabs`` in both.
+_EXACT_INTRINSICS: Final = {
+    ca.OP_SQRT: f"llvm.sqrt.v{LANES}f64",
+    ca.OP_FABS: f"llvm.fabs.v{LANES}f64",
 }
 
 
@@ -132,6 +140,11 @@ def lane_typing(
                 operands = [slots[int(j)] for j in instruction[2:]]
                 if op in _ARITHMETIC:
                     slots[slot] = _ARITHMETIC[op](builder, *operands)
+                elif op in _EXACT_INTRINSICS:
+                    function = cgutils.get_or_insert_function(
+                        builder.module, ir.FunctionType(_VECTOR, [_VECTOR]), _EXACT_INTRINSICS[op]
+                    )
+                    slots[slot] = builder.call(function, operands)
                 else:
                     slots[slot] = _per_lane(context, builder, op, operands)
         return context.get_dummy_value()
