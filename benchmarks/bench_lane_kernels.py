@@ -98,7 +98,7 @@ def node_arguments() -> tuple[dict[str, ca.Function], list[np.ndarray]]:
     optimum = solve_pronto(problem, assembled.guess, options=options, cache=cache).trajectory
     group = discrete.groups[0]
     block = group.blocks[0]
-    functions = _symbolic_kernels(block.dynamics, block.running_cost)
+    functions, _ = _symbolic_kernels(block.dynamics, block.running_cost)
     x, u, p, w = discrete._points(group, optimum.states[:-1], optimum.inputs, problem.parameters)
     forward = group.kernels._forward(x, u, p, w, discrete.h, discrete.n_substeps)
 

@@ -433,12 +433,12 @@ def test_carried_pattern_is_the_closure_of_the_jacobian_pattern() -> None:
     np.testing.assert_array_equal(pattern, expected)
 
 
-def test_node_derivatives_vanish_outside_the_carried_pattern(
+def test_sweeps_carry_the_pattern_s_entries_of_the_node_derivatives(
     compiled: dict[str, BlockKernels], rng: np.random.Generator
 ) -> None:
-    """The kernels take ``D`` as zero outside the pattern: the sweeps' own ``D`` are zero there
-    at every node of several substeps (and the unicycle's pattern has such zeros, so the
-    tests against the CasADi discretisation above check the kernels built on it)."""
+    """The sweeps carry ``D`` at the pattern's entries only, and the unicycle's pattern leaves
+    some out, so the tests against the CasADi discretisation above (which would see a missing
+    nonzero as a wrong Jacobian or Hessian) check the kernels built on it."""
     kernels, weights = compiled["unicycle"], MODELS["unicycle"][1]
     dynamics, _ = unicycle()
     z = ca.SX.sym("z", kernels.n_x + kernels.n_u)
@@ -448,8 +448,7 @@ def test_node_derivatives_vanish_outside_the_carried_pattern(
     )
     # north and east columns: their identity entries only; speed: neither heading nor turn
     assert np.count_nonzero(~pattern) == 8
+    np.testing.assert_array_equal(kernels.carried_entries, np.flatnonzero(pattern))
     x, u, p, w = _points(kernels, weights, rng)
     (sweep,) = kernels._sweeps(x, u, p, w, DT / 3, 3, threads=1, remember=False)
-    # 3 substeps of 4 nodes; (node, group, entry, lane) -> (node, point, entry)
-    carried = np.moveaxis(sweep.carried, 3, 2).reshape(12, -1, *pattern.shape)[:, :N_POINTS]
-    assert np.all(carried[:, :, ~pattern] == 0.0)
+    assert sweep.carried.shape == (12, 2, pattern.sum(), LANES)  # 3 substeps, 6 points

@@ -141,7 +141,7 @@ def lane_typing(
                 if op in _ARITHMETIC:
                     slots[slot] = _ARITHMETIC[op](builder, *operands)
                 elif op in _EXACT_INTRINSICS:
-                    function = cgutils.get_or_insert_function(
+                    function = cgutils.get_or_insert_function(  # type: ignore[no-untyped-call]
                         builder.module, ir.FunctionType(_VECTOR, [_VECTOR]), _EXACT_INTRINSICS[op]
                     )
                     slots[slot] = builder.call(function, operands)

@@ -5,8 +5,9 @@ weights) three node kernels are generated, with no mission quantity baked in:
 
 - ``value(y, u, p, w) -> (f, l)``;
 - ``first(y, u, p, w, D) -> (f, l, J D̃, D̃ᵀ g)`` with ``J = ∂f/∂(y, u)``,
-  ``g = ∇_{(y,u)} l`` and ``D̃ = [D; 0 I]`` for a node's ``D = ∂y/∂(x, u)`` (``n_x × n_z``,
-  matrices row-major);
+  ``g = ∇_{(y,u)} l`` and ``D̃ = [D; 0 I]`` for a node's ``D = ∂y/∂(x, u)`` (``n_x × n_z``;
+  ``D`` and ``J D̃`` as their entries in :func:`_carried_pattern`, row by row: the others are
+  structurally zero);
 - ``hessian(y, u, p, w, λ, ν, D) -> (upper triangle of D̃ᵀ H D̃, ∇_y (ν l + λᵀ f))`` with
   ``H = ∇²_{(y,u)} (ν l + λᵀ f)``.
 
@@ -54,8 +55,7 @@ from typing import Final, Generic, TypeVar
 import casadi as ca
 import numpy as np
 
-from auvplan._typing import BoolArray, FloatArray
-from auvplan.optimization._casadi import row_major
+from auvplan._typing import BoolArray, FloatArray, IntArray
 from auvplan.optimization._kernel_cache import load_kernel_module, mark_compiled
 from auvplan.optimization._lane_codegen import LANES
 from auvplan.optimization._numba_codegen import (
@@ -135,9 +135,10 @@ def closed_loop_batch(x0, alpha, mu, gains, p, w, h, n_sub, path, inputs, costs)
 #: cache), through the ``4m`` nodes of :data:`LANES` points at once (the lane kernels
 #: ``first_lanes`` and ``hessian_lanes``; a last group short of points repeats its last point),
 #: with the arithmetic of the chain rule (module notes) in the same order for every lane.
-#: ``forward_batch`` stores every node's point ``Y_n`` and ``D_n`` (row-major) lane-major,
-#: ``points (n_nodes, G, n_x, LANES)`` and ``carried (n_nodes, G, n_x n_z, LANES)`` for
-#: ``G = ⌈B / LANES⌉`` groups, for ``reverse_batch``, and returns the step's ``∂F/∂(x, u)``,
+#: ``forward_batch`` stores every node's point ``Y_n`` and ``D_n`` lane-major,
+#: ``points (n_nodes, G, n_x, LANES)`` and ``carried (n_nodes, G, n_d, LANES)`` (the ``n_d``
+#: entries ``entries`` of ``D``, :func:`_symbolic_kernels`) for ``G = ⌈B / LANES⌉`` groups,
+#: for ``reverse_batch``, and returns the step's ``∂F/∂(x, u)``,
 #: ``L`` and ``∇L``; ``reverse_batch`` adds ``Σ_n D̃_nᵀ ∇²(K̄_nᵀ f + ν h b_n l) D̃_n`` into
 #: ``total (B, n_z, n_z)``.
 _SWEEP_SOURCE: Final = """
@@ -151,10 +152,10 @@ def lanes_of(rows, first, out):
 
 
 @numba.njit(cache=True, error_model='numpy', nogil=True)
-def forward_batch(x, u, p, w, h, n_sub, points, carried, step_jac, cost, cost_grad):
+def forward_batch(x, u, p, w, h, n_sub, entries, points, carried, step_jac, cost, cost_grad):
     n_points, n_x = x.shape
-    n_d = carried.shape[2]
-    n_z = n_d // n_x
+    n_d = entries.size
+    n_z = step_jac.shape[2]
     rate = np.empty((n_x, LANES))
     q = np.empty((1, LANES))
     rate_d = np.empty((n_d, LANES))
@@ -175,9 +176,8 @@ def forward_batch(x, u, p, w, h, n_sub, points, carried, step_jac, cost, cost_gr
         lanes_of(u, first_point, u_lanes)
         lanes_of(p, first_point, p_lanes)
         lanes_of(w, first_point, w_lanes)
-        dy[:, :] = 0.0
-        for t in range(n_x):
-            dy[t * n_z + t, :] = 1.0
+        for t in range(n_d):
+            dy[t, :] = 1.0 if entries[t] // n_z == entries[t] % n_z else 0.0
         total[:] = 0.0
         total_grad[:, :] = 0.0
         for j in range(n_sub):
@@ -216,8 +216,9 @@ def forward_batch(x, u, p, w, h, n_sub, points, carried, step_jac, cost, cost_gr
             cost[b] = total[lane]
             for c in range(n_z):
                 cost_grad[b, c] = total_grad[c, lane]
+            step_jac[b] = 0.0
             for t in range(n_d):
-                step_jac[b, t // n_z, t % n_z] = dy[t, lane]
+                step_jac[b, entries[t] // n_z, entries[t] % n_z] = dy[t, lane]
 
 
 @numba.njit(cache=True, error_model='numpy', nogil=True)
@@ -298,11 +299,15 @@ def _carried_pattern(jacobian: ca.Sparsity, n_x: int, n_u: int) -> BoolArray:
         pattern = grown.astype(np.int64)
 
 
-def _symbolic_kernels(dynamics: ca.Function, running_cost: ca.Function) -> dict[str, ca.Function]:
-    """The three kernel Functions (module docstring) on SX symbols.
+def _symbolic_kernels(
+    dynamics: ca.Function, running_cost: ca.Function
+) -> tuple[dict[str, ca.Function], IntArray]:
+    """The three kernel Functions (module docstring) on SX symbols, and ``D``'s entries.
 
-    ``D`` enters as ``n_x n_z`` symbols (row-major), of which those outside
-    :func:`_carried_pattern` are taken as the zeros they are.
+    ``D`` enters as one symbol per entry of :func:`_carried_pattern` (row-major order; the
+    others are the zeros they are), and ``first`` returns those entries of ``J D̃`` (the
+    others are zero too: the pattern is closed under ``S ← S_J S̃``). The entries are
+    returned as their row-major indices into ``n_x × n_z``.
     """
     n_x, n_u, n_p = (int(dynamics.numel_in(i)) for i in range(3))
     n_z = n_x + n_u
@@ -315,11 +320,11 @@ def _symbolic_kernels(dynamics: ca.Function, running_cost: ca.Function) -> dict[
     rate, cost = dynamics(y, u, p), running_cost(y, u, p, w)
     yu = ca.vertcat(y, u)
     jacobian = ca.jacobian(rate, yu)
-    d_entries = ca.SX.sym("D", n_x * n_z)
-    pattern = _carried_pattern(jacobian.sparsity(), n_x, n_u)
+    rows, columns = np.nonzero(_carried_pattern(jacobian.sparsity(), n_x, n_u))
+    d_entries = ca.SX.sym("D", rows.size)
     carried = ca.SX.zeros(n_x, n_z)
-    for r, c in zip(*np.nonzero(pattern), strict=True):
-        carried[int(r), int(c)] = d_entries[int(r) * n_z + int(c)]
+    for k, (r, c) in enumerate(zip(rows, columns, strict=True)):
+        carried[int(r), int(c)] = d_entries[k]
     tilde = ca.vertcat(carried, ca.horzcat(ca.SX.zeros(n_u, n_x), ca.SX.eye(n_u)))
     hessian, gradient = ca.hessian(nu * cost + ca.dot(lam, rate), yu)
     curvature = ca.mtimes([tilde.T, hessian, tilde])
@@ -328,7 +333,8 @@ def _symbolic_kernels(dynamics: ca.Function, running_cost: ca.Function) -> dict[
     def dense(name: str, args: list[ca.SX], outputs: list[ca.SX]) -> ca.Function:
         return ca.Function(name, args, ca.cse([ca.densify(out) for out in outputs]))
 
-    return {
+    rate_d = ca.mtimes(jacobian, tilde)
+    functions = {
         "value": dense("model_value", [y, u, p, w], [rate, cost]),
         "first": dense(
             "model_first",
@@ -336,7 +342,7 @@ def _symbolic_kernels(dynamics: ca.Function, running_cost: ca.Function) -> dict[
             [
                 rate,
                 cost,
-                row_major(ca.mtimes(jacobian, tilde)),
+                ca.vertcat(*(rate_d[int(r), int(c)] for r, c in zip(rows, columns, strict=True))),
                 ca.mtimes(tilde.T, ca.gradient(cost, yu)),
             ],
         ),
@@ -344,6 +350,7 @@ def _symbolic_kernels(dynamics: ca.Function, running_cost: ca.Function) -> dict[
             "model_hessian", [y, u, p, w, lam, nu, d_entries], [upper, gradient[:n_x]]
         ),
     }
+    return functions, rows * n_z + columns
 
 
 def _pieces(n_points: int, threads: int) -> list[slice]:
@@ -386,8 +393,9 @@ class LastCall(Generic[_T]):
 class _Forward:
     """A forward sweep: the nodes' points and derivatives, the step's first-order data.
 
-    ``points`` ``Y_n (n_nodes, G, n_x, LANES)``, ``carried`` ``D_n (n_nodes, G, n_x n_z,
-    LANES)`` (row-major ``D``; point ``b`` in group ``b // LANES``, lane ``b % LANES``),
+    ``points`` ``Y_n (n_nodes, G, n_x, LANES)``, ``carried`` ``D_n (n_nodes, G, n_d, LANES)``
+    (:attr:`BlockKernels.carried_entries`; point ``b`` in group ``b // LANES``, lane
+    ``b % LANES``),
     ``step_jac`` ``∂F/∂(x, u)``, ``cost`` ``L``, ``cost_grad`` ``∇L``.
     """
 
@@ -426,6 +434,9 @@ class BlockKernels:
     n_u: int
     n_p: int
     n_w: int
+    carried_entries: IntArray
+    """The entries of a node's ``D`` the sweeps carry (row-major indices into ``n_x × n_z``;
+    :func:`_symbolic_kernels`), the module's ``CARRIED_ENTRIES``."""
     _memory: threading.local = field(default_factory=threading.local, repr=False)
     """Each calling thread's :class:`_SweepMemory` (kernels are shared by every model of a
     vehicle type: solves in two threads must not write over each other's sweeps)."""
@@ -511,12 +522,12 @@ class BlockKernels:
             points, carried = spare.points, spare.carried
         else:
             points = np.empty((*nodes, n_x, LANES))
-            carried = np.empty((*nodes, n_x * n_z, LANES))
+            carried = np.empty((*nodes, self.carried_entries.size, LANES))
         step_jac, cost = np.empty((n_points, n_x, n_z)), np.empty(n_points)
         cost_grad = np.empty((n_points, n_z))
         self.module.forward_batch(
-            np.ascontiguousarray(x), u, p, w, h, n_substeps, points, carried, step_jac, cost,
-            cost_grad,
+            np.ascontiguousarray(x), u, p, w, h, n_substeps, self.carried_entries, points,
+            carried, step_jac, cost, cost_grad,
         )  # fmt: skip
         return _Forward(points, carried, step_jac, cost, cost_grad)
 
@@ -680,23 +691,26 @@ def block_kernels(
         return built
 
     def source() -> str:
-        functions = _symbolic_kernels(dynamics, running_cost)
+        functions, entries = _symbolic_kernels(dynamics, running_cost)
         size = functions["hessian"].n_instructions()
         if size > MAX_KERNEL_INSTRUCTIONS:
             raise UnsupportedOperation(
                 f"the model's Hessian has {size} instructions (> {MAX_KERNEL_INSTRUCTIONS})"
             )
+        carried = f"\nCARRIED_ENTRIES = np.array({entries.tolist()}, dtype=np.int64)\n"
         return numba_source(
             functions,
             f"model kernels {memo[0][:24]}",
-            _APPENDIX,
+            _APPENDIX + carried,
             batched=("value",),
             lanes=("first", "hessian"),  # they run inside the sweeps only
         )
 
     module, is_new = load_kernel_module(key, source, cache_dir)
     n_x, n_u, n_p = (int(dynamics.numel_in(i)) for i in range(3))
-    kernels = BlockKernels(module, n_x, n_u, n_p, int(running_cost.numel_in(3)))
+    kernels = BlockKernels(
+        module, n_x, n_u, n_p, int(running_cost.numel_in(3)), module.CARRIED_ENTRIES
+    )
     started = time.perf_counter()
     if is_new:
         logger.info("compiling the stage kernels of a new vehicle model (once)")
