@@ -6,7 +6,9 @@ instruction as one Python assignment, so the Function becomes a plain function
 ``name(i0, i1, …, o0, o1, …)`` on 1-D float64 arrays (inputs read, dense outputs written), and
 adds ``name_batch`` which applies it to every row of 2-D arrays. numba compiles the result to
 machine code through LLVM: the stage derivatives of the vehicle models then evaluate 10–25
-times faster than in CasADi's virtual machine, without a C compiler.
+times faster than in CasADi's virtual machine, without a C compiler. A kernel can instead be
+written as its instruction list (:func:`lane_program`) for a lane kernel that evaluates four
+points per instruction (:mod:`~auvplan.optimization._lane_codegen`).
 
 Only the scalar operations that smooth models use are translated; any other operation raises
 :class:`UnsupportedOperation`, and the caller keeps the CasADi evaluation.
