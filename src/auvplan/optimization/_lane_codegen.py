@@ -6,10 +6,9 @@ instructions. The kernels of :func:`lane_typing` instead write every SX instruct
 instruction on ``<LANES x double>`` — one value per point — inside the numba function that
 calls it (a numba *intrinsic*, so numba's cache keeps its machine code like any other).
 Arithmetic (``+ − × ÷``, negation, square, doubling, inverse, square root, absolute value) is a
-vector instruction; every
-other operation is numba's own lowering of the scalar kernel's expression
-(:func:`~auvplan.optimization._numba_codegen.scalar_expression`), lane by lane. Each lane
-therefore runs the IEEE operations of the scalar kernel in the same order: the results are
+vector instruction; every other operation is numba's own lowering of the scalar kernel's
+expression (:func:`~auvplan.optimization._numba_codegen.scalar_expression`), lane by lane. Each
+lane therefore runs the IEEE operations of the scalar kernel in the same order: the results are
 those of the scalar kernel, to the bit.
 
 The kernel's arguments are 2-D C-contiguous float64 arrays of ``LANES`` columns, one per
