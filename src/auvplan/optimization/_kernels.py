@@ -140,11 +140,6 @@ def _components(matrix: FloatArray, parent: IntArray, order: IntArray, starts: I
     return n_components
 
 
-#: Stages whose blocks :func:`clip_stage_weights` gathers and clips together: enough for whole
-#: groups of lanes, few enough for the workspace to stay in cache for large coupled fleets.
-CLIP_CHUNK = 64
-
-
 @numba.njit(cache=True, nogil=True)
 def clip_stage_weights(
     q_mat: FloatArray, s_mat: FloatArray, r_mat: FloatArray, floor: float
@@ -159,27 +154,11 @@ def clip_stage_weights(
     the floor becomes ``floor·I`` (:func:`_at_most_floor`: ``V floor·I Vᵀ = floor·I``, e.g. the
     positions of vehicles far apart, which only vanishing barriers curve); the others, of every
     stage, are diagonalised together, ``LANES`` of one size at a time
-    (:func:`~auvplan.optimization._lane_eigen.clip_blocks`), :data:`CLIP_CHUNK` stages at a
-    time. Each stage's result depends on that stage only.
+    (:func:`~auvplan.optimization._lane_eigen.clip_blocks`). Each stage's result depends on
+    that stage only.
 
     Returns the clipped ``Q (N, n_x, n_x)``, ``S (N, n_x, n_u)`` and ``R (N, n_u, n_u)``.
     """
-    n_x = q_mat.shape[1]
-    q_out, s_out, r_out = np.empty_like(q_mat), np.empty_like(s_mat), np.empty_like(r_mat)
-    for start in range(0, q_mat.shape[0], CLIP_CHUNK):
-        rows = slice(start, min(start + CLIP_CHUNK, q_mat.shape[0]))
-        stages = _clipped_stages(q_mat[rows], s_mat[rows], r_mat[rows], floor)
-        q_out[rows] = stages[:, :n_x, :n_x]
-        s_out[rows] = stages[:, :n_x, n_x:]
-        r_out[rows] = stages[:, n_x:, n_x:]
-    return q_out, s_out, r_out
-
-
-@numba.njit(cache=True, nogil=True)
-def _clipped_stages(
-    q_mat: FloatArray, s_mat: FloatArray, r_mat: FloatArray, floor: float
-) -> FloatArray:
-    """The stages of :func:`clip_stage_weights` as symmetric ``(N, n, n)`` matrices, clipped."""
     n_stages, n_x, n_u = s_mat.shape
     n = n_x + n_u
     stages = np.empty((n_stages, n, n))
@@ -231,7 +210,11 @@ def _clipped_stages(
             for i in range(size):
                 for j in range(size):
                     stage[index[i], index[j]] = blocks[b, i, j]
-    return stages
+    return (
+        stages[:, :n_x, :n_x].copy(),
+        stages[:, :n_x, n_x:].copy(),
+        stages[:, n_x:, n_x:].copy(),
+    )
 
 
 @numba.njit(cache=True)

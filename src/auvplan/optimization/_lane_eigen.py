@@ -3,10 +3,9 @@
 The convexified model of the LQ ladder (:func:`auvplan.optimization.lq.convexify`) projects
 thousands of small blocks (e.g. ``8 × 8``, a vehicle's curved states and its inputs, at every
 stage) onto ``{W ⪰ floor·I}``. LAPACK takes ~5 µs per ``8 × 8`` block, most of it overhead;
-here :data:`LANES` blocks of one size (up to :data:`JACOBI_MAX_SIZE`) are diagonalised together
-by the cyclic Jacobi method, every rotation one set of LLVM vector instructions on
-``<LANES x double>`` (numba intrinsics, like :mod:`~auvplan.optimization._lane_codegen`'s
-kernels).
+here :data:`LANES` blocks of one size are diagonalised together by the cyclic Jacobi method,
+every rotation one set of LLVM vector instructions on ``<LANES x double>`` (numba intrinsics,
+like :mod:`~auvplan.optimization._lane_codegen`'s kernels).
 
 A rotation in the plane ``(p, q)`` with ``t = tan φ`` the smaller root of
 ``t² + 2θt − 1 = 0``, ``θ = (a_qq − a_pp) / (2 a_pq)``, ``c = 1/√(1 + t²)``, ``s = t c``,
@@ -40,11 +39,6 @@ __all__ = ["clip_blocks"]
 
 #: Convergence: ``Σ_{i<j} a_ij² ≤ TOLERANCE² ‖A‖_F²`` for every block of a group.
 TOLERANCE: Final = 1e-15
-#: Largest block diagonalised by Jacobi: its ``O(n³)`` per sweep catches up with LAPACK's
-#: overhead as blocks grow (random ``n × n`` blocks: 2.9 against 8.1 µs at 8, 19 against 28 µs
-#: at 16, 25 against 32 µs at 20 — about even on a 5-vehicle family mission's 20 × 20 blocks —
-#: 449 against 222 µs at 50); larger blocks go to LAPACK (``numpy.linalg.eigh``).
-JACOBI_MAX_SIZE: Final = 16
 #: Sweeps before a group stops anyway (a sweep squares the off-diagonal norm near convergence:
 #: 5–6 for an ``8 × 8`` block; a non-finite block never converges and stays non-finite).
 MAX_SWEEPS: Final = 40
@@ -150,37 +144,24 @@ def _jacobi(a: FloatArray, v: FloatArray) -> None:
 def clip_blocks(blocks: FloatArray, floor: float) -> None:
     """``V max(Λ, floor) Vᵀ`` of every symmetric block ``blocks (B, n, n)``, written over it.
 
-    ``LANES`` blocks at a time (:func:`_jacobi`; a last group short of blocks repeats its
-    last one), or one by one by LAPACK above :data:`JACOBI_MAX_SIZE`. Each result depends on
-    its own block only.
+    ``LANES`` blocks at a time (:func:`_jacobi`); a last group short of blocks repeats its
+    last one. Each result depends on its own block only.
     """
     n_blocks, n = blocks.shape[0], blocks.shape[1]
-    if n > JACOBI_MAX_SIZE:
-        for b in range(n_blocks):
-            values, vectors = np.linalg.eigh(blocks[b])
-            blocks[b] = (vectors * np.maximum(values, floor)) @ vectors.T  # BLAS
-        return
     a, v = np.empty((n, n, LANES)), np.empty((n, n, LANES))
+    clipped = np.empty((n, LANES))
     for first in range(0, n_blocks, LANES):
         for lane in range(LANES):
             a[:, :, lane] = blocks[min(first + lane, n_blocks - 1)]
         _jacobi(a, v)
+        for i in range(n):
+            for lane in range(LANES):
+                clipped[i, lane] = max(a[i, i, lane], floor)
         for lane in range(min(LANES, n_blocks - first)):
-            values = np.array([a[i, i, lane] for i in range(n)])
-            _project(v[:, :, lane], values, floor, blocks[first + lane])
-
-
-@numba.njit(cache=True, nogil=True)
-def _project(vectors: FloatArray, values: FloatArray, floor: float, out: FloatArray) -> None:
-    """``out = V max(Λ, floor) Vᵀ``, symmetric to the bit (the upper triangle mirrored).
-
-    For the small blocks of :func:`_jacobi` (``O(n³)`` scalar operations; LAPACK's larger
-    blocks take BLAS's product instead).
-    """
-    n = values.size
-    for i in range(n):
-        for j in range(i, n):
-            value = 0.0
-            for k in range(n):
-                value += vectors[i, k] * max(values[k], floor) * vectors[j, k]
-            out[i, j] = out[j, i] = value
+            block = blocks[first + lane]
+            for i in range(n):
+                for j in range(i, n):
+                    value = 0.0
+                    for k in range(n):
+                        value += v[i, k, lane] * clipped[k, lane] * v[j, k, lane]
+                    block[i, j] = block[j, i] = value
