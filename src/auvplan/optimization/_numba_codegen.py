@@ -24,7 +24,7 @@ import casadi as ca
 __all__ = ["UnsupportedOperation", "lane_program", "numba_source", "scalar_expression"]
 
 #: Version of the generated code; part of every cache key (bump on any change of the output).
-GENERATOR_VERSION: Final = 12
+GENERATOR_VERSION: Final = 11
 
 _BINARY: Final = {ca.OP_ADD: "+", ca.OP_SUB: "-", ca.OP_MUL: "*", ca.OP_DIV: "/"}
 _UNARY: Final = {
