@@ -39,16 +39,12 @@ from auvplan.optimization.block_kernels import _symbolic_kernels
 def _loop_source(n_args: int, lanes: bool) -> str:
     """A numba loop calling ``kernel`` (rows) or ``kernel_lanes`` (groups) on every point."""
     names = [f"a{k}" for k in range(n_args)]
-    call = (
-        f"kernel_lanes({', '.join(f'{a}[g]' for a in names)})"
-        if lanes
-        else (f"kernel({', '.join(f'{a}[g]' for a in names)})")
-    )
+    kernel = "kernel_lanes" if lanes else "kernel"
     return f"""
 @numba.njit(cache=True)
 def loop({", ".join(names)}):
     for g in range(a0.shape[0]):
-        {call}
+        {kernel}({", ".join(f"{a}[g]" for a in names)})
 """
 
 

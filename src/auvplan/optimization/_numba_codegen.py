@@ -188,8 +188,9 @@ def numba_source(
     """
     lines = [f"# {header}", f"# auvplan numba generator version {GENERATOR_VERSION}", ""]
     lines += ["import math", "", "import numba", "import numpy as np", ""]
-    lines += ["from numba.extending import intrinsic", ""]
-    lines += ["from auvplan.optimization._lane_codegen import LANES, lane_typing", ""]
+    if lanes:
+        lines += ["from numba.extending import intrinsic", ""]
+        lines += ["from auvplan.optimization._lane_codegen import LANES, lane_typing", ""]
     for name, function in functions.items():
         if not function.is_a("SXFunction"):
             raise UnsupportedOperation(f"{function.name()} is not an SX Function")

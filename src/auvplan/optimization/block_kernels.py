@@ -395,8 +395,7 @@ class _Forward:
 
     ``points`` ``Y_n (n_nodes, G, n_x, LANES)``, ``carried`` ``D_n (n_nodes, G, n_d, LANES)``
     (:attr:`BlockKernels.carried_entries`; point ``b`` in group ``b // LANES``, lane
-    ``b % LANES``),
-    ``step_jac`` ``∂F/∂(x, u)``, ``cost`` ``L``, ``cost_grad`` ``∇L``.
+    ``b % LANES``), ``step_jac`` ``∂F/∂(x, u)``, ``cost`` ``L``, ``cost_grad`` ``∇L``.
     """
 
     points: FloatArray
