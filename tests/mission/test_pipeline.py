@@ -13,7 +13,8 @@ from auvplan.cli.main import main
 from auvplan.errors import InputError, SolverError
 from auvplan.mission import pipeline
 from auvplan.mission.config import parse_mission
-from auvplan.mission.preplan import goal_keep_outs
+from auvplan.mission.preplan import goal_keep_outs, turn_towards
+from auvplan.scenarios import check
 
 MISSION = """
 [terrain]
@@ -111,6 +112,67 @@ dt_s = 1.0
 
     assert abs(leaving_bearing("remus100")) < 15.0
     assert leaving_bearing("medusa") > 30.0
+
+
+def test_the_turn_towards_a_point_is_an_arc_that_ends_facing_it() -> None:
+    """Seeded poses and targets all round (turns to either side, past 180 deg): the points
+    lie on one circle of the radius, leave along the heading, are at most ``spacing`` apart,
+    and the last one's heading (the arc's tangent) points at the target."""
+    rng = np.random.default_rng(7)
+    radius, spacing = 20.0, 1.5
+    for _ in range(200):
+        start, heading = rng.uniform(-50.0, 50.0, 2), rng.uniform(-np.pi, np.pi)
+        bearing, distance = rng.uniform(-np.pi, np.pi), rng.uniform(2.0, 6.0) * radius
+        target = start + distance * np.array([np.cos(bearing), np.sin(bearing)])
+        turn = turn_towards(start, heading, target, radius, spacing)
+        assert turn is not None
+        np.testing.assert_array_equal(turn[0], start)
+        steps = np.diff(turn, axis=0)
+        assert np.all(np.hypot(*steps.T) <= spacing + 1e-9)
+        centre = start + radius * np.sign(
+            np.array([-np.sin(heading), np.cos(heading)]) @ (target - start)
+        ) * np.array([-np.sin(heading), np.cos(heading)])
+        np.testing.assert_allclose(np.hypot(*(turn - centre).T), radius, rtol=1e-12)
+        first = np.arctan2(steps[0, 1], steps[0, 0])  # chord bearing: half a step's turn off
+        assert abs(np.angle(np.exp(1j * (first - heading)))) <= 0.5 * spacing / radius + 1e-9
+        # the line on to the target is tangent at the end (perpendicular to the radius) and
+        # goes on the way the arc turns
+        radial, ahead = turn[-1] - centre, target - turn[-1]
+        assert radial @ ahead / (radius * np.hypot(*ahead)) == pytest.approx(0.0, abs=1e-9)
+        assert steps[-1] @ ahead > 0.0
+    assert turn_towards(np.zeros(2), 0.0, np.array([0.0, 15.0]), 10.0, 1.0) is None  # inside
+
+
+def test_a_torpedo_whose_route_leaves_behind_it_converges(tmp_path: Path) -> None:
+    """A REMUS 100 (turning radius 44 m) heading north whose A* route over the Monterey
+    sample leaves east-south-east: a Dubins turn into the route, not a loop the rudder
+    cannot fly (before, the projection reversed the propeller and the optimiser stopped at
+    MAX_ITER after 195 iterations); the plan passes the independent check."""
+    mission = tmp_path / "torpedo.toml"
+    mission.write_text(
+        """
+[terrain]
+sample = "monterey"
+window = { lat = [36.79360, 36.79714], lon = [-121.81473, -121.80582] }
+[fleet]
+horizon_s = 700.0
+safety_radius_m = 5.0
+[[vehicle]]
+name = "torpedo1"
+type = "remus100"
+start = { north = 10.0, east = 350.0, heading_deg = 0.0, speed = 0.5 }
+goal = { north = 370.0, east = 380.0, heading_deg = 0.0 }
+[mission]
+depth_m = 10.0
+"""
+    )
+    out = tmp_path / "out"
+    assert main(["-q", "plan", str(mission), "-o", str(out), "--no-figures"]) == 0
+    optimization = json.loads((out / "summary.json").read_text())["optimization"]
+    assert optimization["status"] == "CONVERGED"
+    assert optimization["n_iter"] <= 50
+    report = check(out, mission=mission)
+    assert report.success, report.failures
 
 
 def test_before_optimization_is_called_once_between_stages_2_and_3() -> None:

@@ -37,6 +37,7 @@ from auvplan.planning import (
     Route,
     blocked_cells,
     blocked_lookup,
+    path_length,
     plan_route,
     resample_polyline,
     skirt_discs,
@@ -286,23 +287,77 @@ def _lead_in(
     radius: float,
     spacing: float,
     is_blocked: Callable[[FloatArray, FloatArray], BoolArray],
-) -> FloatArray:
-    """The route polyline leaving its start along the start ``heading`` [rad].
+) -> tuple[FloatArray, FloatArray]:
+    """The route polyline split into a turn from the start ``heading`` [rad] and the rest.
 
     For a vehicle that turns no tighter than ``radius`` [m]: the start pose is the
     optimiser's fixed initial state, so a path that leaves it at an angle asks a
     rudder-steered vehicle for a turn it cannot make (a REMUS 100 turns on 44 m), and the
-    projection saturates the rudder. A point ``radius`` ahead of the start along the heading
-    replaces the route points nearer than that; skipped where that point is blocked, and for
+    projection saturates the rudder. The route's first point ``2 R`` or more from the start
+    (else its end) is reached the Dubins way, a turn of radius ``R`` towards it from the start
+    pose and the tangent on to it (:func:`turn_towards`); the route points before it are
+    dropped. Returns the turn's points and the polyline from its last point on (the tangent
+    and the rest of the route), to be smoothed on its own so that the path leaves along the
+    heading. No turn (only the start point) where that way crosses a blocked cell, and for
     a vehicle whose turns are shorter than the path's sample ``spacing`` [m].
     """
+    unchanged = points[:1], points
     if radius < spacing or len(points) < 2:
-        return points
-    ahead = points[0] + radius * np.array([np.cos(heading), np.sin(heading)])
-    if is_blocked(ahead[:1], ahead[1:])[0]:
-        return points
-    kept = np.hypot(*(points[1:-1] - points[0]).T) > radius
-    return np.vstack([points[:1], ahead[None, :], points[1:-1][kept], points[-1:]])
+        return unchanged
+    far = np.flatnonzero(np.hypot(*(points[1:] - points[0]).T) >= 2.0 * radius)
+    join = int(far[0]) + 1 if far.size else len(points) - 1
+    turn = turn_towards(points[0], heading, points[join], radius, spacing)
+    if turn is None:
+        return unchanged
+    dense = resample_polyline(np.vstack([turn, points[join : join + 1]]), 0.5 * spacing)
+    if np.any(is_blocked(dense[:, 0], dense[:, 1])):
+        return unchanged
+    return turn, np.vstack([turn[-1:], points[join:]])
+
+
+def _joined(first: FloatArray, second: FloatArray, spacing: float) -> FloatArray:
+    """Two polylines end to end (``second`` starts at ``first``'s end), resampled.
+
+    At equal arc-length steps closest to ``spacing`` [m], as :func:`smooth_path` returns its
+    curves.
+    """
+    whole = np.vstack([first[:-1], second])
+    return resample_polyline(whole, 0.0, n_steps=max(1, round(path_length(whole) / spacing)))
+
+
+def turn_towards(
+    start: FloatArray, heading: float, target: FloatArray, radius: float, spacing: float
+) -> FloatArray | None:
+    """Points [m] of the turn of ``radius`` from ``start`` (heading ``ψ_0`` [rad]) to ``target``.
+
+    The turn is to the side of ``target`` (centre ``c = p_0 + s R (−sin ψ_0, cos ψ_0)``,
+    ``s = +1`` to the right, heading from north clockwise) and ends where the heading points
+    at it, the tangent point: with ``v = target − c``, ``d = |v|`` and ``L = √(d² − R²)``
+    the tangent's length, the heading there is ``ψ* = ∠v + s atan2(R, L)``. Returns the arc
+    sampled at most ``spacing`` apart, from ``start`` (exactly) to the tangent point, or
+    ``None`` when ``target`` lies within the circle (``d ≤ R``: no tangent).
+
+    Examples
+    --------
+    >>> turn = turn_towards(np.zeros(2), 0.0, np.array([10.0, 20.0]), 10.0, 1.0)
+    >>> np.round(turn[-1], 6).tolist()  # a quarter circle to the right, then due east
+    [10.0, 10.0]
+    """
+    right = np.array([-np.sin(heading), np.cos(heading)])
+    offset = target - start
+    side = 1.0 if right @ offset >= 0.0 else -1.0
+    centre = start + side * radius * right
+    v = target - centre
+    distance = float(np.hypot(*v))
+    if distance <= radius:
+        return None
+    tangent = np.arctan2(v[1], v[0]) + side * np.arctan2(radius, np.sqrt(distance**2 - radius**2))
+    turned = (side * (tangent - heading)) % (2.0 * np.pi)
+    n_steps = max(1, math.ceil(turned * radius / spacing))
+    psi = heading + side * turned * np.linspace(0.0, 1.0, n_steps + 1)
+    arc = centre - side * radius * np.column_stack([-np.sin(psi), np.cos(psi)])
+    arc[0] = start  # exactly (the optimiser's initial state)
+    return arc
 
 
 def _skirt_goals(
@@ -482,12 +537,15 @@ def plan_routes(
                 )  # fmt: skip
             choices.append(choice)
             # near the route, never through a no-go cell nor within 2 r_c of a kept-out goal
-            path = smooth_path(
-                _lead_in(route.points, float(courses[index]), radius, 0.25 * cell, is_blocked),
-                spacing=0.25 * cell,
-                max_deviation=deviation,
-                is_blocked=_with_discs(is_blocked, keep_out, 2.0 * clearance + 0.25 * cell),
+            kept_out = _with_discs(is_blocked, keep_out, 2.0 * clearance + 0.25 * cell)
+            turn, rest = _lead_in(
+                route.points, float(courses[index]), radius, 0.25 * cell, kept_out
             )
+            path = smooth_path(
+                rest, spacing=0.25 * cell, max_deviation=deviation, is_blocked=kept_out
+            )
+            if len(turn) > 1:
+                path = _joined(turn, path, 0.25 * cell)
             paths.append(_skirt_goals(path, goals, index, clearance, cell, is_blocked))
             logger.info(
                 "A* %s: %d cells, cost %.1f, %d expanded", name, len(route.cells), route.cost,
