@@ -47,8 +47,8 @@ def test_lq_sweep_with_blocks_equals_the_dense_sweep(rng: np.random.Generator) -
     l_x, l_u = rng.normal(size=(N, N_X)), rng.normal(size=(N, N_U))
     p_final, m_x = np.eye(N_X) + 0.1 * np.ones((N_X, N_X)), rng.normal(size=N_X)
     args = (a, b, q, s, r, l_x, l_u, p_final, m_x)
-    dense = _kernels.lq_backward(*args, np.array([[0, N_X]]), np.array([[0, N_U]]), 0.0)
-    blocked = _kernels.lq_backward(*args, *block_ranges(_groups(), N_X, N_U), 0.0)
+    dense = _kernels.lq_backward(*args, np.array([[0, N_X]]), np.array([[0, N_U]]))
+    blocked = _kernels.lq_backward(*args, *block_ranges(_groups(), N_X, N_U))
     assert dense[3] == blocked[3] == -1
     np.testing.assert_allclose(blocked[0], dense[0], rtol=1e-11, atol=1e-12)
     np.testing.assert_allclose(blocked[1], dense[1], rtol=1e-11, atol=1e-12)
@@ -84,8 +84,8 @@ def test_lq_sweep_by_components_equals_the_dense_sweep(
     l_x, l_u = rng.normal(size=(N, N_X)), rng.normal(size=(N, N_U))
     p_final, m_x = np.diag(rng.uniform(1.0, 2.0, N_X)), rng.normal(size=N_X)
     args = (a, b, q, s, r, l_x, l_u, p_final, m_x)
-    dense = _kernels.lq_backward(*args, np.array([[0, N_X]]), np.array([[0, N_U]]), 0.0)
-    parts = _kernels.lq_backward(*args, *block_ranges(_groups(), N_X, N_U), 0.0)
+    dense = _kernels.lq_backward(*args, np.array([[0, N_X]]), np.array([[0, N_U]]))
+    parts = _kernels.lq_backward(*args, *block_ranges(_groups(), N_X, N_U))
     assert dense[3] == parts[3] == -1
     np.testing.assert_allclose(parts[0], dense[0], rtol=1e-10, atol=1e-12)
     np.testing.assert_allclose(parts[1], dense[1], rtol=1e-10, atol=1e-12)
@@ -97,7 +97,7 @@ def test_lq_sweep_by_components_equals_the_dense_sweep(
         rng.normal(size=N_X),
     )
     again = _kernels.lq_backward(
-        a, b, q, s, r, other_x, other_u, p_final, other_m, *block_ranges(_groups(), N_X, N_U), 0.0
+        a, b, q, s, r, other_x, other_u, p_final, other_m, *block_ranges(_groups(), N_X, N_U)
     )
     reused = _kernels.lq_feedforward(a, b, parts[0], parts[2], other_x, other_u, other_m)
     np.testing.assert_allclose(reused, again[1], rtol=1e-9, atol=1e-11)
@@ -138,7 +138,8 @@ def test_clipped_lq_sweep_is_the_sweep_of_the_projected_weights(
     rng: np.random.Generator, pair: tuple[int, int]
 ) -> None:
     """Indefinite stage weights (two subsystems coupled at some stages, a state on its own):
-    the sweep with ``floor`` equals the plain sweep on the weights projected by numpy."""
+    the sweep of the convexified weights equals the sweep of the weights projected by numpy,
+    and the convexified weights are the same to the bit on any number of threads."""
     a, b = _block_diagonal_dynamics(rng)
     w = np.zeros((N, N_X + N_U, N_X + N_U))
     for group in _groups():
@@ -152,21 +153,25 @@ def test_clipped_lq_sweep_is_the_sweep_of_the_projected_weights(
     p_final, m_x = np.diag(rng.uniform(1.0, 2.0, N_X)), rng.normal(size=N_X)
     blocks = block_ranges(_groups(), N_X, N_U)
 
-    def sweep(weights: np.ndarray, floor: float) -> tuple:
-        q, s, r = (weights[:, :N_X, :N_X], weights[:, :N_X, N_X:], weights[:, N_X:, N_X:])
-        args = (a, b, q.copy(), s.copy(), r.copy(), l_x, l_u, p_final, m_x)
-        return _kernels.lq_backward(*args, *blocks, floor)
+    def sweep(q: np.ndarray, s: np.ndarray, r: np.ndarray) -> tuple:
+        return _kernels.lq_backward(a, b, q, s, r, l_x, l_u, p_final, m_x, *blocks)
 
-    clipped, plain = sweep(w, 0.5), sweep(_projected(w, 0.5), 0.0)
+    def parts(stacked: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return tuple(  # type: ignore[return-value]
+            np.ascontiguousarray(x)
+            for x in (stacked[:, :N_X, :N_X], stacked[:, :N_X, N_X:], stacked[:, N_X:, N_X:])
+        )
+
+    assert sweep(*parts(w))[3] >= 0  # unclipped, the sweep fails
+    plain = sweep(*parts(_projected(w, 0.5)))
+    convexified = [convexify(StageWeights(*parts(w), p_final), 0.5, t) for t in (1, 3)]
+    for x, y in zip(
+        (convexified[0].Q, convexified[0].S, convexified[0].R),
+        (convexified[1].Q, convexified[1].S, convexified[1].R),
+        strict=True,
+    ):
+        np.testing.assert_array_equal(x, y)
+    clipped = sweep(convexified[0].Q, convexified[0].S, convexified[0].R)
     assert clipped[3] == plain[3] == -1
     np.testing.assert_allclose(clipped[0], plain[0], rtol=1e-9, atol=1e-11)
     np.testing.assert_allclose(clipped[1], plain[1], rtol=1e-9, atol=1e-11)
-    assert sweep(w, 0.0)[3] >= 0  # unclipped, the sweep fails
-    # clipped before the sweep, stages split over threads (the ladder on several threads):
-    # the sweep's own clipping, to the bit
-    q, s, r = (w[:, :N_X, :N_X], w[:, :N_X, N_X:], w[:, N_X:, N_X:])
-    for threads in (1, 3):
-        weights = convexify(StageWeights(q, s, r, p_final), 0.5, threads)
-        args = (a, b, weights.Q, weights.S, weights.R, l_x, l_u, p_final, m_x)
-        for ours, theirs in zip(_kernels.lq_backward(*args, *blocks, 0.0), clipped, strict=True):
-            np.testing.assert_array_equal(ours, theirs)

@@ -11,6 +11,7 @@ import numba
 import numpy as np
 
 from auvplan._typing import FloatArray, IntArray
+from auvplan.optimization._lane_eigen import clip_blocks
 
 
 @numba.njit(cache=True)
@@ -77,25 +78,6 @@ def _at_most_floor(matrix: FloatArray, floor: float) -> bool:
 
 
 @numba.njit(cache=True)
-def _clip_in_place(matrix: FloatArray, floor: float) -> None:
-    """``V max(Λ, floor) Vᵀ`` of a symmetric matrix, written over it.
-
-    Kept when every eigenvalue is above ``floor`` (:func:`_above_floor`); ``floor·I``, with no
-    eigendecomposition, when none is (:func:`_at_most_floor`: ``V floor·I Vᵀ = floor·I``),
-    e.g. the positions of vehicles far apart, which only vanishing barriers curve.
-    """
-    if _above_floor(matrix, floor):
-        return
-    if _at_most_floor(matrix, floor):
-        matrix[:, :] = 0.0
-        for i in range(matrix.shape[0]):
-            matrix[i, i] = floor
-        return
-    values, vectors = np.linalg.eigh(matrix)
-    matrix[:, :] = (vectors * np.maximum(values, floor)) @ vectors.T
-
-
-@numba.njit(cache=True)
 def _root(parent: IntArray, block: int) -> int:
     """Root of ``block`` in the union-find forest ``parent``."""
     while parent[block] != block:
@@ -109,6 +91,15 @@ def _merge(parent: IntArray, a: int, b: int) -> None:
     a, b = _root(parent, a), _root(parent, b)
     if a != b:
         parent[max(a, b)] = min(a, b)
+
+
+@numba.njit(cache=True)
+def _all_joined(parent: IntArray) -> bool:
+    """Whether every block of the union-find forest ``parent`` is in one tree."""
+    for block in range(parent.size):  # noqa: SIM110 (numba compiles no generator)
+        if _root(parent, block) != 0:
+            return False
+    return True
 
 
 @numba.njit(cache=True)
@@ -149,69 +140,98 @@ def _components(matrix: FloatArray, parent: IntArray, order: IntArray, starts: I
     return n_components
 
 
-@numba.njit(cache=True)
-def _clip_components(
-    stage: FloatArray, floor: float, parent: IntArray, order: IntArray, starts: IntArray
-) -> None:
-    """``V max(Λ, floor) Vᵀ`` of a symmetric matrix, written over it, block by block.
-
-    The matrix is block-diagonal in the components of its nonzero entries (:func:`_components`;
-    ``parent``, ``order``, ``starts`` are its scratch arrays): each block is tested and clipped on
-    its own (:func:`_clip_in_place`), a ``1 × 1`` block as ``max(w, floor)``.
-    """
-    for c in range(_components(stage, parent, order, starts)):
-        index = order[starts[c] : starts[c + 1]]
-        size = index.size
-        if size == 1:
-            if stage[index[0], index[0]] <= floor:  # noqa: PLR1730 (max() would drop a NaN)
-                stage[index[0], index[0]] = floor
-            continue
-        block = np.empty((size, size))
-        for i in range(size):
-            for j in range(size):
-                block[i, j] = stage[index[i], index[j]]
-        _clip_in_place(block, floor)
-        for i in range(size):
-            for j in range(size):
-                stage[index[i], index[j]] = block[i, j]
-
-
-@numba.njit(cache=True)
-def _clipped_stage(
-    q: FloatArray, s: FloatArray, r: FloatArray, floor: float
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """``Q, S, R`` of ``½(W + Wᵀ)``, ``W = [[Q, S], [Sᵀ, R]]``, eigenvalues clipped at ``floor``.
-
-    Only the blocks of coupled coordinates that fail the Cholesky test of ``W − floor·I``
-    change (:func:`_clip_components`): within a vehicle e.g. its position, which its dynamics
-    do not curve, is a block of its own; at ``O(Σ n_c³)`` instead of ``O(n³)``.
-    """
-    n_x, n_u = s.shape
-    n = n_x + n_u
-    stage = np.empty((n, n))
-    stage[:n_x, :n_x] = 0.5 * (q + q.T)
-    stage[:n_x, n_x:] = s
-    stage[n_x:, :n_x] = s.T
-    stage[n_x:, n_x:] = 0.5 * (r + r.T)
-    scratch = np.empty((3, n + 1), dtype=np.int64)
-    _clip_components(stage, floor, scratch[0], scratch[1], scratch[2])
-    return stage[:n_x, :n_x].copy(), stage[:n_x, n_x:].copy(), stage[n_x:, n_x:].copy()
+#: Stages whose blocks :func:`clip_stage_weights` gathers and clips together: enough for whole
+#: groups of lanes, few enough for the workspace to stay in cache for large coupled fleets.
+CLIP_CHUNK = 64
 
 
 @numba.njit(cache=True, nogil=True)
 def clip_stage_weights(
     q_mat: FloatArray, s_mat: FloatArray, r_mat: FloatArray, floor: float
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """:func:`_clipped_stage` of every stage.
+    """``Q, S, R`` of ``½(W_k + W_kᵀ)``, ``W_k = [[Q_k, S_k], [S_kᵀ, R_k]]``, clipped at ``floor``.
+
+    The projection ``V max(Λ, floor) Vᵀ`` of every stage, block by block: a stage's weights are
+    block-diagonal in the components of their nonzero entries (:func:`_components`; within a
+    vehicle e.g. its position, which its dynamics do not curve, is a block of its own). A
+    ``1 × 1`` block becomes ``max(w, floor)``; a block passing the Cholesky test of
+    ``B − floor·I`` is kept (:func:`_above_floor`); one whose Gershgorin discs lie at or below
+    the floor becomes ``floor·I`` (:func:`_at_most_floor`: ``V floor·I Vᵀ = floor·I``, e.g. the
+    positions of vehicles far apart, which only vanishing barriers curve); the others, of every
+    stage, are diagonalised together, ``LANES`` of one size at a time
+    (:func:`~auvplan.optimization._lane_eigen.clip_blocks`), :data:`CLIP_CHUNK` stages at a
+    time. Each stage's result depends on that stage only.
 
     Returns the clipped ``Q (N, n_x, n_x)``, ``S (N, n_x, n_u)`` and ``R (N, n_u, n_u)``.
     """
-    q_out = np.empty_like(q_mat)
-    s_out = np.empty_like(s_mat)
-    r_out = np.empty_like(r_mat)
-    for k in range(q_mat.shape[0]):
-        q_out[k], s_out[k], r_out[k] = _clipped_stage(q_mat[k], s_mat[k], r_mat[k], floor)
+    n_x = q_mat.shape[1]
+    q_out, s_out, r_out = np.empty_like(q_mat), np.empty_like(s_mat), np.empty_like(r_mat)
+    for start in range(0, q_mat.shape[0], CLIP_CHUNK):
+        rows = slice(start, min(start + CLIP_CHUNK, q_mat.shape[0]))
+        stages = _clipped_stages(q_mat[rows], s_mat[rows], r_mat[rows], floor)
+        q_out[rows] = stages[:, :n_x, :n_x]
+        s_out[rows] = stages[:, :n_x, n_x:]
+        r_out[rows] = stages[:, n_x:, n_x:]
     return q_out, s_out, r_out
+
+
+@numba.njit(cache=True, nogil=True)
+def _clipped_stages(
+    q_mat: FloatArray, s_mat: FloatArray, r_mat: FloatArray, floor: float
+) -> FloatArray:
+    """The stages of :func:`clip_stage_weights` as symmetric ``(N, n, n)`` matrices, clipped."""
+    n_stages, n_x, n_u = s_mat.shape
+    n = n_x + n_u
+    stages = np.empty((n_stages, n, n))
+    jobs = np.empty((n_stages * n, n + 2), dtype=np.int64)  # stage, size, indices
+    n_jobs = 0
+    scratch = np.empty((3, n + 1), dtype=np.int64)
+    for k in range(n_stages):
+        stage = stages[k]
+        for i in range(n_x):
+            for j in range(n_x):
+                stage[i, j] = 0.5 * (q_mat[k, i, j] + q_mat[k, j, i])
+            for j in range(n_u):
+                stage[i, n_x + j] = stage[n_x + j, i] = s_mat[k, i, j]
+        for i in range(n_u):
+            for j in range(n_u):
+                stage[n_x + i, n_x + j] = 0.5 * (r_mat[k, i, j] + r_mat[k, j, i])
+        for c in range(_components(stage, scratch[0], scratch[1], scratch[2])):
+            index = scratch[1][scratch[2][c] : scratch[2][c + 1]]
+            size = index.size
+            if size == 1:
+                if stage[index[0], index[0]] <= floor:  # noqa: PLR1730 (max() would drop a NaN)
+                    stage[index[0], index[0]] = floor
+                continue
+            block = np.empty((size, size))
+            for i in range(size):
+                for j in range(size):
+                    block[i, j] = stage[index[i], index[j]]
+            if _above_floor(block, floor):
+                continue
+            if _at_most_floor(block, floor):
+                for i in range(size):
+                    for j in range(size):
+                        stage[index[i], index[j]] = floor if i == j else 0.0
+                continue
+            jobs[n_jobs, 0], jobs[n_jobs, 1] = k, size
+            jobs[n_jobs, 2 : 2 + size] = index
+            n_jobs += 1
+    for size in range(2, n + 1):
+        chosen = np.flatnonzero(jobs[:n_jobs, 1] == size)
+        blocks = np.empty((chosen.size, size, size))
+        for b in range(chosen.size):
+            stage, index = stages[jobs[chosen[b], 0]], jobs[chosen[b], 2 : 2 + size]
+            for i in range(size):
+                for j in range(size):
+                    blocks[b, i, j] = stage[index[i], index[j]]
+        clip_blocks(blocks, floor)
+        for b in range(chosen.size):
+            stage, index = stages[jobs[chosen[b], 0]], jobs[chosen[b], 2 : 2 + size]
+            for i in range(size):
+                for j in range(size):
+                    stage[index[i], index[j]] = blocks[b, i, j]
+    return stages
 
 
 @numba.njit(cache=True)
@@ -527,7 +547,6 @@ def lq_backward(
     r_final: FloatArray,
     x_blocks: IntArray,
     u_blocks: IntArray,
-    floor: float,
 ) -> tuple[FloatArray, FloatArray, FloatArray, int]:
     """Discrete Riccati with cross term for the LQ direction (§6.3), component by component.
 
@@ -543,12 +562,6 @@ def lq_backward(
     ``M = R + BᵀPB`` and ``g = l_u + Bᵀr`` (``P``, ``r`` of stage ``k + 1``), stage ``k`` has
     ``K = M⁻¹G``, ``v = −M⁻¹g``, ``P ← Q + AᵀPA − GᵀK`` and ``r ← l_x + Aᵀr − Kᵀg``, all
     formed in workspaces allocated once per sweep.
-
-    With ``floor > 0`` every stage's weights ``W_k = [[Q_k, S_k], [S_kᵀ, R_k]]`` are replaced
-    by their projection onto ``{W ⪰ floor·I}`` (eigenvalues clipped at ``floor``, per
-    component and in it per block of coupled coordinates: :func:`_clipped_stage`) as the
-    sweep reaches them: the convexified model, without a clipped copy of the weights. The
-    caller clips ``P_N``.
 
     Returns the feedback ``K^o (N, n_u, n_x)``, feed-forward ``v^o (N, n_u)``, ``M_k⁻¹``
     ``(N, n_u, n_u)`` (for other gradients: :func:`lq_feedforward`) and the stage index at
@@ -570,25 +583,23 @@ def lq_backward(
     apa, bpa, bpb = np.empty((n_x, n_x)), np.empty((n_u, n_x)), np.empty((n_u, n_u))
     solution = np.empty((n_u, n_x + 1 + n_u))  # [K | −v | M⁻¹]
     _join_coupled(p, x_owner, x_owner, parent)
+    first = _component(parent, 0, x_blocks, u_blocks)  # block 0's component
     for k in range(n_stages - 1, -1, -1):
-        _join_coupled(q_mat[k], x_owner, x_owner, parent)
-        _join_coupled(s_mat[k], x_owner, u_owner, parent)
-        _join_coupled(r_mat[k], u_owner, u_owner, parent)
+        if not _all_joined(parent):  # else nothing is left to join, nor to split
+            _join_coupled(q_mat[k], x_owner, x_owner, parent)
+            _join_coupled(s_mat[k], x_owner, u_owner, parent)
+            _join_coupled(r_mat[k], u_owner, u_owner, parent)
+            first = _component(parent, 0, x_blocks, u_blocks)
         a, b = a_mat[k], b_mat[k]
         for root in range(n_blocks):
             if _root(parent, root) != root:
                 continue
-            xs, us, xb, ub = _component(parent, root, x_blocks, u_blocks)
+            xs, us, xb, ub = first if root == 0 else _component(parent, root, x_blocks, u_blocks)
             n, m = xs.size, us.size
             _gather_component(p, xs, xs, p_c)
             _gather_component(q_mat[k], xs, xs, apa)  # AᵀPA is added to Q
             _gather_component(s_mat[k], xs, us, s_c)
             _gather_component(r_mat[k], us, us, bpb)  # BᵀPB is added to R
-            if floor > 0.0:
-                q_clip, s_clip, r_clip = _clipped_stage(
-                    apa[:n, :n], s_c[:n, :m], bpb[:m, :m], floor
-                )
-                apa[:n, :n], s_c[:n, :m], bpb[:m, :m] = q_clip, s_clip, r_clip
             for i in range(m):
                 for j in range(n):
                     bpa[i, j] = s_c[j, i]  # BᵀPA is added to Sᵀ

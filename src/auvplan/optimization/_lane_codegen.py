@@ -29,12 +29,13 @@ from numba.core import cgutils, compiler, types
 
 from auvplan.optimization._numba_codegen import scalar_expression
 
-__all__ = ["LANES", "lane_typing"]
+__all__ = ["LANES", "VECTOR", "lane_typing", "splat", "vector_intrinsic", "vector_pointer"]
 
 #: Points per evaluation (four doubles: one AVX2 register).
 LANES: Final = 4
 
-_VECTOR: Final = ir.VectorType(ir.DoubleType(), LANES)
+#: ``<LANES x double>``, one value per point.
+VECTOR: Final = ir.VectorType(ir.DoubleType(), LANES)
 _ARITHMETIC: Final[dict[int, Callable[..., Any]]] = {
     ca.OP_ADD: lambda b, x, y: b.fadd(x, y),
     ca.OP_SUB: lambda b, x, y: b.fsub(x, y),
@@ -42,20 +43,33 @@ _ARITHMETIC: Final[dict[int, Callable[..., Any]]] = {
     ca.OP_DIV: lambda b, x, y: b.fdiv(x, y),
     ca.OP_NEG: lambda b, x: b.fneg(x),
     ca.OP_SQ: lambda b, x: b.fmul(x, x),
-    ca.OP_TWICE: lambda b, x: b.fmul(_splat(2.0), x),
-    ca.OP_INV: lambda b, x: b.fdiv(_splat(1.0), x),
+    ca.OP_TWICE: lambda b, x: b.fmul(splat(2.0), x),
+    ca.OP_INV: lambda b, x: b.fdiv(splat(1.0), x),
 }
 #: Operations that are one LLVM vector intrinsic with the scalar code's exact result: IEEE 754
 #: rounds a square root correctly (the scalar ``math.sqrt`` is the C library's), ``abs`` is
 #: ``llvm.fabs`` in both.
-_EXACT_INTRINSICS: Final = {
-    ca.OP_SQRT: f"llvm.sqrt.v{LANES}f64",
-    ca.OP_FABS: f"llvm.fabs.v{LANES}f64",
-}
+_EXACT_INTRINSICS: Final = {ca.OP_SQRT: "llvm.sqrt", ca.OP_FABS: "llvm.fabs"}
 
 
-def _splat(value: float) -> ir.Constant:
-    return ir.Constant(_VECTOR, [value] * LANES)
+def splat(value: float) -> ir.Constant:
+    """``value`` in every lane."""
+    return ir.Constant(VECTOR, [value] * LANES)
+
+
+def vector_intrinsic(builder: ir.IRBuilder, name: str, *operands: Any) -> Any:
+    """The LLVM intrinsic ``name`` (e.g. ``llvm.sqrt``) on :data:`VECTOR` operands."""
+    kind = ir.FunctionType(VECTOR, [VECTOR] * len(operands))
+    function = cgutils.get_or_insert_function(  # type: ignore[no-untyped-call]
+        builder.module, kind, f"{name}.v{LANES}f64"
+    )
+    return builder.call(function, operands)
+
+
+def vector_pointer(context: Any, builder: ir.IRBuilder, kind: Any, array: Any) -> Any:
+    """The data of a float64 array (numba type ``kind``, value ``array``) as ``VECTOR*``."""
+    data = context.make_array(kind)(context, builder, array).data
+    return builder.bitcast(data, VECTOR.as_pointer())
 
 
 @functools.cache
@@ -75,7 +89,7 @@ def _per_lane(context: Any, builder: ir.IRBuilder, op: int, operands: list[Any])
     compiled = context.compile_subroutine(
         builder, _scalar_function(op, len(operands)), signature, flags=flags
     )
-    vector = ir.Constant(_VECTOR, None)
+    vector = ir.Constant(VECTOR, None)
     for lane in range(LANES):
         scalars = [builder.extract_element(x, ir.Constant(ir.IntType(32), lane)) for x in operands]
         value = context.call_internal(builder, compiled.fndesc, signature, scalars)
@@ -116,9 +130,7 @@ def lane_typing(
 
     def codegen(context: Any, builder: ir.IRBuilder, signature: Any, args: Any) -> Any:
         pointers = [
-            builder.bitcast(
-                context.make_array(kind)(context, builder, value).data, _VECTOR.as_pointer()
-            )
+            vector_pointer(context, builder, kind, value)
             for kind, value in zip(signature.args, args, strict=True)
         ]
         slots: dict[int, Any] = {}
@@ -134,16 +146,13 @@ def lane_typing(
                 address = builder.gep(pointers[n_in + slot], [row])
                 builder.store(slots[int(instruction[3])], address, align=8)
             elif op == ca.OP_CONST:
-                slots[slot] = _splat(float(instruction[2]))
+                slots[slot] = splat(float(instruction[2]))
             else:
                 operands = [slots[int(j)] for j in instruction[2:]]
                 if op in _ARITHMETIC:
                     slots[slot] = _ARITHMETIC[op](builder, *operands)
                 elif op in _EXACT_INTRINSICS:
-                    function = cgutils.get_or_insert_function(  # type: ignore[no-untyped-call]
-                        builder.module, ir.FunctionType(_VECTOR, [_VECTOR]), _EXACT_INTRINSICS[op]
-                    )
-                    slots[slot] = builder.call(function, operands)
+                    slots[slot] = vector_intrinsic(builder, _EXACT_INTRINSICS[op], *operands)
                 else:
                     slots[slot] = _per_lane(context, builder, op, operands)
         return context.get_dummy_value()

@@ -43,9 +43,8 @@ class DirectionType(enum.Enum):
 def convexify(weights: StageWeights, floor: float, threads: int = 1) -> StageWeights:
     """Clip the eigenvalues of every ``[[Q, S], [Sᵀ, R]]`` and of ``P_N`` at ``floor``.
 
-    The convexified model of the ladder as arrays (:func:`solve_lq_direction` on one thread
-    clips inside its Riccati sweep instead, without these copies). Only the blocks of coupled
-    coordinates that fail a Cholesky test above the floor change
+    The convexified model of the ladder. Only the blocks of coupled coordinates that fail a
+    Cholesky test above the floor change
     (:func:`auvplan.optimization._kernels.clip_stage_weights`); the stages are split over
     ``threads`` threads (the same results for any number).
 
@@ -180,9 +179,8 @@ def _try_direction(
     weights: StageWeights,
     direction: DirectionType,
     blocks: tuple[IntArray, IntArray],
-    floor: float = 0.0,
 ) -> LqDirection | None:
-    """The direction of one ladder level; with ``floor > 0`` every stage weight is clipped."""
+    """The direction of one ladder level (``None`` if its model fails)."""
     lin = linearization
     feedback, feedforward, m_inverse, failed = _kernels.lq_backward(
         lin.A,
@@ -195,7 +193,6 @@ def _try_direction(
         np.ascontiguousarray(weights.P_N),
         np.ascontiguousarray(lin.m_x),
         *blocks,
-        floor,
     )
     if failed >= 0:
         logger.debug("%s LQ model not positive definite at stage %d", direction.value, failed)
@@ -223,8 +220,8 @@ def solve_lq_direction(
     """Search direction by the discrete Riccati recursion with cross term (§6.3).
 
     Fallback ladder: Newton (``weights``) → convexified quasi-Newton (eigenvalue-clipped
-    ``quasi_weights()``, or clipped ``weights`` when none given; clipped stage by stage inside
-    the sweep) → steepest (``steepest_weights``, e.g. the regulator weights). A level is
+    ``quasi_weights()``, or clipped ``weights`` when none given: :func:`convexify`) →
+    steepest (``steepest_weights``, e.g. the regulator weights). A level is
     rejected when some ``M_k = R_k + B_kᵀ P_{k+1} B_k`` fails the Cholesky test or
     ``Dh·ζ > 0``.
 
@@ -244,8 +241,8 @@ def solve_lq_direction(
         Independent subsystems' indices of ``(x, u)``; ``A_k`` and ``B_k`` are block-diagonal
         in them (:func:`block_ranges`), which the Riccati sweep uses.
     threads : int
-        With more than one, the convexified model's stages are clipped on as many threads
-        before its sweep (:func:`convexify`) instead of by the sweep: the same direction.
+        The convexified model's stages are clipped on as many threads (the same direction
+        for any number).
 
     Returns
     -------
@@ -262,17 +259,8 @@ def solve_lq_direction(
     if direction is not None:
         return direction
     base = quasi_weights() if quasi_weights is not None else weights
-    if threads > 1:
-        convexified = convexify(base, eigenvalue_floor, threads)
-        direction = _try_direction(linearization, convexified, DirectionType.CONVEXIFIED, blocks)
-    else:
-        direction = _try_direction(
-            linearization,
-            StageWeights(base.Q, base.S, base.R, _clipped_matrix(base.P_N, eigenvalue_floor)),
-            DirectionType.CONVEXIFIED,
-            blocks,
-            eigenvalue_floor,
-        )
+    convexified = convexify(base, eigenvalue_floor, threads)
+    direction = _try_direction(linearization, convexified, DirectionType.CONVEXIFIED, blocks)
     if direction is not None:
         return direction
     if steepest_weights is not None:
