@@ -6,9 +6,10 @@ import logging
 
 import numpy as np
 import pytest
+import shapely
 
 from auvplan._typing import FloatArray
-from auvplan.mission.comm_routes import comm_margin
+from auvplan.mission.comm_routes import comm_corridor, comm_margin
 from auvplan.mission.config import CommConfig, PlannerConfig
 from auvplan.mission.preplan import plan_routes
 from auvplan.planning import CircleObstacle
@@ -82,3 +83,27 @@ def test_a_corridor_too_narrow_falls_back_with_a_warning(
     for one, other in zip(paths, free, strict=True):
         np.testing.assert_array_equal(one, other)
     assert any("green: no route stays" in record.getMessage() for record in caplog.records)
+
+
+def test_a_wide_corridor_around_a_curved_path_is_one_area() -> None:
+    """GEOS buffers this gently curving partner path (a REMUS 100 route's 18 samples) by
+    839 m into a polygon and a 16 m^2 sliver 1 km away; the corridor is the polygon (the
+    sliver made the planner fail with a traceback)."""
+    partner = np.array([
+        [365.3, 394.2], [365.0, 392.2], [364.6, 390.2], [364.3, 388.2], [364.1, 386.3],
+        [363.6, 382.3], [363.4, 380.3], [363.3, 378.3], [363.1, 376.3], [363.1, 374.3],
+        [363.1, 372.3], [363.1, 370.3], [363.3, 368.3], [363.4, 366.3], [363.7, 364.3],
+        [364.4, 360.4], [364.9, 358.5], [365.5, 356.5],
+    ])  # fmt: skip
+    starts = np.array([partner[0], [600.0, 100.0]])
+    goals = np.array([partner[-1], [200.0, 200.0]])
+    deviation = 18.4  # a REMUS 100's corner cut
+    max_range = 839.0 - CLEARANCE + comm_margin(CLEARANCE, deviation)  # a buffer of 839 m
+    comm = CommConfig.model_validate({"pair": ["blue", "green"], "max_range_m": max_range})
+    (area,) = comm_corridor(
+        1, NAMES, (comm,), [partner], starts, goals,
+        geometry=GridGeometry(N, N, SPACING, SPACING), clearance=CLEARANCE, deviation=deviation,
+    )  # fmt: skip
+    polygon = shapely.Polygon(area.region.vertices)
+    assert polygon.area > 0.99 * np.pi * 839.0**2  # the whole buffer, not the sliver
+    assert polygon.contains(shapely.LineString(partner))

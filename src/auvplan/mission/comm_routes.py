@@ -75,7 +75,9 @@ def comm_corridor(
                 shapely.LineString([goals[index, :2], goals[partner, :2]]).buffer(link),
             ]
         )
-        # pieces that each touch the partner's path: one polygon (shapely's x, y = north, east)
+        # pieces that each touch the partner's path: one polygon (shapely's x, y = north, east),
+        # but for the slivers GEOS may leave apart from a wide buffer of a dense curve
+        region = max(shapely.get_parts(region), key=lambda part: part.area)
         areas.append(
             OperatingArea(
                 PolygonObstacle(
