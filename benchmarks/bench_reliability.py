@@ -5,6 +5,7 @@ Run::
     .venv/bin/python benchmarks/bench_reliability.py N [--first-seed S] [--jobs 1]
         [--timeout 1800] [--max-horizon-s T] [--output DIR] [--data-dir DIR]
         [--edge-model navigation|paper|crossed] [--fleet auto|coupled|decomposed]
+        [--vehicle TYPE] [--headings-all-round]
 
 For seeds ``S .. S+N-1`` (with ``--max-horizon-s``, seeds whose horizon is longer are skipped
 and the following seeds taken instead, until N scenarios ran), each scenario of
@@ -21,6 +22,9 @@ Prints the success rate, a table of failure classes with counts and seeds, and t
 ``DIR/results.csv``. ``--edge-model`` plans every scenario on those routes instead of its own
 draw (the family draws the paper's and the crossed edge model; ``navigation`` is the default
 of a mission that names none); ``--fleet`` solves every fleet coupled or vehicle by vehicle.
+``--vehicle`` flies every scenario with that vehicle type instead of MEDUSAs (e.g.
+``remus100``), and ``--headings-all-round`` draws each start heading uniformly in
+``(−180°, 180°]`` (seeded by the scenario's seed) instead of about the line to the goal.
 """
 
 from __future__ import annotations
@@ -152,13 +156,24 @@ def run_scenario(
     timeout: float,
     edge_model: str | None = None,
     fleet: str | None = None,
+    vehicle: str | None = None,
+    headings_all_round: bool = False,
 ) -> Row:
-    """Write, plan and check one scenario (its routes' ``edge_model`` and its
-    ``solver.fleet`` replaced if given)."""
+    """Write, plan and check one scenario (its routes' ``edge_model``, its ``solver.fleet``
+    and its vehicles' ``type`` replaced if given; start headings drawn all round if asked)."""
     for table, key, value in (("planner", "edge_model", edge_model), ("solver", "fleet", fleet)):
         if value is not None:
             entries = {**scenario.mission.get(table, {}), key: value}
             scenario = dataclasses.replace(scenario, mission={**scenario.mission, table: entries})
+    if vehicle is not None or headings_all_round:
+        rng = np.random.default_rng(scenario.seed)
+        vehicles = []
+        for table in scenario.mission["vehicle"]:
+            start = dict(table["start"])
+            if headings_all_round:
+                start["heading_deg"] = round(float(rng.uniform(-180.0, 180.0)), 1)
+            vehicles.append({**table, "start": start, "type": vehicle or table["type"]})
+        scenario = dataclasses.replace(scenario, mission={**scenario.mission, "vehicle": vehicles})
     folder = scenario_folder(root, scenario.seed)
     mission = scenario.write(folder)
     row = Row(
@@ -252,6 +267,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         default=None,
         help="solve every scenario's fleet so (solver.fleet; default: the mission's own)",
     )
+    parser.add_argument("--vehicle", default=None, help="fly every scenario with this type")
+    parser.add_argument(
+        "--headings-all-round", action="store_true", help="start headings drawn uniformly"
+    )
     args = parser.parse_args(argv)
     scenarios = select_scenarios(args.n, args.first_seed, args.max_horizon_s, args.data_dir)
     args.output.mkdir(parents=True, exist_ok=True)
@@ -262,7 +281,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
 
     def one(scenario: Scenario) -> Row:
-        row = run_scenario(scenario, args.output, args.timeout, args.edge_model, args.fleet)
+        row = run_scenario(
+            scenario, args.output, args.timeout, args.edge_model, args.fleet, args.vehicle,
+            args.headings_all_round,
+        )  # fmt: skip
         print(
             f"seed {row.seed:4d}  {row.failure_class:<40.40s} {row.wall_s:7.1f} s "
             f"{row.peak_rss_mb:7.0f} MB  {row.description}",

@@ -114,6 +114,33 @@ dt_s = 1.0
     assert leaving_bearing("medusa") > 30.0
 
 
+def test_a_torpedo_turn_keeps_clear_of_another_start() -> None:
+    """Torpedo ``a`` heads north with its route due east: its turn of 44 m would pass 4 m from
+    ``b``'s start, where ``b`` is at t = 0 whatever the schedule; its path keeps 2 r_c away."""
+    mission = """
+[terrain]
+synthetic = true
+[fleet]
+horizon_s = 1200.0
+safety_radius_m = 5.0
+[[vehicle]]
+name = "a"
+type = "remus100"
+start = { north = 100.0, east = 100.0, heading_deg = 0.0, speed = 0.5 }
+goal = { north = 100.0, east = 600.0, heading_deg = 90.0 }
+[[vehicle]]
+name = "b"
+type = "remus100"
+start = { north = 140.0, east = 144.0, heading_deg = 90.0, speed = 0.5 }
+goal = { north = 300.0, east = 600.0, heading_deg = 90.0 }
+[solver]
+dt_s = 1.0
+"""
+    config = parse_mission(tomllib.loads(mission))
+    path = pipeline.run_preplan(config).paths[0]
+    assert np.min(np.hypot(*(path - [140.0, 144.0]).T)) >= 10.0
+
+
 def test_the_turn_towards_a_point_is_an_arc_that_ends_facing_it() -> None:
     """Seeded poses and targets all round (turns to either side, past 180 deg): the points
     lie on one circle of the radius, leave along the heading, are at most ``spacing`` apart,

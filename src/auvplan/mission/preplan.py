@@ -538,9 +538,17 @@ def plan_routes(
             choices.append(choice)
             # near the route, never through a no-go cell nor within 2 r_c of a kept-out goal
             kept_out = _with_discs(is_blocked, keep_out, 2.0 * clearance + 0.25 * cell)
-            turn, rest = _lead_in(
-                route.points, float(courses[index]), radius, 0.25 * cell, kept_out
+            # the turn from the start also keeps 2 r_c from the others' starts (the vehicles
+            # are there together at t = 0: no schedule separates them)
+            other_starts = tuple(
+                CircleObstacle(float(north), float(east), clearance)
+                for other, (north, east) in enumerate(starts[:, :2])
+                if other != index
             )
+            turn, rest = _lead_in(
+                route.points, float(courses[index]), radius, 0.25 * cell,
+                _with_discs(kept_out, other_starts, 2.0 * clearance + 0.25 * cell),
+            )  # fmt: skip
             path = smooth_path(
                 rest, spacing=0.25 * cell, max_deviation=deviation, is_blocked=kept_out
             )
