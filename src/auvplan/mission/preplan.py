@@ -293,26 +293,27 @@ def _lead_in(
     For a vehicle that turns no tighter than ``radius`` [m]: the start pose is the
     optimiser's fixed initial state, so a path that leaves it at an angle asks a
     rudder-steered vehicle for a turn it cannot make (a REMUS 100 turns on 44 m), and the
-    projection saturates the rudder. The route's first point ``2 R`` or more from the start
-    (else its end) is reached the Dubins way, a turn of radius ``R`` towards it from the start
-    pose and the tangent on to it (:func:`turn_towards`); the route points before it are
-    dropped. Returns the turn's points and the polyline from its last point on (the tangent
-    and the rest of the route), to be smoothed on its own so that the path leaves along the
-    heading. No turn (only the start point) where that way crosses a blocked cell, and for
-    a vehicle whose turns are shorter than the path's sample ``spacing`` [m].
+    projection saturates the rudder. A route point ``2 R`` or more from the start (else its
+    end) is reached the Dubins way, a turn of radius ``R`` towards it from the start pose and
+    the tangent on to it (:func:`turn_towards`), and the route points before it are dropped:
+    the first such point whose way crosses no blocked cell (``is_blocked``). Returns the
+    turn's points and the polyline from its last point on (the tangent and the rest of the
+    route), to be smoothed on its own so that the path leaves along the heading. No turn
+    (only the start point) where every way is blocked, and for a vehicle whose turns are
+    shorter than the path's sample ``spacing`` [m].
     """
     unchanged = points[:1], points
     if radius < spacing or len(points) < 2:
         return unchanged
-    far = np.flatnonzero(np.hypot(*(points[1:] - points[0]).T) >= 2.0 * radius)
-    join = int(far[0]) + 1 if far.size else len(points) - 1
-    turn = turn_towards(points[0], heading, points[join], radius, spacing)
-    if turn is None:
-        return unchanged
-    dense = resample_polyline(np.vstack([turn, points[join : join + 1]]), 0.5 * spacing)
-    if np.any(is_blocked(dense[:, 0], dense[:, 1])):
-        return unchanged
-    return turn, np.vstack([turn[-1:], points[join:]])
+    far = np.flatnonzero(np.hypot(*(points[1:] - points[0]).T) >= 2.0 * radius) + 1
+    for join in far if far.size else [len(points) - 1]:
+        turn = turn_towards(points[0], heading, points[join], radius, spacing)
+        if turn is None:
+            continue
+        dense = resample_polyline(np.vstack([turn, points[join : join + 1]]), 0.5 * spacing)
+        if not np.any(is_blocked(dense[:, 0], dense[:, 1])):
+            return turn, np.vstack([turn[-1:], points[join:]])
+    return unchanged
 
 
 def _joined(first: FloatArray, second: FloatArray, spacing: float) -> FloatArray:
