@@ -142,23 +142,25 @@ dt_s = 1.0
 
 
 def test_the_turn_towards_a_point_is_an_arc_that_ends_facing_it() -> None:
-    """Seeded poses and targets all round (turns to either side, past 180 deg): the points
-    lie on one circle of the radius, leave along the heading, are at most ``spacing`` apart,
-    and the last one's heading (the arc's tangent) points at the target."""
+    """Seeded poses and targets all round, turning towards the target or the long way round
+    (past 180 deg): the points lie on one circle of the radius, leave along the heading, are
+    at most ``spacing`` apart, and the last one's heading (the arc's tangent) points at the
+    target."""
     rng = np.random.default_rng(7)
     radius, spacing = 20.0, 1.5
-    for _ in range(200):
+    for case in range(400):
+        the_long_way = case % 2 == 1
         start, heading = rng.uniform(-50.0, 50.0, 2), rng.uniform(-np.pi, np.pi)
         bearing, distance = rng.uniform(-np.pi, np.pi), rng.uniform(2.0, 6.0) * radius
         target = start + distance * np.array([np.cos(bearing), np.sin(bearing)])
-        turn = turn_towards(start, heading, target, radius, spacing)
+        turn = turn_towards(start, heading, target, radius, spacing, the_long_way)
         assert turn is not None
         np.testing.assert_array_equal(turn[0], start)
         steps = np.diff(turn, axis=0)
         assert np.all(np.hypot(*steps.T) <= spacing + 1e-9)
-        centre = start + radius * np.sign(
-            np.array([-np.sin(heading), np.cos(heading)]) @ (target - start)
-        ) * np.array([-np.sin(heading), np.cos(heading)])
+        right = np.array([-np.sin(heading), np.cos(heading)])
+        side = np.sign(right @ (target - start)) * (-1.0 if the_long_way else 1.0)
+        centre = start + radius * side * right
         np.testing.assert_allclose(np.hypot(*(turn - centre).T), radius, rtol=1e-12)
         first = np.arctan2(steps[0, 1], steps[0, 0])  # chord bearing: half a step's turn off
         assert abs(np.angle(np.exp(1j * (first - heading)))) <= 0.5 * spacing / radius + 1e-9

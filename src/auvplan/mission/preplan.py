@@ -295,8 +295,9 @@ def _lead_in(
     rudder-steered vehicle for a turn it cannot make (a REMUS 100 turns on 44 m), and the
     projection saturates the rudder. A route point ``2 R`` or more from the start (else its
     end) is reached the Dubins way, a turn of radius ``R`` towards it from the start pose and
-    the tangent on to it (:func:`turn_towards`), and the route points before it are dropped:
-    the first such point whose way crosses no blocked cell (``is_blocked``). Returns the
+    the tangent on to it (:func:`turn_towards`; turning away from it, the long way round,
+    where the short way is blocked), and the route points before it are dropped: the first
+    such point whose way crosses no blocked cell (``is_blocked``). Returns the
     turn's points and the polyline from its last point on (the tangent and the rest of the
     route), to be smoothed on its own so that the path leaves along the heading. No turn
     (only the start point) where every way is blocked, and for a vehicle whose turns are
@@ -307,12 +308,13 @@ def _lead_in(
         return unchanged
     far = np.flatnonzero(np.hypot(*(points[1:] - points[0]).T) >= 2.0 * radius) + 1
     for join in far if far.size else [len(points) - 1]:
-        turn = turn_towards(points[0], heading, points[join], radius, spacing)
-        if turn is None:
-            continue
-        dense = resample_polyline(np.vstack([turn, points[join : join + 1]]), 0.5 * spacing)
-        if not np.any(is_blocked(dense[:, 0], dense[:, 1])):
-            return turn, np.vstack([turn[-1:], points[join:]])
+        for the_long_way in (False, True):
+            turn = turn_towards(points[0], heading, points[join], radius, spacing, the_long_way)
+            if turn is None:
+                continue
+            way = resample_polyline(np.vstack([turn, points[join : join + 1]]), 0.5 * spacing)
+            if not np.any(is_blocked(way[:, 0], way[:, 1])):
+                return turn, np.vstack([turn[-1:], points[join:]])
     return unchanged
 
 
@@ -327,12 +329,18 @@ def _joined(first: FloatArray, second: FloatArray, spacing: float) -> FloatArray
 
 
 def turn_towards(
-    start: FloatArray, heading: float, target: FloatArray, radius: float, spacing: float
+    start: FloatArray,
+    heading: float,
+    target: FloatArray,
+    radius: float,
+    spacing: float,
+    the_long_way: bool = False,
 ) -> FloatArray | None:
     """Points [m] of the turn of ``radius`` from ``start`` (heading ``ψ_0`` [rad]) to ``target``.
 
-    The turn is to the side of ``target`` (centre ``c = p_0 + s R (−sin ψ_0, cos ψ_0)``,
-    ``s = +1`` to the right, heading from north clockwise) and ends where the heading points
+    The turn is to the side of ``target`` (to the other side ``the_long_way``; centre
+    ``c = p_0 + s R (−sin ψ_0, cos ψ_0)``, ``s = +1`` to the right, heading from north
+    clockwise) and ends where the heading points
     at it, the tangent point: with ``v = target − c``, ``d = |v|`` and ``L = √(d² − R²)``
     the tangent's length, the heading there is ``ψ* = ∠v + s atan2(R, L)``. Returns the arc
     sampled at most ``spacing`` apart, from ``start`` (exactly) to the tangent point, or
@@ -346,7 +354,7 @@ def turn_towards(
     """
     right = np.array([-np.sin(heading), np.cos(heading)])
     offset = target - start
-    side = 1.0 if right @ offset >= 0.0 else -1.0
+    side = (1.0 if right @ offset >= 0.0 else -1.0) * (-1.0 if the_long_way else 1.0)
     centre = start + side * radius * right
     v = target - centre
     distance = float(np.hypot(*v))
@@ -539,17 +547,23 @@ def plan_routes(
             choices.append(choice)
             # near the route, never through a no-go cell nor within 2 r_c of a kept-out goal
             kept_out = _with_discs(is_blocked, keep_out, 2.0 * clearance + 0.25 * cell)
-            # the turn from the start also keeps 2 r_c from the others' starts (the vehicles
-            # are there together at t = 0: no schedule separates them)
+            # the turn from the start keeps 2 r_c from the others' starts where it can (each
+            # vehicle is at its start at t = 0: a turn swinging past another's may have no
+            # schedule), else it may pass them (timing may still separate the vehicles)
             other_starts = tuple(
                 CircleObstacle(float(north), float(east), clearance)
                 for other, (north, east) in enumerate(starts[:, :2])
                 if other != index
             )
-            turn, rest = _lead_in(
-                route.points, float(courses[index]), radius, 0.25 * cell,
+            for checker in (
                 _with_discs(kept_out, other_starts, 2.0 * clearance + 0.25 * cell),
-            )  # fmt: skip
+                kept_out,
+            ):
+                turn, rest = _lead_in(
+                    route.points, float(courses[index]), radius, 0.25 * cell, checker
+                )
+                if len(turn) > 1:
+                    break
             path = smooth_path(
                 rest, spacing=0.25 * cell, max_deviation=deviation, is_blocked=kept_out
             )
