@@ -86,6 +86,11 @@ def test_routes_keep_out_of_the_other_vehicles_goals() -> None:
     assert [(d.north, d.east) for d in goal_keep_outs(starts, goals, 2, 5.0, 2.0)] == [(100.0, 0.0)]
 
 
+def _first_path(mission: str) -> np.ndarray:
+    """Stage 1's smoothed path of the mission's first vehicle (north, east [m])."""
+    return pipeline.run_preplan(parse_mission(tomllib.loads(mission))).paths[0]
+
+
 def test_a_torpedo_path_leaves_along_its_start_heading() -> None:
     """The A* route leaves diagonally (37 deg); a REMUS 100 starting north (turning radius
     44 m) gets a path that leaves within 15 deg of north, a MEDUSA keeps the route's way."""
@@ -105,8 +110,7 @@ dt_s = 1.0
 """
 
     def leaving_bearing(vehicle: str) -> float:
-        config = parse_mission(tomllib.loads(mission.replace("TYPE", vehicle)))
-        path = pipeline.run_preplan(config).paths[0]
+        path = _first_path(mission.replace("TYPE", vehicle))
         ahead = path[np.argmax(np.hypot(*(path - path[0]).T) > 15.0)] - path[0]
         return float(np.degrees(np.arctan2(ahead[1], ahead[0])))
 
@@ -136,8 +140,7 @@ goal = { north = 300.0, east = 600.0, heading_deg = 90.0 }
 [solver]
 dt_s = 1.0
 """
-    config = parse_mission(tomllib.loads(mission))
-    path = pipeline.run_preplan(config).paths[0]
+    path = _first_path(mission)
     assert np.min(np.hypot(*(path - [140.0, 144.0]).T)) >= 10.0
 
 

@@ -37,8 +37,8 @@ from auvplan.planning import (
     Route,
     blocked_cells,
     blocked_lookup,
-    path_length,
     plan_route,
+    resample_at_spacing,
     resample_polyline,
     skirt_discs,
     smooth_path,
@@ -318,16 +318,6 @@ def _lead_in(
     return unchanged
 
 
-def _joined(first: FloatArray, second: FloatArray, spacing: float) -> FloatArray:
-    """Two polylines end to end (``second`` starts at ``first``'s end), resampled.
-
-    At equal arc-length steps closest to ``spacing`` [m], as :func:`smooth_path` returns its
-    curves.
-    """
-    whole = np.vstack([first[:-1], second])
-    return resample_polyline(whole, 0.0, n_steps=max(1, round(path_length(whole) / spacing)))
-
-
 def turn_towards(
     start: FloatArray,
     heading: float,
@@ -546,7 +536,8 @@ def plan_routes(
                 )  # fmt: skip
             choices.append(choice)
             # near the route, never through a no-go cell nor within 2 r_c of a kept-out goal
-            kept_out = _with_discs(is_blocked, keep_out, 2.0 * clearance + 0.25 * cell)
+            keep_off = 2.0 * clearance + 0.25 * cell
+            kept_out = _with_discs(is_blocked, keep_out, keep_off)
             # the turn from the start keeps 2 r_c from the others' starts where it can (each
             # vehicle is at its start at t = 0: a turn swinging past another's may have no
             # schedule), else it may pass them (timing may still separate the vehicles)
@@ -556,7 +547,7 @@ def plan_routes(
                 if other != index
             )
             for checker in (
-                _with_discs(kept_out, other_starts, 2.0 * clearance + 0.25 * cell),
+                _with_discs(kept_out, other_starts, keep_off),
                 kept_out,
             ):
                 turn, rest = _lead_in(
@@ -567,8 +558,8 @@ def plan_routes(
             path = smooth_path(
                 rest, spacing=0.25 * cell, max_deviation=deviation, is_blocked=kept_out
             )
-            if len(turn) > 1:
-                path = _joined(turn, path, 0.25 * cell)
+            if len(turn) > 1:  # the turn and the smoothed rest, sampled alike
+                path = resample_at_spacing(np.vstack([turn[:-1], path]), 0.25 * cell)
             paths.append(_skirt_goals(path, goals, index, clearance, cell, is_blocked))
             logger.info(
                 "A* %s: %d cells, cost %.1f, %d expanded", name, len(route.cells), route.cost,

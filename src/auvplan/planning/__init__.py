@@ -15,7 +15,13 @@ from auvplan.planning.obstacles import (
 from auvplan.planning.problem import EdgeModel, PathResult, PlanningProblem, SearchStatus
 from auvplan.planning.route import Route, blocked_cells, blocked_lookup, plan_route
 from auvplan.planning.skirt import skirt_discs
-from auvplan.planning.smoothing import path_headings, path_length, resample_polyline, smooth_path
+from auvplan.planning.smoothing import (
+    path_headings,
+    path_length,
+    resample_at_spacing,
+    resample_polyline,
+    smooth_path,
+)
 
 __all__ = [
     "CircleObstacle",
@@ -36,6 +42,7 @@ __all__ = [
     "path_length",
     "plan_astar",
     "plan_route",
+    "resample_at_spacing",
     "resample_polyline",
     "skirt_discs",
     "smooth_path",

@@ -156,8 +156,7 @@ def smooth_path(
         if curve is not None:
             return curve
         logger.info("smooth_path: no spline passed the checks; returning the polyline")
-    n_steps = max(1, round(path_length(grid_path) / spacing))
-    return resample_polyline(grid_path, 0.0, n_steps=n_steps)
+    return resample_at_spacing(grid_path, spacing)
 
 
 def _fit_within_bounds(
@@ -264,6 +263,16 @@ def _uniform_steps(length: float, resolution: float, n_steps: int | None) -> Flo
     if n_steps is None:
         n_steps = max(1, int(np.ceil(length / resolution)))
     return np.linspace(0.0, length, n_steps + 1)
+
+
+def resample_at_spacing(points: FloatArray, spacing: float) -> FloatArray:
+    """A polyline at equal arc-length steps ``L / n``, ``n = max(1, round(L / spacing))``.
+
+    The steps closest to ``spacing`` [m] that divide the length ``L`` (as :func:`smooth_path`
+    samples its curves); exact vertices at both ends.
+    """
+    n_steps = max(1, round(path_length(points) / spacing))
+    return resample_polyline(points, 0.0, n_steps=n_steps)
 
 
 def resample_polyline(
