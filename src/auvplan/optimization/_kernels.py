@@ -206,9 +206,7 @@ def _clipped_stages(
                 if stage[index[0], index[0]] <= floor:  # noqa: PLR1730 (max() would drop a NaN)
                     stage[index[0], index[0]] = floor
                 continue
-            for i in range(size):
-                for j in range(size):
-                    block[i, j] = stage[index[i], index[j]]
+            _gather_component(stage, index, index, block)
             if _above_floor(block, size, floor, work):
                 continue
             if _at_most_floor(block, size, floor):
@@ -224,15 +222,11 @@ def _clipped_stages(
         blocks = np.empty((chosen.size, size, size))
         for b in range(chosen.size):
             stage, index = stages[jobs[chosen[b], 0]], jobs[chosen[b], 2 : 2 + size]
-            for i in range(size):
-                for j in range(size):
-                    blocks[b, i, j] = stage[index[i], index[j]]
+            _gather_component(stage, index, index, blocks[b])
         clip_blocks(blocks, floor)
         for b in range(chosen.size):
             stage, index = stages[jobs[chosen[b], 0]], jobs[chosen[b], 2 : 2 + size]
-            for i in range(size):
-                for j in range(size):
-                    stage[index[i], index[j]] = blocks[b, i, j]
+            _scatter_component(blocks[b], index, index, stage)
     return stages
 
 
