@@ -550,20 +550,23 @@ def regulator_riccati(
     """Time-varying discrete LQR gains ``K_k = M⁻¹ Bᵀ P_{k+1} A`` (pronto.md §6.1).
 
     ``M = R_r + BᵀPB`` and ``P_k = Q_r + AᵀPA − (BᵀPA)ᵀ K_k``: :func:`_riccati_stage` on one
-    block without cross term nor gradients. Returns the gains ``(N, n_u, n_x)`` and ``ok``
-    (False if some ``M_k`` was not PD).
+    block without cross term nor gradients. ``a_mat (N, n_x, n_x)`` and ``b_mat`` may be
+    views into a larger system's matrices (a subsystem's blocks): each stage's is copied
+    into a workspace. Returns the gains ``(N, n_u, n_x)`` and ``ok`` (False if some ``M_k``
+    was not PD).
     """
     n_stages, n_x, n_u = b_mat.shape
     gains = np.zeros((n_stages, n_u, n_x))
     xb, ub = np.array([[0, n_x]]), np.array([[0, n_u]])  # one block
     no_cross, no_x, no_u = np.zeros((n_x, n_u)), np.zeros(n_x), np.zeros(n_u)
     p, r = p_final.copy(), np.zeros(n_x)
+    a, b = np.empty((n_x, n_x)), np.empty((n_x, n_u))
     work = _riccati_workspaces(n_x, n_u)
     solution = work[-1]
     for k in range(n_stages - 1, -1, -1):
-        if not _riccati_stage(
-            a_mat[k], b_mat[k], (q_r, no_cross, r_r), no_x, no_u, p, r, xb, ub, work
-        ):
+        a[:, :] = a_mat[k]
+        b[:, :] = b_mat[k]
+        if not _riccati_stage(a, b, (q_r, no_cross, r_r), no_x, no_u, p, r, xb, ub, work):
             return gains, False
         gains[k] = solution[:, :n_x]
     return gains, True

@@ -545,10 +545,12 @@ class BlockKernels:
 
         ``remember``: keep the forward sweeps for :meth:`hessian` at the same arguments.
         """
+        sweeps = self._sweeps(x, u, p, w, h, n_substeps, threads, remember)
+        if len(sweeps) == 1:  # the sweep's own arrays (fresh for every sweep, never written)
+            return sweeps[0].step_jac, sweeps[0].cost, sweeps[0].cost_grad
         n_z = self.n_x + self.n_u
         step_jac = np.empty((x.shape[0], self.n_x, n_z))
         cost, cost_grad = np.empty(x.shape[0]), np.empty((x.shape[0], n_z))
-        sweeps = self._sweeps(x, u, p, w, h, n_substeps, threads, remember)
         for rows, forward in zip(_pieces(x.shape[0], threads), sweeps, strict=True):
             step_jac[rows], cost[rows], cost_grad[rows] = (
                 forward.step_jac, forward.cost, forward.cost_grad,

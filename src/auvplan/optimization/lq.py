@@ -59,7 +59,9 @@ def convexify(weights: StageWeights, floor: float, threads: int = 1) -> StageWei
         pieces(q.shape[0], threads, q.shape[0]),
         threads,
     )
-    q_mat, s_mat, r_mat = (np.concatenate(part) for part in zip(*parts, strict=True))
+    q_mat, s_mat, r_mat = (
+        part[0] if len(part) == 1 else np.concatenate(part) for part in zip(*parts, strict=True)
+    )
     return StageWeights(q_mat, s_mat, r_mat, _clipped_matrix(weights.P_N, floor))
 
 

@@ -88,8 +88,8 @@ def design_regulator(
         if dare:
             p_final = _terminal_are(a_last[states, states], b_last[states, inputs], q_r, r_r)
         return _kernels.regulator_riccati(
-            np.ascontiguousarray(a_block),
-            np.ascontiguousarray(b_block),
+            a_block,
+            b_block,
             np.ascontiguousarray(q_r),
             np.ascontiguousarray(r_r),
             np.ascontiguousarray(p_final),
