@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import threading
 import warnings
 
 import numpy as np
@@ -26,6 +27,12 @@ def test_pieces_tile_the_items_one_per_thread_and_none_over_the_largest() -> Non
 
 def test_map_threads_keeps_the_order_of_the_items() -> None:
     assert _threads.map_threads(lambda i: i * i, list(range(7)), 3) == [i * i for i in range(7)]
+
+
+def test_the_calling_thread_computes_the_first_item_and_a_worker_the_others() -> None:
+    ident = _threads.map_threads(lambda _: threading.get_ident(), [0, 1, 2], 2)
+    assert ident[0] == threading.get_ident()
+    assert threading.get_ident() not in ident[1:]
 
 
 def test_a_forked_child_makes_its_own_worker_threads() -> None:

@@ -36,7 +36,14 @@ os.register_at_fork(after_in_child=_pool.cache_clear)
 
 
 def map_threads(function: Callable[[_T], _R], items: Sequence[_T], threads: int) -> list[_R]:
-    """``[function(item) for item in items]``, on ``threads`` threads when more than one."""
+    """``[function(item) for item in items]``, on ``threads`` threads when more than one.
+
+    The calling thread is one of them: it computes the first item while ``threads − 1``
+    workers take the others (no hand-off to wait for on its own share).
+    """
     if threads == 1 or len(items) == 1:
         return [function(item) for item in items]
-    return list(_pool(threads).map(function, items))
+    pool = _pool(threads - 1)
+    others = [pool.submit(function, item) for item in items[1:]]
+    first = function(items[0])
+    return [first, *(future.result() for future in others)]
