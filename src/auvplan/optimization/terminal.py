@@ -5,12 +5,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import casadi as ca
-import numpy as np
 
 from auvplan._typing import FloatArray
 from auvplan.errors import InputError
 from auvplan.optimization._casadi import (
     dense_function,
+    evaluate,
     signature_sizes,
     symbols,
     with_symbol_fallback,
@@ -21,7 +21,11 @@ __all__ = ["TerminalCost", "make_terminal_cost"]
 
 @dataclass(frozen=True, eq=False)
 class TerminalCost:
-    """Terminal cost ``m(x_N)`` with exact gradient and Hessian (one CasADi call)."""
+    """Terminal cost ``m(x_N)`` with exact gradient and Hessian (one CasADi call).
+
+    Both Functions have dense outputs and are evaluated on numpy buffers
+    (:func:`~auvplan.optimization._casadi.evaluate`: no conversion to CasADi matrices).
+    """
 
     n_x: int
     function: ca.Function
@@ -29,16 +33,13 @@ class TerminalCost:
 
     def evaluate(self, state: FloatArray) -> tuple[float, FloatArray, FloatArray]:
         """Return ``m(x)``, ``m_x`` of shape ``(n_x,)`` and ``m_xx`` of shape ``(n_x, n_x)``."""
-        value, gradient, hessian = self._derivatives(np.asarray(state, dtype=np.float64))
-        return (
-            float(value),
-            np.asarray(gradient.full(), dtype=np.float64).reshape(self.n_x),
-            np.asarray(hessian.full(), dtype=np.float64),
-        )
+        value, gradient, hessian = evaluate(self._derivatives, [state])
+        # CasADi's dense outputs are column-major: m_xx is symmetric, so its transpose is it
+        return float(value[0]), gradient, hessian.reshape(self.n_x, self.n_x).T.copy()
 
     def value(self, state: FloatArray) -> float:
         """``m(x)``."""
-        return float(self.function(np.asarray(state, dtype=np.float64)))
+        return float(evaluate(self.function, [state])[0][0])
 
 
 def make_terminal_cost(terminal_cost: ca.Function, n_x: int) -> TerminalCost:
@@ -60,6 +61,7 @@ def make_terminal_cost(terminal_cost: ca.Function, n_x: int) -> TerminalCost:
         derivatives = dense_function(
             "terminal", [x], [value, grad, hess], ["x"], ["m", "m_x", "m_xx"]
         )
-        return TerminalCost(n_x, terminal_cost, derivatives)
+        value_function = dense_function("terminal_value", [x], [value], ["x"], ["m"])
+        return TerminalCost(n_x, value_function, derivatives)
 
     return with_symbol_fallback(build)
