@@ -141,18 +141,19 @@ def _weighted_rows(
 
 
 @numba.njit(cache=True)
-def _add_to_block(
-    k: int, row: int, column: int, value: float, h_xx: FloatArray, h_xu: FloatArray,
-    h_uu: FloatArray,
-) -> None:  # fmt: skip
-    """Add ``value`` at ``(row, column)`` of ``[[H_xx, H_xu], [·, H_uu]]`` (``H_ux`` not kept)."""
+def _block_of(
+    row: int, column: int, h_xx: FloatArray, h_xu: FloatArray, h_uu: FloatArray
+) -> tuple[FloatArray, int, int, bool]:
+    """Where ``(row, column)`` of ``[[H_xx, H_xu], [·, H_uu]]`` is kept: the block and its entry.
+
+    The last value is False for an entry of ``H_ux``, which is not kept.
+    """
     n_x = h_xx.shape[1]
     if row < n_x and column < n_x:
-        h_xx[k, row, column] += value
-    elif row < n_x:
-        h_xu[k, row, column - n_x] += value
-    elif column >= n_x:
-        h_uu[k, row - n_x, column - n_x] += value
+        return h_xx, row, column, True
+    if row < n_x:
+        return h_xu, row, column - n_x, True
+    return h_uu, row - n_x, column - n_x, column >= n_x
 
 
 @numba.njit(cache=True)
@@ -160,9 +161,15 @@ def _add_entries(
     nonzeros: FloatArray, rows: IntArray, columns: IntArray, h_xx: FloatArray,
     h_xu: FloatArray, h_uu: FloatArray,
 ) -> None:  # fmt: skip
-    for k in range(nonzeros.shape[0]):
-        for e in range(rows.size):
-            _add_to_block(k, rows[e], columns[e], nonzeros[k, e], h_xx, h_xu, h_uu)
+    """``H[k] += nonzeros[k, e]`` at ``(rows[e], columns[e])``, entry by entry over the stages.
+
+    For each stage the entries arrive in the order of ``e``, as from a loop over the stages.
+    """
+    for e in range(rows.size):
+        block, row, column, kept = _block_of(rows[e], columns[e], h_xx, h_xu, h_uu)
+        if kept:
+            for k in range(nonzeros.shape[0]):
+                block[k, row, column] += nonzeros[k, e]
 
 
 @numba.njit(cache=True)
@@ -175,16 +182,22 @@ def _add_outer_products(
     h_xu: FloatArray,
     h_uu: FloatArray,
 ) -> None:
+    """``H[k] += w_kj g_a g_b`` for every row ``j``'s nonzeros ``a``, ``b`` (``g = values[k]``).
+
+    Pair by pair over the stages (rows with ``w_kj = 0`` skipped); for each stage the terms
+    arrive in the order of ``(j, a, b)``, as from a loop over the stages.
+    """
     n_points, n_c = weights.shape
-    for k in range(n_points):
-        for j in range(n_c):
-            w = weights[k, j]
-            if w == 0.0:
-                continue
-            for a in range(row_start[j], row_start[j + 1]):
-                g_a = w * values[k, a]
-                for b in range(row_start[j], row_start[j + 1]):
-                    _add_to_block(k, columns[a], columns[b], g_a * values[k, b], h_xx, h_xu, h_uu)
+    for j in range(n_c):
+        for a in range(row_start[j], row_start[j + 1]):
+            for b in range(row_start[j], row_start[j + 1]):
+                block, row, column, kept = _block_of(columns[a], columns[b], h_xx, h_xu, h_uu)
+                if not kept:
+                    continue
+                for k in range(n_points):
+                    w = weights[k, j]
+                    if w != 0.0:
+                        block[k, row, column] += w * values[k, a] * values[k, b]
 
 
 def discretize_constraints(

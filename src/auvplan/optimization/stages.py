@@ -54,12 +54,20 @@ class CostParts:
 def _barrier_terms(
     model: ProntoModel, slack: FloatArray, delta: float
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-    """Barrier value, its first and second derivatives in ``s``, and the arguments ``z``."""
-    hockey_value = composed_barrier(slack, delta, is_hockey=True)
-    plain_value = composed_barrier(slack, delta, is_hockey=False)
-    mask = model.is_hockey[None, :]
-    parts = [np.where(mask, h, p) for h, p in zip(hockey_value, plain_value, strict=True)]
-    argument = np.where(mask, hockey_stick(slack)[0], slack)
+    """Barrier value, its first and second derivatives in ``s``, and the arguments ``z``.
+
+    Each constraint column through its own kind of barrier (hockey or plain) only.
+    """
+    parts = [np.empty_like(slack) for _ in range(3)]
+    argument = slack.copy()
+    hockey = model.is_hockey
+    for columns, is_hockey in ((hockey, True), (~hockey, False)):
+        if columns.any():
+            terms = composed_barrier(slack[:, columns], delta, is_hockey=is_hockey)
+            for part, term in zip(parts, terms, strict=True):
+                part[:, columns] = term
+    if hockey.any():
+        argument[:, hockey] = hockey_stick(slack[:, hockey])[0]
     return parts[0], parts[1], parts[2], argument
 
 
