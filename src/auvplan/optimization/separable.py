@@ -21,11 +21,13 @@ block-diagonal. It is a :class:`~auvplan.optimization.discretization.StepModel`.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import casadi as ca
+import numba
 import numpy as np
 
 from auvplan._typing import FloatArray, IntArray
@@ -135,6 +137,42 @@ class _Group:
     kernels: BlockKernels
     blocks: tuple[StageBlock, ...]
     weights: FloatArray
+
+    @functools.cached_property
+    def starts(self) -> tuple[IntArray, IntArray]:
+        """Each block's first row in the stacked state and input."""
+        return (
+            np.array([b.states.start for b in self.blocks], dtype=np.uint64),
+            np.array([b.inputs.start for b in self.blocks], dtype=np.uint64),
+        )
+
+
+@numba.njit(cache=True)
+def _place_blocks(
+    source: FloatArray,
+    rows: IntArray,
+    columns: IntArray,
+    source_corner: tuple[int, int],
+    size: tuple[int, int],
+    out: FloatArray,
+) -> None:
+    """Write each block's part of ``source`` into its place in the stacked ``out``.
+
+    Block ``i``'s stage ``k`` is ``source[i N + k]`` (``N = out.shape[0]``); its
+    ``size = (r, c)`` entries from ``source_corner`` go to ``out[k]`` from
+    ``(rows[i], columns[i])`` (unsigned: no negative-index wraparound in the loops). Every
+    other entry of ``out`` is left as it is.
+    """
+    n_stages = out.shape[0]
+    first_row, first_column = np.uint64(source_corner[0]), np.uint64(source_corner[1])
+    n_rows, n_columns = np.uint64(size[0]), np.uint64(size[1])
+    for i in range(rows.size):
+        for k in range(n_stages):
+            block, stage = source[i * n_stages + k], out[k]
+            for r in range(n_rows):
+                line, target = block[first_row + r], stage[rows[i] + r]
+                for c in range(n_columns):
+                    target[columns[i] + c] = line[first_column + c]
 
 
 @dataclass(frozen=True, eq=False)
@@ -274,11 +312,12 @@ class BlockDiscreteModel:
             jac, total, grad = group.kernels.first_order(
                 *points, self.h, self.n_substeps, remember, self.threads
             )
-            n_bx = group.kernels.n_x
+            n_bx, n_bu = group.kernels.n_x, group.kernels.n_u
+            xs, us = group.starts
+            _place_blocks(jac, xs, xs, (0, 0), (n_bx, n_bx), f_x)
+            _place_blocks(jac, xs, us, (0, n_bx), (n_bx, n_bu), f_u)
             for i, block in enumerate(group.blocks):
                 rows = slice(i * n_stages, (i + 1) * n_stages)
-                f_x[:, block.states, block.states] = jac[rows, :, :n_bx]
-                f_u[:, block.states, block.inputs] = jac[rows, :, n_bx:]
                 cost += total[rows]
                 l_x[:, block.states] = grad[rows, :n_bx]
                 l_u[:, block.inputs] = grad[rows, n_bx:]
@@ -312,12 +351,11 @@ class BlockDiscreteModel:
                 *points, self.h, self.n_substeps, np.ascontiguousarray(weights), cost_weight,
                 self.threads,
             )  # fmt: skip
-            n_bx = group.kernels.n_x
-            for i, block in enumerate(group.blocks):
-                rows = slice(i * n_stages, (i + 1) * n_stages)
-                h_xx[:, block.states, block.states] = hessian[rows, :n_bx, :n_bx]
-                h_xu[:, block.states, block.inputs] = hessian[rows, :n_bx, n_bx:]
-                h_uu[:, block.inputs, block.inputs] = hessian[rows, n_bx:, n_bx:]
+            n_bx, n_bu = group.kernels.n_x, group.kernels.n_u
+            xs, us = group.starts
+            _place_blocks(hessian, xs, xs, (0, 0), (n_bx, n_bx), h_xx)
+            _place_blocks(hessian, xs, us, (0, n_bx), (n_bx, n_bu), h_xu)
+            _place_blocks(hessian, us, us, (n_bx, n_bx), (n_bu, n_bu), h_uu)
         return h_xx, h_xu, h_uu
 
     def lagrangian_hessians(
