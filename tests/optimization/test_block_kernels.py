@@ -343,7 +343,7 @@ def test_sweeps_written_over_the_last_ones_memory_give_fresh_results(
     assert memory.spares  # the memory was there to reuse
     kept = memory.last.get(*points[-1][:4], np.array([DT / 2, 2, kernel_module.CHUNK, threads]))
     assert kept is not None
-    assert not _share_memory(memory.spares, kept)
+    assert not _share_memory(memory.spares, kept.pieces)
 
 
 def test_each_thread_remembers_and_writes_over_its_own_sweeps(
@@ -371,7 +371,8 @@ def test_each_thread_remembers_and_writes_over_its_own_sweeps(
     key = np.array([DT / 2, 2, kernel_module.CHUNK, 1])
     kept = mine.last.get(x, u, p, w, key)  # still this thread's linearisation
     assert kept is not None
-    assert not _share_memory(theirs[0].spares + theirs[0].last.get(x + 0.2, u, p, w, key), kept)
+    elsewhere = theirs[0].last.get(x + 0.2, u, p, w, key)
+    assert not _share_memory(theirs[0].spares + elsewhere.pieces, kept.pieces)
 
 
 def test_closed_loop_equals_a_loop_of_substeps(
@@ -450,5 +451,5 @@ def test_sweeps_carry_the_pattern_s_entries_of_the_node_derivatives(
     assert np.count_nonzero(~pattern) == 8
     np.testing.assert_array_equal(kernels.carried_entries, np.flatnonzero(pattern))
     x, u, p, w = _points(kernels, weights, rng)
-    (sweep,) = kernels._sweeps(x, u, p, w, DT / 3, 3, threads=1, remember=False)
+    (sweep,) = kernels._sweeps(x, u, p, w, DT / 3, 3, threads=1, remember=False).pieces
     assert sweep.carried.shape == (12, 2, pattern.sum(), LANES)  # 3 substeps, 6 points

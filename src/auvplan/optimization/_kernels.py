@@ -149,8 +149,12 @@ CLIP_CHUNK = 64
 
 @numba.njit(cache=True, nogil=True)
 def clip_stage_weights(
-    q_mat: FloatArray, s_mat: FloatArray, r_mat: FloatArray, floor: float
-) -> tuple[FloatArray, FloatArray, FloatArray]:
+    q_mat: FloatArray,
+    s_mat: FloatArray,
+    r_mat: FloatArray,
+    floor: float,
+    out: tuple[FloatArray, FloatArray, FloatArray],
+) -> None:
     """``Q, S, R`` of ``½(W_k + W_kᵀ)``, ``W_k = [[Q_k, S_k], [S_kᵀ, R_k]]``, clipped at ``floor``.
 
     The projection ``V max(Λ, floor) Vᵀ`` of every stage, block by block: a stage's weights are
@@ -164,17 +168,17 @@ def clip_stage_weights(
     (:func:`~auvplan.optimization._lane_eigen.clip_blocks`), :data:`CLIP_CHUNK` stages at a
     time. Each stage's result depends on that stage only.
 
-    Returns the clipped ``Q (N, n_x, n_x)``, ``S (N, n_x, n_u)`` and ``R (N, n_u, n_u)``.
+    Writes the clipped ``Q (N, n_x, n_x)``, ``S (N, n_x, n_u)`` and ``R (N, n_u, n_u)`` into
+    ``out`` (arrays of those shapes, e.g. a piece of larger ones).
     """
     n_x = q_mat.shape[1]
-    q_out, s_out, r_out = np.empty_like(q_mat), np.empty_like(s_mat), np.empty_like(r_mat)
+    q_out, s_out, r_out = out
     for start in range(0, q_mat.shape[0], CLIP_CHUNK):
         rows = slice(start, min(start + CLIP_CHUNK, q_mat.shape[0]))
         stages = _clipped_stages(q_mat[rows], s_mat[rows], r_mat[rows], floor)
         q_out[rows] = stages[:, :n_x, :n_x]
         s_out[rows] = stages[:, :n_x, n_x:]
         r_out[rows] = stages[:, n_x:, n_x:]
-    return q_out, s_out, r_out
 
 
 @numba.njit(cache=True, nogil=True)

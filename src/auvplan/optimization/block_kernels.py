@@ -391,25 +391,34 @@ class LastCall(Generic[_T]):
 
 @dataclass(frozen=True)
 class _Forward:
-    """A forward sweep: the nodes' points and derivatives, the step's first-order data.
+    """A forward sweep's nodes: their points and derivatives, for the reverse sweep.
 
     ``points`` ``Y_n (n_nodes, G, n_x, LANES)``, ``carried`` ``D_n (n_nodes, G, n_d, LANES)``
     (:attr:`BlockKernels.carried_entries`; point ``b`` in group ``b // LANES``, lane
-    ``b % LANES``), ``step_jac`` ``∂F/∂(x, u)``, ``cost`` ``L``, ``cost_grad`` ``∇L``.
+    ``b % LANES``).
     """
 
     points: FloatArray
     carried: FloatArray
-    step_jac: FloatArray
-    cost: FloatArray
-    cost_grad: FloatArray
+
+
+@dataclass(frozen=True)
+class _Sweeps:
+    """The forward sweeps of a batch, one per piece, and the step's first-order data of all.
+
+    ``first_order`` is ``(∂F/∂(x, u), L, ∇L)`` of every point; each piece's arrays are views
+    of their rows (written there by its sweep: no gathering of the pieces).
+    """
+
+    pieces: list[_Forward]
+    first_order: tuple[FloatArray, FloatArray, FloatArray]
 
 
 @dataclass
 class _SweepMemory:
     """One thread's forward sweeps: the last remembered ones and the ones they evicted."""
 
-    last: LastCall[list[_Forward]] = field(default_factory=LastCall)
+    last: LastCall[_Sweeps] = field(default_factory=LastCall)
     """The sweeps of the last :meth:`BlockKernels.first_order` call, by its arguments: a
     Newton step asks for the Hessians at the trajectory it just linearised."""
     spares: list[_Forward] = field(default_factory=list)
@@ -457,7 +466,7 @@ class BlockKernels:
         n_substeps: int,
         threads: int,
         remember: bool = True,
-    ) -> list[_Forward]:
+    ) -> _Sweeps:
         """The forward sweeps of every piece of :func:`_pieces` (reused when the arguments repeat).
 
         ``remember=False`` leaves the remembered sweeps alone (e.g. Jacobians at other points
@@ -471,15 +480,24 @@ class BlockKernels:
             spares: list[_Forward | None] = [None] * len(pieces)
             if remember:  # else the sweeps outlive this call: the caller reads them
                 spares[: len(memory.spares)] = memory.spares[: len(pieces)]
-            sweeps = map_threads(
-                lambda work: self._forward(
-                    x[work[0]], u[work[0]], p[work[0]], w[work[0]], h, n_substeps, work[1]
-                ),
-                list(zip(pieces, spares, strict=True)),
-                threads,
+            n_points, n_z = x.shape[0], self.n_x + self.n_u
+            whole = (
+                np.empty((n_points, self.n_x, n_z)),
+                np.empty(n_points),
+                np.empty((n_points, n_z)),
+            )
+
+            def forward(work: tuple[slice, _Forward | None]) -> _Forward:
+                rows, spare = work
+                out = (whole[0][rows], whole[1][rows], whole[2][rows])
+                return self._forward(x[rows], u[rows], p[rows], w[rows], h, n_substeps, out, spare)
+
+            sweeps = _Sweeps(
+                map_threads(forward, list(zip(pieces, spares, strict=True)), threads), whole
             )
             if remember:
-                memory.spares[:] = memory.last.put(sweeps, *arguments) or []
+                last = memory.last.put(sweeps, *arguments)
+                memory.spares[:] = [] if last is None else last.pieces
         return sweeps
 
     def step(
@@ -508,27 +526,28 @@ class BlockKernels:
         w: FloatArray,
         h: float,
         n_substeps: int,
+        out: tuple[FloatArray, FloatArray, FloatArray],
         spare: _Forward | None = None,
     ) -> _Forward:
         """Forward sweep through the ``4m`` nodes with first-order derivatives.
 
+        ``out``: where the step's ``(∂F/∂(x, u), L, ∇L)`` of these points are written.
         ``spare``: a sweep no longer needed, whose node arrays are written over when their
         shapes match (fresh memory is first touched page by page).
         """
-        n_points, n_x, n_z = x.shape[0], self.n_x, self.n_x + self.n_u
+        n_points, n_x = x.shape[0], self.n_x
         nodes = (4 * n_substeps, -(-n_points // LANES))
         if spare is not None and spare.points.shape == (*nodes, n_x, LANES):
             points, carried = spare.points, spare.carried
         else:
             points = np.empty((*nodes, n_x, LANES))
             carried = np.empty((*nodes, self.carried_entries.size, LANES))
-        step_jac, cost = np.empty((n_points, n_x, n_z)), np.empty(n_points)
-        cost_grad = np.empty((n_points, n_z))
+        step_jac, cost, cost_grad = out
         self.module.forward_batch(
             np.ascontiguousarray(x), u, p, w, h, n_substeps, self.carried_entries, points,
             carried, step_jac, cost, cost_grad,
         )  # fmt: skip
-        return _Forward(points, carried, step_jac, cost, cost_grad)
+        return _Forward(points, carried)
 
     def first_order(
         self,
@@ -545,17 +564,8 @@ class BlockKernels:
 
         ``remember``: keep the forward sweeps for :meth:`hessian` at the same arguments.
         """
-        sweeps = self._sweeps(x, u, p, w, h, n_substeps, threads, remember)
-        if len(sweeps) == 1:  # the sweep's own arrays (fresh for every sweep, never written)
-            return sweeps[0].step_jac, sweeps[0].cost, sweeps[0].cost_grad
-        n_z = self.n_x + self.n_u
-        step_jac = np.empty((x.shape[0], self.n_x, n_z))
-        cost, cost_grad = np.empty(x.shape[0]), np.empty((x.shape[0], n_z))
-        for rows, forward in zip(_pieces(x.shape[0], threads), sweeps, strict=True):
-            step_jac[rows], cost[rows], cost_grad[rows] = (
-                forward.step_jac, forward.cost, forward.cost_grad,
-            )  # fmt: skip
-        return step_jac, cost, cost_grad
+        # fresh arrays for every sweep, never written after it
+        return self._sweeps(x, u, p, w, h, n_substeps, threads, remember).first_order
 
     def hessian(
         self,
@@ -579,7 +589,8 @@ class BlockKernels:
             self._reverse(forward, u[rows], p[rows], w[rows], h, costate[rows], cost_weight,
                           total[rows])  # fmt: skip
 
-        map_threads(reverse, list(zip(_pieces(x.shape[0], threads), sweeps, strict=True)), threads)
+        pieces = list(zip(_pieces(x.shape[0], threads), sweeps.pieces, strict=True))
+        map_threads(reverse, pieces, threads)
         return total
 
     def _reverse(

@@ -54,15 +54,15 @@ def convexify(weights: StageWeights, floor: float, threads: int = 1) -> StageWei
         Positive-definite weights (projection onto ``{W ⪰ floor·I}`` per stage).
     """
     q, s, r = (np.ascontiguousarray(w) for w in (weights.Q, weights.S, weights.R))
-    parts = map_threads(
-        lambda rows: _kernels.clip_stage_weights(q[rows], s[rows], r[rows], floor),
+    clipped = (np.empty_like(q), np.empty_like(s), np.empty_like(r))
+    map_threads(
+        lambda rows: _kernels.clip_stage_weights(
+            q[rows], s[rows], r[rows], floor, (clipped[0][rows], clipped[1][rows], clipped[2][rows])
+        ),
         pieces(q.shape[0], threads, q.shape[0]),
         threads,
     )
-    q_mat, s_mat, r_mat = (
-        part[0] if len(part) == 1 else np.concatenate(part) for part in zip(*parts, strict=True)
-    )
-    return StageWeights(q_mat, s_mat, r_mat, _clipped_matrix(weights.P_N, floor))
+    return StageWeights(*clipped, _clipped_matrix(weights.P_N, floor))
 
 
 def _clipped_matrix(matrix: FloatArray, floor: float) -> FloatArray:
