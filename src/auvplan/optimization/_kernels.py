@@ -364,7 +364,7 @@ def _unsigned_block(xb: IntArray, ub: IntArray, c: int) -> tuple[np.uint64, ...]
 
     Loops over them index without numba's negative-index wraparound, which stops the
     compiler from vectorising them (a signed range from an unknown start could be negative):
-    the block products run about three times faster.
+    a 16 × 16 block product ran 2.6 times faster.
     """
     return (np.uint64(xb[c, 0]), np.uint64(xb[c, 1]), np.uint64(ub[c, 0]), np.uint64(ub[c, 1]))
 
