@@ -51,11 +51,13 @@ SCALING_FLEETS = (2, 4, 8, 16, 32)
 SCALING_ITERATIONS = 4
 
 
-def run(case: str, solver: str, cache: Path, max_iter: int | None = None) -> dict[str, Any]:
+def run(
+    case: str, solver: str, cache: Path, max_iter: int | None = None, repeats: int = 1
+) -> dict[str, Any]:
     """One measurement in a fresh process (``_fleet.py``); its JSON record."""
-    command = [sys.executable, str(HERE / "_fleet.py"), case, solver]
+    command = [sys.executable, str(HERE / "_fleet.py"), case, solver, "--repeats", str(repeats)]
     if max_iter is not None:
-        command.append(str(max_iter))
+        command += ["--max-iter", str(max_iter)]
     env = {**os.environ, "AUVPLAN_CACHE_DIR": str(cache)}
     done = subprocess.run(command, capture_output=True, text=True, env=env, check=False)
     if done.returncode != 0:
@@ -102,10 +104,11 @@ def _row(record: dict[str, Any], label: str, reference: float | None) -> str:
     )
 
 
-def comparison(cases: tuple[str, ...]) -> str:
+def comparison(cases: tuple[str, ...], repeats: int = 1) -> str:
     """Table 1: each case with every solver (the ratio is IPOPT's time over each).
 
-    Each case starts from an empty kernel cache (its cold run compiles the kernels).
+    Each case starts from an empty kernel cache (its cold run compiles the kernels). A solve
+    alone (auvplan's and the CasADi solvers') is the fastest of ``repeats`` in its process.
     """
     lines = [
         "| case | solver | wall s | IPOPT / this | iterations | final cost | peak MB |",
@@ -120,18 +123,23 @@ def comparison(cases: tuple[str, ...]) -> str:
                 "auvplan, cold cache, 2 threads": run(case, "kernels-2", cold_cache),
                 "auvplan, warm cache": run(case, "kernels", cold_cache),
                 "auvplan, solve alone (model and kernels loaded)": run(
-                    case, "kernels-solve", cold_cache
+                    case, "kernels-solve", cold_cache, repeats=repeats
                 ),
                 "auvplan, warm cache, 2 threads": run(case, "kernels-2", cold_cache),
-                "auvplan, solve alone, 2 threads": run(case, "kernels-solve-2", cold_cache),
+                "auvplan, solve alone, 2 threads": run(
+                    case, "kernels-solve-2", cold_cache, repeats=repeats
+                ),
                 "PRONTO on the CasADi VM": run(case, "casadi", cold_cache),
-                "CasADi + IPOPT (MX NLP)": run(case, "ipopt-mx", cold_cache),
+                "CasADi + IPOPT (MX NLP)": run(case, "ipopt-mx", cold_cache, repeats=repeats),
             }
             if case == "demo":  # the SX NLP needs ~15 GB already here: crossing only
-                records["CasADi + IPOPT (SX NLP)"] = run(case, "ipopt", cold_cache)
-            records["CasADi + IPOPT (C-compiled stage)"] = run(case, "ipopt-c", cold_cache)
-            records["CasADi + FATROP (VM)"] = run(case, "fatrop", cold_cache)
-            records["CasADi + FATROP (C-compiled stage)"] = run(case, "fatrop-c", cold_cache)
+                records["CasADi + IPOPT (SX NLP)"] = run(case, "ipopt", cold_cache, repeats=repeats)
+            for label, solver in (
+                ("CasADi + IPOPT (C-compiled stage)", "ipopt-c"),
+                ("CasADi + FATROP (VM)", "fatrop"),
+                ("CasADi + FATROP (C-compiled stage)", "fatrop-c"),
+            ):
+                records[label] = run(case, solver, cold_cache, repeats=repeats)
         solved = [r for label, r in records.items() if "IPOPT" in label and "error" not in r]
         ipopt = min(solved, key=lambda r: r["wall_s"], default=records["CasADi + IPOPT (MX NLP)"])
         reference = ipopt.get("wall_s")  # the faster IPOPT set-up
@@ -248,10 +256,13 @@ def scaling(cache: Path) -> str:
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="the crossing comparison only")
+    parser.add_argument(
+        "--repeats", type=int, default=1, help="solves alone: the fastest of R in a process"
+    )
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="auvplan_bench_") as cache_dir:
         cache = Path(cache_dir)
-        tables = [comparison(COMPARED[:1] if args.quick else COMPARED)]
+        tables = [comparison(COMPARED[:1] if args.quick else COMPARED, args.repeats)]
         run("demo", "kernels", cache)  # fills the cache of the following tables
         if not args.quick:
             tables += [targets(cache), scaling(cache), decomposed_scaling(cache)]

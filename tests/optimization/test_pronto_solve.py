@@ -11,6 +11,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
+from auvplan.errors import InputError
 from auvplan.optimization import (
     PathConstraint,
     ProntoIteration,
@@ -168,6 +169,19 @@ def test_fatrop_reaches_the_optimum_of_pronto_and_ipopt(make_problem) -> None:
     if problem.constraints:
         slacks = _constraint_slacks(problem, fatrop.trajectory.states, fatrop.trajectory.inputs)
         assert np.min(slacks) > -1e-7
+
+
+def test_repeated_reference_solves_are_the_same_solve() -> None:
+    """``repeats`` solves the NLP again from the same start: the same iterations and result
+    (a benchmark then reports the fastest solve); fewer than one is refused."""
+    problem = unicycle_problem()
+    start = solve_pronto(problem, zero_guess(problem)).trajectory
+    once, thrice = (solve_fatrop(problem, start, repeats=r) for r in (1, 3))
+    assert thrice.n_iter == once.n_iter
+    np.testing.assert_array_equal(thrice.trajectory.states, once.trajectory.states)
+    assert thrice.cost == once.cost
+    with pytest.raises(InputError, match="repeats"):
+        solve_ipopt(problem, start, repeats=0)
 
 
 @pytest.mark.skipif(shutil.which("gcc") is None and shutil.which("cc") is None, reason="no C")
