@@ -4,6 +4,7 @@ Run once and print every table (all ratios from this one run, on this machine)::
 
     .venv/bin/python benchmarks/bench_pronto.py           # comparison, targets, scaling
     .venv/bin/python benchmarks/bench_pronto.py --quick   # the crossing only
+    .venv/bin/python benchmarks/bench_pronto.py --quick --repeats 3   # solves alone: best of 3
 
 Cases are real missions up to the stage-3 problem (:mod:`_fleet`): ``demo`` is the built-in
 two-MEDUSA crossing (600 s, ``dt_s`` 0.5, propeller order 3) optimised energy-only, and
@@ -19,7 +20,9 @@ stage Function and its derivatives compiled to C (``compiled=True``; the first r
 empty cache, compiles). A CasADi solve that reaches the optimum is set, by its solve alone
 (without building or compiling), against auvplan's warm stage 3 (in a fresh process: the
 model built and numba's cached kernels loaded, about 0.3 s) and against auvplan's solve
-alone (a second solve in the process, like for like); one that does not is marked.
+alone (a second solve in the process, like for like); one that does not is marked. With
+``--repeats R`` every solve alone, auvplan's and the CasADi solvers', is the fastest of R in
+its process (the same solve from the same start).
 
 Tables: (1) auvplan vs CasADi VM vs IPOPT: wall time, iterations, final cost, peak memory;
 (2) the targets of issues 12 and 27 (fleets of 4, 8, 16 and 32 for an hour, coupled and
