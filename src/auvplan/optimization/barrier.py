@@ -36,6 +36,7 @@ from auvplan.errors import InputError
 
 __all__ = [
     "BarrierKind",
+    "barrier_and_argument",
     "barrier_expression",
     "composed_barrier",
     "hockey_stick",
@@ -141,11 +142,19 @@ def composed_barrier(
     >>> bool(abs(value[0]) < 1e-12)
     True
     """
+    value, first, second, _ = barrier_and_argument(slack, delta, is_hockey=is_hockey)
+    return value, first, second
+
+
+def barrier_and_argument(
+    slack: FloatArray, delta: float, *, is_hockey: bool
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """:func:`composed_barrier` and the log barrier's argument ``z`` (``σ(s)`` or ``s``)."""
     if not is_hockey:
-        return log_barrier(slack, delta)
+        return (*log_barrier(slack, delta), np.asarray(slack, dtype=np.float64))
     z, dz, ddz = hockey_stick(slack)
     value, first, second = log_barrier(z, delta)
-    return value, first * dz, second * dz * dz + first * ddz
+    return value, first * dz, second * dz * dz + first * ddz, z
 
 
 def barrier_expression(slack: Any, delta: float, *, is_hockey: bool) -> Any:

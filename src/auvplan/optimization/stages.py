@@ -14,7 +14,7 @@ import numpy as np
 
 from auvplan._typing import BoolArray, FloatArray
 from auvplan.optimization import _kernels
-from auvplan.optimization.barrier import composed_barrier, hockey_stick
+from auvplan.optimization.barrier import barrier_and_argument
 from auvplan.optimization.constraints import SparseJacobians
 from auvplan.optimization.model import ProntoModel
 from auvplan.optimization.problem import Trajectory
@@ -58,17 +58,14 @@ def _barrier_terms(
 
     Each constraint column through its own kind of barrier (hockey or plain) only.
     """
-    parts = [np.empty_like(slack) for _ in range(3)]
-    argument = slack.copy()
+    parts = [np.empty_like(slack) for _ in range(4)]
     hockey = model.is_hockey
     for columns, is_hockey in ((hockey, True), (~hockey, False)):
         if columns.any():
-            terms = composed_barrier(slack[:, columns], delta, is_hockey=is_hockey)
+            terms = barrier_and_argument(slack[:, columns], delta, is_hockey=is_hockey)
             for part, term in zip(parts, terms, strict=True):
                 part[:, columns] = term
-    if hockey.any():
-        argument[:, hockey] = hockey_stick(slack[:, hockey])[0]
-    return parts[0], parts[1], parts[2], argument
+    return parts[0], parts[1], parts[2], parts[3]
 
 
 def constraint_nodes(
