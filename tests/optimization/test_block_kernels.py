@@ -26,7 +26,9 @@ from auvplan.optimization._numba_codegen import (
     _TEMPLATES,
     _UNARY,
     UnsupportedOperation,
+    instructions,
     numba_source,
+    split_stage,
 )
 
 from ._kernel_models import assert_close, cart, fixed_weights, pendulum, unicycle
@@ -130,6 +132,53 @@ def test_lane_kernels_equal_the_scalar_kernels_to_the_bit(
     actual = np.empty((rows.shape[0], function.numel_out(0)))
     module.kernel_groups(rows, actual)
     np.testing.assert_array_equal(actual, _compiled(function, kernel_cache)(rows))
+
+
+#: Groups of ``LANES`` rows through a two-input lane kernel split at its second input.
+_STAGE_LOOP = """
+@numba.njit(cache=True)
+def kernel_groups(rows, stage_rows, out):
+    y, u = np.empty((rows.shape[1], LANES)), np.empty((stage_rows.shape[1], LANES))
+    stage, results = np.empty((KERNEL_STAGE_SIZE, LANES)), np.empty((out.shape[1], LANES))
+    for first in range(0, rows.shape[0], LANES):
+        for lane in range(LANES):
+            y[:, lane] = rows[first + lane]
+            u[:, lane] = stage_rows[first + lane]
+        kernel_stage_lanes(y, u, stage)
+        kernel_lanes(y, u, stage, results)
+        for lane in range(LANES):
+            out[first + lane] = results[:, lane]
+"""
+
+
+def test_stage_constant_operations_are_hoisted_with_the_same_bits(
+    kernel_cache: Path, rng: np.random.Generator
+) -> None:
+    """What depends on the stage input alone is computed once, before the rest, bit for bit."""
+    every, rows = _every_operation(rng)
+    _, stage_rows = _every_operation(rng)
+    y, u = ca.SX.sym("y", 8), ca.SX.sym("u", 8)
+    function = ca.Function("split", [y, u], [ca.vertcat(every(y) * every(u), every(u))])
+    stage, body, size = split_stage(instructions(function), (1,), 2)
+    transcendental = {ca.OP_SIN, ca.OP_TANH, ca.OP_ERF, ca.OP_EXP}
+    assert {i.op for i in stage} >= transcendental
+    assert all(i.operands[0] == 1 for i in stage if i.op == ca.OP_INPUT)  # u alone
+    assert sum(i.op == ca.OP_TANH for i in body) == 1  # tanh(y) stays; tanh(u) is hoisted
+    assert size >= every.numel_out(0)  # every(u) is read by the products and the outputs
+    whole = np.hstack([rows, stage_rows])
+    joined = ca.Function("joined", [ca.vertcat(y, u)], [function(y, u)])
+    expected = _compiled(joined, kernel_cache)(whole)
+    source = numba_source({"kernel": function}, "split kernel", stage_inputs=(1,))
+    module, _ = load_kernel_module(source, lambda: source, kernel_cache)
+    actual = np.empty_like(expected)
+    module.kernel_batch(rows, stage_rows, actual)  # the stage, then the body, row by row
+    np.testing.assert_array_equal(actual, expected)
+    source = numba_source(
+        {"kernel": function}, "split lanes", _STAGE_LOOP, lanes=("kernel",), stage_inputs=(1,)
+    )
+    module, _ = load_kernel_module(source, lambda: source, kernel_cache)
+    module.kernel_groups(rows, stage_rows, actual)
+    np.testing.assert_array_equal(actual, expected)
 
 
 def test_infinite_and_nan_constants_evaluate_like_casadi(kernel_cache: Path) -> None:

@@ -175,9 +175,9 @@ def without_warm_up(monkeypatch: pytest.MonkeyPatch) -> None:
 
 def _rate(kernels: BlockKernels, x: np.ndarray, u: np.ndarray) -> np.ndarray:
     """``f`` of the pendulum kernels at one point (compiles the ``value`` kernel only)."""
-    rate, cost = np.empty(2), np.empty(1)
-    kernels.module.value(x, u, np.zeros(1), np.ones(2), rate, cost)
-    return rate
+    rate, cost = np.empty((1, 2)), np.empty((1, 1))
+    kernels.module.value_batch(x[None], u[None], np.zeros((1, 1)), np.ones((1, 2)), rate, cost)
+    return rate[0]
 
 
 def _pendulum_rate(gravity: float, x: np.ndarray, u: np.ndarray) -> np.ndarray:

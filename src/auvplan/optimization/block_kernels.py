@@ -11,6 +11,9 @@ weights) three node kernels are generated, with no mission quantity baked in:
 - ``hessian(y, u, p, w, λ, ν, D) -> (upper triangle of D̃ᵀ H D̃, ∇_y (ν l + λᵀ f))`` with
   ``H = ∇²_{(y,u)} (ν l + λᵀ f)``.
 
+Each is split in two (:func:`~auvplan.optimization._numba_codegen.split_stage`): what depends
+on ``u``, ``p`` and ``w`` alone (e.g. ``tanh`` of each input, a smooth actuator limit) is the
+same at every node of a step, and is computed once per step by ``name_stage``.
 They are translated to numba (:mod:`~auvplan.optimization._numba_codegen`) and cached on
 disk (:mod:`~auvplan.optimization._kernel_cache`) under a key made of the serialised ``f``
 and ``l``: the first mission with a model pays the compilation (seconds, logged), every
@@ -104,6 +107,7 @@ def closed_loop_batch(x0, alpha, mu, gains, p, w, h, n_sub, path, inputs, costs)
     y = np.empty(n_x)
     rate = np.empty(n_x)
     q = np.empty(1)
+    stage = np.empty(VALUE_STAGE_SIZE)
     factors, offsets = rk4_coefficients(h)
     for b in range(n_points):
         for t in range(n_x):
@@ -115,13 +119,14 @@ def closed_loop_batch(x0, alpha, mu, gains, p, w, h, n_sub, path, inputs, costs)
                 for j in range(n_x):
                     s += gains[b, k, i, j] * (alpha[b, k, j] - start[j])
                 inputs[b, k, i] = s
+            value_stage(start, inputs[b, k], p[b, k], w[b], stage)
             cost = 0.0
             for j in range(n_sub):
                 for t in range(n_x):
                     y[t] = start[t]
                     advanced[t] = start[t]
                 for i in range(4):
-                    value(y, inputs[b, k], p[b, k], w[b], rate, q)
+                    value(y, inputs[b, k], p[b, k], w[b], stage, rate, q)
                     cost += factors[i] * q[0]
                     for t in range(n_x):
                         advanced[t] += factors[i] * rate[t]
@@ -133,7 +138,8 @@ def closed_loop_batch(x0, alpha, mu, gains, p, w, h, n_sub, path, inputs, costs)
 """
 #: The derivative sweeps appended to every kernel module (as the closed loop, for numba's
 #: cache), through the ``4m`` nodes of :data:`LANES` points at once (the lane kernels
-#: ``first_lanes`` and ``hessian_lanes``; a last group short of points repeats its last point),
+#: ``first_lanes`` and ``hessian_lanes``, after their ``_stage_lanes`` once per group of points;
+#: a last group short of points repeats its last point),
 #: with the arithmetic of the chain rule (module notes) in the same order for every lane.
 #: ``forward_batch`` stores every node's point ``Y_n`` and ``D_n`` lane-major,
 #: ``points (n_nodes, G, n_x, LANES)`` and ``carried (n_nodes, G, n_d, LANES)`` (the ``n_d``
@@ -169,6 +175,7 @@ def forward_batch(x, u, p, w, h, n_sub, entries, points, carried, step_jac, cost
     w_lanes = np.empty((w.shape[1], LANES))
     total = np.empty(LANES)
     total_grad = np.empty((n_z, LANES))
+    stage = np.empty((FIRST_STAGE_SIZE, LANES))
     factors, offsets = rk4_coefficients(h)
     for g in range(points.shape[1]):
         first_point = g * LANES
@@ -176,6 +183,7 @@ def forward_batch(x, u, p, w, h, n_sub, entries, points, carried, step_jac, cost
         lanes_of(u, first_point, u_lanes)
         lanes_of(p, first_point, p_lanes)
         lanes_of(w, first_point, w_lanes)
+        first_stage_lanes(y, u_lanes, p_lanes, w_lanes, dy, stage)
         for t in range(n_d):
             dy[t, :] = 1.0 if entries[t] // n_z == entries[t] % n_z else 0.0
         total[:] = 0.0
@@ -187,8 +195,8 @@ def forward_batch(x, u, p, w, h, n_sub, entries, points, carried, step_jac, cost
             advanced_d[:, :] = dy
             carried[n, g] = dy
             for i in range(4):
-                first_lanes(points[n + i, g], u_lanes, p_lanes, w_lanes, carried[n + i, g], rate,
-                            q, rate_d, grad_d)
+                first_lanes(points[n + i, g], u_lanes, p_lanes, w_lanes, carried[n + i, g], stage,
+                            rate, q, rate_d, grad_d)
                 for lane in range(LANES):
                     total[lane] += factors[i] * q[0, lane]
                 for c in range(n_z):
@@ -237,12 +245,15 @@ def reverse_batch(points, carried, u, p, w, h, costate, cost_weight, total):
     u_lanes = np.empty((u.shape[1], LANES))
     p_lanes = np.empty((p.shape[1], LANES))
     w_lanes = np.empty((w.shape[1], LANES))
+    stage = np.empty((HESSIAN_STAGE_SIZE, LANES))
     for g in range(n_groups):
         first_point = g * LANES
         lanes_of(costate, first_point, y_bar)
         lanes_of(u, first_point, u_lanes)
         lanes_of(p, first_point, p_lanes)
         lanes_of(w, first_point, w_lanes)
+        hessian_stage_lanes(points[0, g], u_lanes, p_lanes, w_lanes, k_bar, weight, carried[0, g],
+                            stage)
         upper[:, :] = 0.0
         for j in range(n_nodes // 4 - 1, -1, -1):
             start_bar[:, :] = y_bar
@@ -254,7 +265,7 @@ def reverse_batch(points, carried, u, p, w, h, costate, cost_weight, total):
                             k_bar[t, lane] += offsets[i] * point_bar[t, lane]
                 weight[:, :] = cost_weight * factors[i]
                 hessian_lanes(points[4 * j + i, g], u_lanes, p_lanes, w_lanes, k_bar, weight,
-                              carried[4 * j + i, g], node_upper, point_bar)
+                              carried[4 * j + i, g], stage, node_upper, point_bar)
                 for t in range(n_upper):
                     for lane in range(LANES):
                         upper[t, lane] += node_upper[t, lane]
@@ -716,6 +727,7 @@ def block_kernels(
             _APPENDIX + carried,
             batched=("value",),
             lanes=("first", "hessian"),  # they run inside the sweeps only
+            stage_inputs=(1, 2, 3),  # u, p, w: the same at every node of a step
         )
 
     module, is_new = load_kernel_module(key, source, cache_dir)
