@@ -133,8 +133,11 @@ def measure(
     ``kernels-solve``: the solve alone, like the CasADi solvers' ``solve_s`` (their NLP built
     and compiled code loaded): a second solve in the process, with the model and every
     numba kernel loaded by the first (``wall_s`` is the second solve's).
-    ``kernels-2``/``kernels-solve-2``: alike with the stage evaluations on two threads
-    (``n_threads = 2``, as ``auvplan plan`` runs a coupled fleet on two cores).
+    ``kernels-projected``: the same from the CasADi solvers' start, PRONTO's projected
+    initial trajectory, solved as it is (``solve_pronto(…, projected=True)``: no projection
+    of the guess inside the time). ``kernels-2``/``kernels-solve-2``/``kernels-projected-2``:
+    alike with the stage evaluations on two threads (``n_threads = 2``, as ``auvplan plan``
+    runs a coupled fleet on two cores).
     ``max_iter`` caps the solver's iterations (for per-iteration timing). ``repeats``: a
     solve alone (``kernels-solve``, the CasADi solvers' ``solve_s``) is the fastest of that
     many solves in the process from the same start (``solves_s`` lists auvplan's), the same
@@ -190,11 +193,19 @@ def measure(
         cache.get(problem, backend)
         record["model_s"] = time.perf_counter() - started
         record["threads"] = threads
-        if kind == "kernels-solve":
-            solve_pronto(problem, guess, options=options, cache=cache)
+        if kind in ("kernels-solve", "kernels-projected"):
+            projected = kind == "kernels-projected"
+            start = (
+                project_guess(cache.get(problem, backend), guess, options)[0]
+                if projected
+                else guess
+            )
+            solve_pronto(problem, start, options=options, cache=cache, projected=projected)
             for _ in range(repeats):
                 started = time.perf_counter()
-                outcome = solve_pronto(problem, guess, options=options, cache=cache)
+                outcome = solve_pronto(
+                    problem, start, options=options, cache=cache, projected=projected
+                )
                 solves.append(time.perf_counter() - started)
             record.update(repeats=repeats, solves_s=solves)
         else:

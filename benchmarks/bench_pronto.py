@@ -20,9 +20,10 @@ stage Function and its derivatives compiled to C (``compiled=True``; the first r
 empty cache, compiles). A CasADi solve that reaches the optimum is set, by its solve alone
 (without building or compiling), against auvplan's warm stage 3 (in a fresh process: the
 model built and numba's cached kernels loaded, about 0.3 s) and against auvplan's solve
-alone (a second solve in the process, like for like); one that does not is marked. With
-``--repeats R`` every solve alone, auvplan's and the CasADi solvers', is the fastest of R in
-its process (the same solve from the same start).
+alone (a second solve in the process, like for like), also from the CasADi solvers' own
+start (PRONTO's projected initial trajectory, solved as it is: ``projected=True``); one that
+does not is marked. With ``--repeats R`` every solve alone, auvplan's and the CasADi
+solvers', is the fastest of R in its process (the same solve from the same start).
 
 Tables: (1) auvplan vs CasADi VM vs IPOPT: wall time, iterations, final cost, peak memory;
 (2) the targets of issues 12 and 27 (fleets of 4, 8, 16 and 32 for an hour, coupled and
@@ -132,6 +133,12 @@ def comparison(cases: tuple[str, ...], repeats: int = 1) -> str:
                 "auvplan, solve alone, 2 threads": run(
                     case, "kernels-solve-2", cold_cache, repeats=repeats
                 ),
+                "auvplan, solve alone from the CasADi solvers' start": run(
+                    case, "kernels-projected", cold_cache, repeats=repeats
+                ),
+                "auvplan, solve alone from the CasADi solvers' start, 2 threads": run(
+                    case, "kernels-projected-2", cold_cache, repeats=repeats
+                ),
                 "PRONTO on the CasADi VM": run(case, "casadi", cold_cache),
                 "CasADi + IPOPT (MX NLP)": run(case, "ipopt-mx", cold_cache, repeats=repeats),
             }
@@ -157,6 +164,8 @@ def comparison(cases: tuple[str, ...], repeats: int = 1) -> str:
             "auvplan, solve alone (model and kernels loaded)",
             "auvplan, warm cache, 2 threads",
             "auvplan, solve alone, 2 threads",
+            "auvplan, solve alone from the CasADi solvers' start",
+            "auvplan, solve alone from the CasADi solvers' start, 2 threads",
         ):
             if "error" not in records[label]:
                 lines.extend(_solve_ratios(case, label, records))

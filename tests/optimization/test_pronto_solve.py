@@ -11,7 +11,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from auvplan.errors import InputError
+from auvplan.errors import InputError, SolverError
 from auvplan.optimization import (
     PathConstraint,
     ProntoIteration,
@@ -20,6 +20,7 @@ from auvplan.optimization import (
     TrajectoryProblem,
     build_model,
     converged,
+    project_guess,
     pronto,
     solve_fatrop,
     solve_ipopt,
@@ -151,6 +152,53 @@ def test_max_iter_status() -> None:
     assert result.status is ProntoStatus.MAX_ITER
     assert len(result.history) == 2
     assert result.history[1].cost < result.history[0].cost
+
+
+@pytest.mark.parametrize("make_problem", [unicycle_problem, crossing_problem])
+def test_a_projected_guess_is_solved_as_it_is_with_the_same_iterates(make_problem) -> None:
+    """From ``P(guess)`` with ``projected=True``: the solve from the guess, to the bit."""
+    problem = make_problem()
+    guess, options = zero_guess(problem), ProntoOptions()
+    projected = project_guess(build_model(problem), guess, options)[0]
+    expected = solve_pronto(problem, guess, options=options)
+    result = solve_pronto(problem, projected, options=options, projected=True)
+    assert result.status is expected.status is ProntoStatus.CONVERGED
+    assert [r.cost for r in result.history] == [r.cost for r in expected.history]
+    np.testing.assert_array_equal(result.trajectory.states, expected.trajectory.states)
+    np.testing.assert_array_equal(result.regulator_gains, expected.regulator_gains)
+
+
+def test_a_projected_guess_without_a_direction_returns_its_regulator(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """No direction computed (the ladder failed at once): the regulator along the guess."""
+    problem = unicycle_problem()
+    options = ProntoOptions()
+    model = build_model(problem)
+    projected = project_guess(model, zero_guess(problem), options)[0]
+
+    def fail(*args: object, **kwargs: object) -> None:
+        raise SolverError("no descent direction")
+
+    monkeypatch.setattr(pronto, "compute_direction", fail)
+    result = solve_pronto(problem, projected, options=options, projected=True)
+    assert result.status is ProntoStatus.LINE_SEARCH_FAILED
+    assert result.history == ()
+    expected = pronto.first_order_model(model, projected, result.epsilon, result.delta).gains
+    np.testing.assert_array_equal(result.regulator_gains, expected)
+    assert np.any(result.regulator_gains != 0.0)
+
+
+def test_a_guess_that_is_not_a_trajectory_is_refused_as_projected() -> None:
+    problem = unicycle_problem()
+    projected = project_guess(build_model(problem), zero_guess(problem), ProntoOptions())[0]
+    off = dataclasses.replace(projected, states=projected.states.copy())
+    off.states[20, 1] += 1e-3
+    with pytest.raises(InputError, match=r"step 19 is off by 0\.001 in state 1"):
+        solve_pronto(problem, off, projected=True)
+    moved = dataclasses.replace(projected, states=projected.states + 0.5)
+    with pytest.raises(InputError, match="its start differs from x0"):
+        solve_pronto(problem, moved, projected=True)
 
 
 @pytest.mark.parametrize("make_problem", [unicycle_problem, crossing_problem])

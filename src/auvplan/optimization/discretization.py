@@ -69,6 +69,10 @@ class StepModel(Protocol):
         """Input dimension."""
         ...
 
+    def step(self, states: FloatArray, inputs: FloatArray, parameters: FloatArray) -> FloatArray:
+        """Next states ``F(x_k, u_k, p_k)``, shape ``(N, n_x)``."""
+        ...
+
     def cost(self, states: FloatArray, inputs: FloatArray, parameters: FloatArray) -> FloatArray:
         """Stage costs ``L(x_k, u_k, p_k)``, shape ``(N,)``."""
         ...

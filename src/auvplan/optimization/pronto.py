@@ -56,9 +56,36 @@ from auvplan.optimization.steps import (
     shift_decrement,
 )
 
-__all__ = ["check_guess", "final_result", "solve_pronto"]
+__all__ = ["check_guess", "check_trajectory", "final_result", "solve_pronto"]
 
 logger = logging.getLogger(__name__)
+
+
+#: Largest step defect ``|x_{k+1} − F(x_k, u_k)|`` of a guess given as a trajectory, relative to
+#: the largest state entry (rounding of a trajectory integrated by the same model: ~1e-16).
+TRAJECTORY_RTOL = 1e-9
+
+
+def check_trajectory(model: ProntoModel, trajectory: Trajectory) -> None:
+    """Check that ``trajectory`` is one of the discrete dynamics from the problem's ``x0``.
+
+    Raises
+    ------
+    InputError
+        If it does not start at ``x0`` or a step is off by more than :data:`TRAJECTORY_RTOL`.
+    """
+    problem = model.problem
+    states = trajectory.states
+    stepped = model.discrete.step(states[:-1], trajectory.inputs, problem.parameters)
+    defects = np.abs(np.vstack([states[:1] - problem.initial_state, states[1:] - stepped]))
+    scale = max(1.0, float(np.max(np.abs(states))))
+    worst = np.unravel_index(int(np.argmax(defects)), defects.shape)
+    if defects[worst] > TRAJECTORY_RTOL * scale:
+        where = "its start differs from x0" if worst[0] == 0 else f"step {worst[0] - 1} is off"
+        raise InputError(
+            f"the guess is not a trajectory of the dynamics ({where} by {defects[worst]:.3g} in "
+            f"state {worst[1]}): solve it with projected=False"
+        )
 
 
 def check_guess(problem: TrajectoryProblem, guess: Trajectory) -> None:
@@ -87,7 +114,8 @@ class _State:
     """Mutable loop state of :func:`solve_pronto` (private)."""
 
     trajectory: Trajectory
-    gains: FloatArray
+    gains: FloatArray | None
+    """The last regulator (``None`` until the first direction, when the guess was not projected)."""
     delta: float
     n_iter: int = 0
     history: list[ProntoIteration] = field(default_factory=list)
@@ -429,6 +457,7 @@ def solve_pronto(
     options: ProntoOptions | None = None,
     callback: Callable[[ProntoIteration], None] | None = None,
     cache: ModelCache | None = None,
+    projected: bool = False,
 ) -> ProntoResult:
     """Minimise the problem's objective with discrete-time PRONTO (and barrier continuation).
 
@@ -438,7 +467,7 @@ def solve_pronto(
         Dynamics, costs, constraints, grid.
     guess : Trajectory
         Initial curve; need not satisfy the dynamics nor the constraints (it is projected
-        with a regulator designed along it).
+        with a regulator designed along it), unless ``projected``.
     options : ProntoOptions, optional
         Solver options (defaults: ``ProntoOptions()``).
     callback : callable, optional
@@ -446,6 +475,10 @@ def solve_pronto(
         ``StopIteration`` stops the solve (status ``MAX_ITER``).
     cache : ModelCache, optional
         Where to look up (and keep) the problem's model; default: build it for this call.
+    projected : bool
+        The guess is already a trajectory of the dynamics from ``x0`` (a projected guess, or
+        an earlier solve's trajectory, as the CasADi reference solvers start from): it is the
+        first iterate as it is, without a projection (checked: :func:`check_trajectory`).
 
     Returns
     -------
@@ -455,7 +488,8 @@ def solve_pronto(
     Raises
     ------
     InputError
-        If the guess has the wrong shape or non-finite values.
+        If the guess has the wrong shape or non-finite values, or is not a trajectory of the
+        dynamics although ``projected``.
     SolverError
         If the projection of the guess diverges.
 
@@ -481,11 +515,19 @@ def solve_pronto(
     # The solver's linear algebra is on matrices of tens of rows, stage by stage: BLAS threads
     # only add synchronisation (3x slower eigen-decompositions on two cores).
     with _blas_pools().limit(limits=1, user_api="blas"):
-        trajectory, gains = project_guess(model, guess, options)
-        state = _State(trajectory, gains, options.delta_initial)
+        if projected:
+            check_trajectory(model, guess)
+            state = _State(guess, None, options.delta_initial)
+        else:
+            state = _State(*project_guess(model, guess, options), options.delta_initial)
         status, message, epsilon = _continuation(model, state, options, start, callback)
+        gains = state.gains
+        if gains is None:  # no direction was computed
+            gains = first_order_model(
+                model, state.trajectory, epsilon, state.delta, options=options
+            ).gains
         return final_result(
-            model, state.trajectory, state.gains, status=status, message=message,
+            model, state.trajectory, gains, status=status, message=message,
             epsilon=epsilon, delta=state.delta, n_iter=state.n_iter,
             history=tuple(state.history), options=options, start=start,
         )  # fmt: skip
