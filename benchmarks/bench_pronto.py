@@ -4,7 +4,7 @@ Run once and print every table (all ratios from this one run, on this machine)::
 
     .venv/bin/python benchmarks/bench_pronto.py           # comparison, targets, scaling
     .venv/bin/python benchmarks/bench_pronto.py --quick   # the crossing only
-    .venv/bin/python benchmarks/bench_pronto.py --quick --repeats 3   # solves alone: best of 3
+    .venv/bin/python benchmarks/bench_pronto.py --quick --repeats 10  # solves alone: best of 10
 
 Cases are real missions up to the stage-3 problem (:mod:`_fleet`): ``demo`` is the built-in
 two-MEDUSA crossing (600 s, ``dt_s`` 0.5, propeller order 3) optimised energy-only, and

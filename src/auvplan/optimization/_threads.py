@@ -35,7 +35,7 @@ _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
 MMAP_THRESHOLD = 32 << 20
 
 
-def keep_freed_memory() -> bool:
+def keep_freed_memory() -> None:
     """Let glibc reuse the memory of freed arrays below :data:`MMAP_THRESHOLD` (process-wide).
 
     An iteration frees arrays of a few MiB (sweeps, Hessians, clipped weights) and the next
@@ -45,16 +45,12 @@ def keep_freed_memory() -> bool:
     than 60 on one). With the thresholds fixed at the values glibc's dynamic rule
     reaches at most (``M_MMAP_THRESHOLD`` 32 MiB, ``M_TRIM_THRESHOLD`` 64 MiB), under 100.
     Arrays from 32 MiB up are still mapped and unmapped one by one, so a large fleet's
-    memory is returned as before. Returns whether it was set (glibc only; elsewhere nothing
-    changes).
+    memory is returned as before. glibc only: elsewhere nothing changes.
     """
-    if platform.libc_ver()[0] != "glibc":
-        return False
-    libc = ctypes.CDLL(None)
-    return bool(
+    if platform.libc_ver()[0] == "glibc":
+        libc = ctypes.CDLL(None)
         libc.mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD)
-        and libc.mallopt(_M_TRIM_THRESHOLD, 2 * MMAP_THRESHOLD)
-    )
+        libc.mallopt(_M_TRIM_THRESHOLD, 2 * MMAP_THRESHOLD)
 
 
 @functools.cache
