@@ -190,16 +190,12 @@ def measure(
             **{**options.__dict__, "stage_kernels": backend.stage_kernels, "n_threads": threads}
         )
         cache = ModelCache()
-        cache.get(problem, backend)
+        model = cache.get(problem, backend)
         record["model_s"] = time.perf_counter() - started
         record["threads"] = threads
         if kind in ("kernels-solve", "kernels-projected"):
             projected = kind == "kernels-projected"
-            start = (
-                project_guess(cache.get(problem, backend), guess, options)[0]
-                if projected
-                else guess
-            )
+            start = project_guess(model, guess, options)[0] if projected else guess
             solve_pronto(problem, start, options=options, cache=cache, projected=projected)
             for _ in range(repeats):
                 started = time.perf_counter()
