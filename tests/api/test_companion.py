@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+import operator
 from pathlib import Path
 
 import pytest
@@ -43,25 +44,16 @@ def test_warm_up_runs_once_per_machine_and_settings(
     assert warm_marker(other) != marker  # other settings, other kernels
 
 
-class _Failed:
-    """A finished task whose warm-up raised."""
-
-    def ready(self) -> bool:
-        return True
-
-    def get(self) -> None:
-        raise RuntimeError("a vehicle file the small mission cannot fly")
-
-
 def test_a_failed_warm_up_is_logged_not_marked(
     tmp_path: Path, caplog: pytest.LogCaptureFixture
 ) -> None:
-    companion = Companion()
-    companion._warm_up = (_Failed(), tmp_path / "marker", 0.0)  # type: ignore[assignment]
-    with caplog.at_level(logging.INFO, logger="auvplan.api.companion"):
-        companion.wait_for_warm_up()
+    with Companion() as companion:
+        companion.start().submit(operator.truediv, 1, 0)  # a warm-up that raises there
+        companion._warm_up = (tmp_path / "marker", 0.0)
+        with caplog.at_level(logging.INFO, logger="auvplan.api.companion"):
+            companion.wait_for_warm_up()
     assert not (tmp_path / "marker").exists()
-    assert "kernel warm-up failed (a vehicle file the small mission cannot fly)" in caplog.text
+    assert "kernel warm-up failed (division by zero)" in caplog.text
 
 
 def test_plan_with_a_second_process_writes_the_whole_folder(

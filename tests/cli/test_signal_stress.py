@@ -6,7 +6,8 @@ process competing for the cores, and delivers SIGTERM to the process or SIGINT t
 process group (what Ctrl-C in a terminal does) at a moment drawn uniformly over the run.
 Whatever the moment, the promise is:
 
-* exit 0 (the signal came after the work), 130 (SIGINT) or 143 (SIGTERM), never a crash;
+* exit 0 (the signal came after the work), 130 (SIGINT) or 143 (SIGTERM), never a crash
+  and never a hang (a run still going :data:`HANG_S` after its signal is killed and reported);
 * stderr empty (``-q``) or exactly ``auvplan: interrupted`` / ``auvplan: terminated``;
 * the folder holds the complete old output or the complete new one (every file the run
   writes new, the user's own file kept), never a mixture, and no hidden ``.partial``/``.old``;
@@ -35,6 +36,8 @@ REPO = Path(__file__).parents[2]
 MISSION = REPO / "tests" / "regression" / "golden_mission.toml"
 SLOW_TRIALS = 200
 OLD = b"old output\n"
+#: A run still going this long after its signal hangs [s].
+HANG_S = 120.0
 pytestmark = pytest.mark.skipif(not Path("/proc/self/status").is_file(), reason="needs Linux /proc")
 
 
@@ -145,7 +148,12 @@ def _trial(root: Path, files: list[str], duration_s: float, rng: random.Random) 
             os.killpg(process.pid, signal.SIGINT)  # Ctrl-C: every process of the group
         else:
             process.send_signal(signal.SIGTERM)
-    _, stderr = process.communicate(timeout=120)
+    try:
+        _, stderr = process.communicate(timeout=HANG_S)
+    except subprocess.TimeoutExpired:  # a hang is a broken promise, and nothing left running
+        os.killpg(process.pid, signal.SIGKILL)
+        _, stderr = process.communicate()
+        stderr = f"{stderr}[hung: killed after {HANG_S:.0f} s]"
     time.sleep(0.2)  # a worker that outlived the main process would still be here
     orphans = _processes_with(token)
     for pid in orphans:

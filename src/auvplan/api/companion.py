@@ -32,22 +32,19 @@ import hashlib
 import importlib
 import io
 import logging
-import multiprocessing
 import os
 import time
 import warnings
 from contextlib import AbstractContextManager
-from multiprocessing import resource_tracker
-from multiprocessing.pool import AsyncResult, Pool
 from pathlib import Path
 from types import TracebackType
-from typing import TYPE_CHECKING, Final, TypeVar
+from typing import TYPE_CHECKING, Final
 
 import numba
 
 import auvplan
+from auvplan._worker import WorkerProcess
 from auvplan.errors import InputError
-from auvplan.interrupts import checkpoint, children_ignore_ctrl_c
 from auvplan.mission.config import MissionConfig
 from auvplan.mission.warmup import warm_up, warm_up_missions
 from auvplan.optimization._kernel_cache import cache_root
@@ -57,10 +54,7 @@ if TYPE_CHECKING:
     from auvplan.mission.pipeline import MissionResult
 
 logger = logging.getLogger(__name__)
-T = TypeVar("T")
 
-#: How often a wait for the worker checks for a stop request, in seconds.
-POLL_S: Final = 0.05
 #: The figures that the worker draws: about half of the drawing time of a run (the maps,
 #: coordination and separation figures take about as long as these).
 WORKER_FIGURES: Final = frozenset({"paths", "paths_cost", "paths_energy_only", "time_series"})
@@ -87,48 +81,44 @@ class Companion(AbstractContextManager["Companion"]):
     """The worker process (module notes); started on first use, stopped on exit."""
 
     def __init__(self) -> None:
-        self._pool: Pool | None = None
-        self._warm_up: tuple[AsyncResult[None], Path, float] | None = None
+        self._worker: WorkerProcess | None = None
+        self._warm_up: tuple[Path, float] | None = None  # marker, start [s]: sent, not read
 
-    def start(self) -> None:
+    def start(self) -> WorkerProcess:
         """Spawn the worker now, so that its imports overlap the mission's own work."""
-        if self._pool is None:
-            context = multiprocessing.get_context("spawn")
-            # multiprocessing's resource tracker, started on first need, unblocks SIGINT
-            # when it has started: start it before, so that the block below holds
-            resource_tracker.ensure_running()
-            with children_ignore_ctrl_c():  # Ctrl-C is this process's to handle
-                self._pool = context.Pool(1, initializer=_prepare)
+        if self._worker is None:
+            self._worker = WorkerProcess("spawn", _prepare, name="auvplan-companion")
+        return self._worker
 
     def warm_up(self, config: MissionConfig) -> bool:
         """Start the warm-up of ``config`` unless it already ran here; True if it started."""
         marker = warm_marker(config)
         if marker.exists():
             return False
-        self.start()
-        assert self._pool is not None
+        worker = self.start()
         logger.info(
             "first run with these vehicles and solver settings: compiling the optimiser's "
             "kernels in a second process (once)"
         )
-        task = self._pool.apply_async(warm_up, (config,))
-        self._warm_up = (task, marker, time.perf_counter())
+        worker.submit(warm_up, config)
+        self._warm_up = (marker, time.perf_counter())
         return True
 
     def wait_for_warm_up(self) -> None:
         """Wait for a running warm-up to finish (:meth:`_finish_warm_up`)."""
         if self._warm_up is not None:
-            if not self._warm_up[0].ready():
+            if not (self._worker is not None and self._worker.ready()):
                 logger.info("waiting for the optimiser's kernels (compiling in a second process)")
             self._finish_warm_up()
 
     def _finish_warm_up(self) -> None:
         """Mark a finished warm-up done, or log why it failed (the mission then compiles)."""
         assert self._warm_up is not None
-        task, marker, started = self._warm_up
+        assert self._worker is not None
+        marker, started = self._warm_up
         self._warm_up = None
         try:
-            _result(task)
+            self._worker.result()
         except Exception as error:  # noqa: BLE001 (the mission compiles what it needs itself)
             logger.info("kernel warm-up failed (%s); the optimiser compiles its kernels", error)
             return
@@ -145,23 +135,31 @@ class Companion(AbstractContextManager["Companion"]):
         """The figures of ``result`` (:func:`~auvplan.viz.report.render_mission_figures`).
 
         The worker renders those of :data:`WORKER_FIGURES` while this process renders the
-        rest; the run is pickled over (a few MB).
+        rest; the run is pickled over (a few MB). A warm-up still running is waited for
+        first (the worker does one thing at a time).
         """
         from auvplan.viz.report import figure_builders, render_mission_figures
 
         stems = list(figure_builders(result))
         theirs = [stem for stem in stems if stem in WORKER_FIGURES]
-        self.start()
-        assert self._pool is not None
+        self.wait_for_warm_up()
+        worker = self.start()
         draw = functools.partial(render_mission_figures, figure_format=figure_format, dpi=dpi)
-        task = self._pool.apply_async(draw, (result,), {"stems": theirs})
-        ours = draw(result, stems=set(stems) - set(theirs))
+        failure: Exception | None = None
         try:
-            drawn: dict[str, RenderedFigure] = _result(task)
-            rendered = {**ours, **drawn}
+            worker.submit(functools.partial(draw, stems=theirs), result)
         except Exception as error:  # noqa: BLE001 (e.g. a result that does not pickle)
-            logger.info("figures of the second process failed (%s); drawing them here", error)
-            rendered = {**ours, **draw(result, stems=theirs)}
+            failure = error
+        ours = draw(result, stems=set(stems) - set(theirs))
+        if failure is None:
+            try:
+                drawn: dict[str, RenderedFigure] = worker.result()
+            except Exception as error:  # noqa: BLE001 (e.g. the worker was killed)
+                failure = error
+        if failure is not None:
+            logger.info("figures of the second process failed (%s); drawing them here", failure)
+            drawn = draw(result, stems=theirs)
+        rendered = {**ours, **drawn}
         return {stem: rendered[stem] for stem in stems}
 
     def close(self) -> None:
@@ -170,12 +168,11 @@ class Companion(AbstractContextManager["Companion"]):
         A warm-up still compiling is abandoned (numba writes its cache files whole or not
         at all); a finished one is marked done.
         """
-        if self._warm_up is not None and self._warm_up[0].ready():
+        if self._warm_up is not None and self._worker is not None and self._worker.ready():
             self._finish_warm_up()
-        if self._pool is not None:
-            self._pool.terminate()
-            self._pool.join()
-            self._pool = None
+        if self._worker is not None:
+            self._worker.close()
+            self._worker = None
 
     def __exit__(
         self,
@@ -186,20 +183,12 @@ class Companion(AbstractContextManager["Companion"]):
         self.close()
 
 
-def _result(task: AsyncResult[T]) -> T:
-    """``task.get()``, honouring stop requests while it waits (the worker runs on)."""
-    while not task.ready():
-        task.wait(POLL_S)
-        checkpoint()
-    return task.get()
-
-
 def _prepare() -> None:
     """The worker's start: import what it will run while the mission's process plans.
 
-    It ignores SIGINT (it was started with SIGINT blocked, :func:`children_ignore_ctrl_c`):
-    Ctrl-C in a terminal reaches every process of the group, and the mission's process, which
-    reports it, stops the worker (:meth:`Companion.close`). Its logs
+    It ignores SIGINT (:class:`~auvplan._worker.WorkerProcess`): Ctrl-C in a terminal
+    reaches every process of the group, and the mission's process, which reports it, stops
+    the worker (:meth:`Companion.close`). Its logs
     and warnings are dropped: the mission's process reports.
     """
     logging.getLogger("auvplan").addHandler(logging.NullHandler())

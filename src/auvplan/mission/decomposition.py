@@ -40,19 +40,17 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
-import multiprocessing
 import time
 from collections.abc import Callable
 from contextlib import nullcontext
 from dataclasses import dataclass, field
-from multiprocessing.connection import Connection
 from typing import Final, Self
 
 import numpy as np
 
 from auvplan._typing import FloatArray, IntArray
+from auvplan._worker import WorkerLost, WorkerProcess
 from auvplan.errors import SolverError
-from auvplan.interrupts import checkpoint, children_ignore_ctrl_c
 from auvplan.mission.assembly import AssembledProblem, fleet_problem
 from auvplan.mission.fleet import FleetLayout, FleetWeights, build_fleet_functions
 from auvplan.mission.preplan import PreplanStage
@@ -85,8 +83,6 @@ NEGLIGIBLE_SLACK: Final = 10.0
 MOVE_ALLOWANCE: Final = 30.0
 #: Offset [m] of a parked neighbour slot from the vehicle's own desired position.
 PARKED: Final = 1.0e6
-#: How often [s] a wait for the second process looks for a stop request.
-HELPER_POLL_S: Final = 0.2
 
 
 def neighbour_reach(separation: float) -> float:
@@ -434,54 +430,49 @@ def _solve_vehicle(
 class _Helper:
     """A second process that solves one vehicle's problem while this one solves another.
 
-    Forked, so it starts with the fleet's problems; it ignores Ctrl-C (this process stops
-    it) and is killed when the block ends, finished or not.
+    Forked (:class:`~auvplan._worker.WorkerProcess`), so it starts with the fleet's
+    problems and keeps its own copies of the vehicles' problems and caches; it ignores
+    Ctrl-C (this process stops it) and is killed when the block ends, finished or not.
     """
 
     def __init__(self, fleet: _Fleet, vehicles: list[_Vehicle]) -> None:
-        context = multiprocessing.get_context("fork")
-        self._connection, child = context.Pipe()
-        with children_ignore_ctrl_c():
-            self._process = context.Process(
-                target=_serve, args=(child, fleet, vehicles), daemon=True
-            )
-            self._process.start()
-        child.close()
+        self._worker = WorkerProcess("fork", _adopt, (fleet, vehicles), name="auvplan-fleet")
 
     def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *_exc: object) -> None:
-        self._process.kill()
-        self._process.join()
-        self._connection.close()
+        self._worker.close()
 
     def submit(self, vehicle: _Vehicle, where: FloatArray, options: ProntoOptions) -> None:
         """Start solving ``vehicle`` (at its latest trajectory and ``δ``) against ``where``."""
-        self._connection.send((vehicle.index, vehicle.trajectory, where, options))
+        self._worker.submit(_solve_adopted, vehicle.index, vehicle.trajectory, where, options)
 
     def result(self) -> tuple[ProntoResult, frozenset[int], int]:
         """What :func:`_solve_vehicle` returned in the helper; its error raised here."""
-        while not self._connection.poll(HELPER_POLL_S):
-            checkpoint()
-            if not self._process.is_alive():
-                raise SolverError("the optimiser's second process ended unexpectedly")
-        kind, value = self._connection.recv()
-        if kind == "error":
-            raise value
-        return value  # type: ignore[no-any-return]
-
-
-def _serve(connection: Connection, fleet: _Fleet, vehicles: list[_Vehicle]) -> None:
-    """The helper's loop: solve each vehicle sent, send back the outcome or the error."""
-    while True:
-        index, trajectory, where, options = connection.recv()
-        vehicle = vehicles[index]
-        vehicle.trajectory = trajectory
         try:
-            connection.send(("ok", _solve_vehicle(fleet, vehicle, where, options)))
-        except Exception as error:  # noqa: BLE001 (sent to the parent, which raises it)
-            connection.send(("error", error))
+            return self._worker.result()  # type: ignore[no-any-return]
+        except WorkerLost as error:
+            raise SolverError(f"the optimiser's second process failed: {error}") from error
+
+
+#: In the helper process only: the fleet and vehicles it was forked with (:func:`_adopt`).
+_adopted: list[tuple[_Fleet, list[_Vehicle]]] = []
+
+
+def _adopt(fleet: _Fleet, vehicles: list[_Vehicle]) -> None:
+    """The helper's start: keep the fleet and its vehicles for :func:`_solve_adopted`."""
+    _adopted[:] = [(fleet, vehicles)]
+
+
+def _solve_adopted(
+    index: int, trajectory: Trajectory, where: FloatArray, options: ProntoOptions
+) -> tuple[ProntoResult, frozenset[int], int]:
+    """In the helper: :func:`_solve_vehicle` for vehicle ``index`` from ``trajectory``."""
+    fleet, vehicles = _adopted[0]
+    vehicle = vehicles[index]
+    vehicle.trajectory = trajectory
+    return _solve_vehicle(fleet, vehicle, where, options)
 
 
 def _fleet_result(
