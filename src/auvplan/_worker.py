@@ -24,6 +24,7 @@ import multiprocessing
 from collections.abc import Callable
 from multiprocessing import resource_tracker
 from multiprocessing.connection import Connection
+from multiprocessing.context import ForkContext, SpawnContext
 from multiprocessing.reduction import ForkingPickler
 from typing import Any, Final, Literal, Self
 
@@ -62,15 +63,13 @@ class WorkerProcess:
         *,
         name: str = "auvplan-worker",
     ) -> None:
-        context = (
-            multiprocessing.get_context("fork")
-            if method == "fork"
-            else multiprocessing.get_context("spawn")
-        )
-        if method != "fork":
+        if method == "fork":
+            context: ForkContext | SpawnContext = multiprocessing.get_context("fork")
+        else:
             # a spawned start uses multiprocessing's resource tracker, which unblocks SIGINT
             # when it starts: start it first, so that the block below holds
             resource_tracker.ensure_running()
+            context = multiprocessing.get_context("spawn")
         self._connection, child = context.Pipe()
         with children_ignore_ctrl_c():  # Ctrl-C is this process's to handle
             self._process = context.Process(

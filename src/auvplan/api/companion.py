@@ -107,7 +107,8 @@ class Companion(AbstractContextManager["Companion"]):
     def wait_for_warm_up(self) -> None:
         """Wait for a running warm-up to finish (:meth:`_finish_warm_up`)."""
         if self._warm_up is not None:
-            if not (self._worker is not None and self._worker.ready()):
+            assert self._worker is not None
+            if not self._worker.ready():
                 logger.info("waiting for the optimiser's kernels (compiling in a second process)")
             self._finish_warm_up()
 
@@ -168,9 +169,9 @@ class Companion(AbstractContextManager["Companion"]):
         A warm-up still compiling is abandoned (numba writes its cache files whole or not
         at all); a finished one is marked done.
         """
-        if self._warm_up is not None and self._worker is not None and self._worker.ready():
-            self._finish_warm_up()
         if self._worker is not None:
+            if self._warm_up is not None and self._worker.ready():
+                self._finish_warm_up()
             self._worker.close()
             self._worker = None
 
